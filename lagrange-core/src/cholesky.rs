@@ -1,0 +1,67 @@
+//! Fixed-size Cholesky solve of `M x = b` for a symmetric positive definite mass matrix.
+
+use crate::{Error, Real};
+use nalgebra::{SMatrix, SVector};
+
+/// Solves `m x = b` for symmetric positive definite `m` by Cholesky factorisation, on the
+/// stack, reading only the lower triangle.
+///
+/// A pivot that is not positive, or that lost every significant digit to cancellation
+/// (below `EPSILON` times its diagonal entry), means `m` is singular or indefinite.
+///
+/// # Errors
+/// [`Error::SingularMassMatrix`] with the index of the failing pivot.
+///
+/// ```
+/// use lagrange_core::{solve_spd, Error};
+/// use nalgebra::{Matrix2, Vector2};
+/// let x = solve_spd(&Matrix2::<f64>::new(4.0, 2.0, 2.0, 3.0), &Vector2::new(2.0, 1.0))?;
+/// assert!((x[0] - 0.5).abs() < 1e-15 && x[1].abs() < 1e-15);
+/// assert_eq!(
+///     solve_spd(&Matrix2::new(1.0, 1.0, 1.0, 1.0), &Vector2::new(1.0, 1.0)),
+///     Err(Error::SingularMassMatrix { pivot: 1 })
+/// );
+/// # Ok::<(), Error>(())
+/// ```
+pub fn solve_spd<T: Real, const N: usize>(
+    m: &SMatrix<T, N, N>,
+    b: &SVector<T, N>,
+) -> Result<SVector<T, N>, Error> {
+    let mut l = SMatrix::<T, N, N>::zeros();
+    for j in 0..N {
+        let mut d = m[(j, j)];
+        for k in 0..j {
+            d -= l[(j, k)] * l[(j, k)];
+        }
+        // `!(d > tol)` also catches NaN.
+        if !(d > m[(j, j)].abs() * T::EPSILON) {
+            return Err(Error::SingularMassMatrix { pivot: j });
+        }
+        let ljj = d.sqrt();
+        l[(j, j)] = ljj;
+        for i in j + 1..N {
+            let mut s = m[(i, j)];
+            for k in 0..j {
+                s -= l[(i, k)] * l[(j, k)];
+            }
+            l[(i, j)] = s / ljj;
+        }
+    }
+    // Forward substitution L y = b, then back substitution L^T x = y, in place.
+    let mut x = *b;
+    for i in 0..N {
+        let mut s = x[i];
+        for k in 0..i {
+            s -= l[(i, k)] * x[k];
+        }
+        x[i] = s / l[(i, i)];
+    }
+    for i in (0..N).rev() {
+        let mut s = x[i];
+        for k in i + 1..N {
+            s -= l[(k, i)] * x[k];
+        }
+        x[i] = s / l[(i, i)];
+    }
+    Ok(x)
+}

@@ -1,0 +1,62 @@
+//! The error type shared by every lagrange crate.
+
+use core::fmt;
+
+/// Everything that can go wrong in building or stepping a mechanism.
+///
+/// Small and `Copy`, so that it costs nothing to return from a hot loop; no variant allocates.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[non_exhaustive]
+pub enum Error {
+    /// A constructor or method was given a parameter it cannot use.
+    InvalidParameter {
+        /// The parameter's name as it appears in the signature.
+        name: &'static str,
+        /// Why it was refused, e.g. "must be positive and finite".
+        reason: &'static str,
+    },
+    /// A state (time, coordinate or velocity) holds NaN or an infinity.
+    NonFiniteState,
+    /// The mass matrix is singular or not positive definite: the Cholesky pivot at this index
+    /// was not positive.
+    SingularMassMatrix {
+        /// Index of the first pivot that was zero, negative or NaN.
+        pivot: usize,
+    },
+    /// The coordinates are at a singular configuration of the mechanism, where its equations
+    /// of motion are undefined (e.g. a spherical pendulum exactly at a pole).
+    Singularity {
+        /// Which configuration, e.g. "sin(th) = 0".
+        what: &'static str,
+    },
+    /// An iterative solve did not converge.
+    NoConvergence {
+        /// How many iterations were spent.
+        iterations: u32,
+    },
+    /// An adaptive integrator needed a step smaller than its minimum.
+    StepSizeUnderflow,
+}
+
+impl fmt::Display for Error {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::InvalidParameter { name, reason } => {
+                write!(f, "invalid parameter `{name}`: {reason}")
+            }
+            Self::NonFiniteState => f.write_str("state is not finite (NaN or infinity)"),
+            Self::SingularMassMatrix { pivot } => write!(
+                f,
+                "mass matrix is singular or not positive definite (pivot {pivot})"
+            ),
+            Self::Singularity { what } => write!(f, "singular configuration: {what}"),
+            Self::NoConvergence { iterations } => {
+                write!(f, "no convergence after {iterations} iterations")
+            }
+            Self::StepSizeUnderflow => f.write_str("step size fell below its minimum"),
+        }
+    }
+}
+
+impl core::error::Error for Error {}

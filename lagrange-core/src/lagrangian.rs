@@ -1,0 +1,211 @@
+//! Automatic Euler-Lagrange: write `T` and `V` once, generic over a [`Scalar`], and get the
+//! equations of motion by differentiating them with nested [`Dual`] numbers.
+
+use crate::{Dual, Mechanism, Real, Scalar, State};
+use nalgebra::{SMatrix, SVector};
+
+/// A mechanism given by its Lagrangian `L = T - V`, written generic over the scalar so that it
+/// can be both evaluated (`S = f64`) and differentiated (`S` a [`Dual`] number).
+///
+/// Convert parameters with [`Scalar::from_real`] and literals with [`Scalar::from_f64`]; do all
+/// math through [`Scalar`]'s methods. Wrap it in [`EulerLagrange`] to get a [`Mechanism`].
+///
+/// ```
+/// use lagrange_core::{EulerLagrange, Lagrangian, Mechanism, Scalar, State};
+/// use nalgebra::SVector;
+///
+/// /// A pendulum of length `l` in gravity `g`, unit mass.
+/// struct Pendulum { l: f64, g: f64 }
+///
+/// impl Lagrangian<f64, 1> for Pendulum {
+///     fn kinetic<S: Scalar<Real = f64>>(&self, _t: S, _q: &SVector<S, 1>, qd: &SVector<S, 1>) -> S {
+///         let l = S::from_real(self.l);
+///         S::from_f64(0.5) * l * l * qd[0] * qd[0]
+///     }
+///     fn potential<S: Scalar<Real = f64>>(&self, _t: S, q: &SVector<S, 1>) -> S {
+///         -S::from_real(self.g * self.l) * q[0].cos()
+///     }
+/// }
+///
+/// let m = EulerLagrange::new(Pendulum { l: 1.0, g: 9.81 });
+/// let a = m.acceleration(&State::new(0.0, [0.5], [0.0]))?;
+/// assert!((a[0] + 9.81 * 0.5f64.sin()).abs() < 1e-14);
+/// # Ok::<(), lagrange_core::Error>(())
+/// ```
+pub trait Lagrangian<T: Real, const N: usize> {
+    /// True when the kinetic energy depends on `t` explicitly (a driven mechanism written in
+    /// a fixed frame), so that `d2L/dq'dt` is needed: one more dual evaluation per call.
+    const EXPLICIT_TIME: bool = false;
+
+    /// Every term of `L` that depends on the velocities: the kinetic energy `T(t, q, q')`.
+    fn kinetic<S: Scalar<Real = T>>(&self, t: S, q: &SVector<S, N>, qd: &SVector<S, N>) -> S;
+
+    /// The potential energy `V(t, q)`.
+    fn potential<S: Scalar<Real = T>>(&self, t: S, q: &SVector<S, N>) -> S;
+
+    /// Non-conservative generalized forces `Q` (damping, inputs); zero by default.
+    fn non_conservative_force(&self, state: &State<T, N>) -> SVector<T, N> {
+        let _ = state;
+        SVector::zeros()
+    }
+}
+
+/// First derivatives along the coordinates.
+type D1<T, const N: usize> = Dual<T, N>;
+/// Second derivatives: an outer direction over an inner one.
+type D2<T, const N: usize> = Dual<Dual<T, N>, N>;
+
+/// The [`Mechanism`] a [`Lagrangian`] defines, with
+///
+/// ```text
+/// M   = d2T/dq'dq'
+/// f   = dT/dq - dV/dq - (d2T/dq'dq) q' - d2T/dq'dt
+/// ```
+///
+/// each entry exact to rounding, from forward-mode dual numbers: one nested evaluation of `T`
+/// for `M`, one nested evaluation of `T` and one plain dual evaluation of `V` for `f` (and one
+/// more of `T` when [`Lagrangian::EXPLICIT_TIME`]). No symbolic step, no heap. This is both the
+/// general path for a user's own mechanism and the oracle the hand-derived systems are tested
+/// against.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct EulerLagrange<L> {
+    lagrangian: L,
+}
+
+impl<L> EulerLagrange<L> {
+    /// The mechanism of `lagrangian`.
+    pub fn new(lagrangian: L) -> Self {
+        Self { lagrangian }
+    }
+    /// The Lagrangian.
+    #[must_use]
+    pub fn lagrangian(&self) -> &L {
+        &self.lagrangian
+    }
+}
+
+/// `x` as a second-order dual constant.
+fn d2_constant<T: Real, const N: usize>(x: T) -> D2<T, N> {
+    D2::constant(D1::constant(x))
+}
+
+impl<T: Real, const N: usize, L: Lagrangian<T, N>> Mechanism<T, N> for EulerLagrange<L> {
+    fn mass_matrix(&self, s: &State<T, N>) -> SMatrix<T, N, N> {
+        // Velocities seeded in both the outer and the inner direction:
+        // r.eps[k].eps[i] = d2T/dq'_k dq'_i.
+        let q = s.q.map(d2_constant);
+        let qd = SVector::<D2<T, N>, N>::from_fn(|k, _| D2::variable(D1::variable(s.qd[k], k), k));
+        let r = self.lagrangian.kinetic(d2_constant(s.t), &q, &qd);
+        SMatrix::from_fn(|i, k| r.eps[k].eps[i])
+    }
+
+    fn rhs(&self, s: &State<T, N>) -> SVector<T, N> {
+        // Outer direction k on q_k, inner direction i on q'_i: r.eps[k].re = dT/dq_k and
+        // r.eps[k].eps[i] = d2T/dq_k dq'_i.
+        let inner_qd =
+            SVector::<D2<T, N>, N>::from_fn(|i, _| D2::constant(D1::variable(s.qd[i], i)));
+        let outer_q = SVector::<D2<T, N>, N>::from_fn(|k, _| D2::variable(D1::constant(s.q[k]), k));
+        let r = self
+            .lagrangian
+            .kinetic(d2_constant(s.t), &outer_q, &inner_qd);
+
+        let v = self.lagrangian.potential(
+            D1::constant(s.t),
+            &SVector::<D1<T, N>, N>::from_fn(|k, _| D1::variable(s.q[k], k)),
+        );
+
+        let mut f = SVector::<T, N>::from_fn(|i, _| {
+            let mut fi = r.eps[i].re - v.eps[i];
+            for k in 0..N {
+                fi -= r.eps[k].eps[i] * s.qd[k];
+            }
+            fi
+        });
+
+        if L::EXPLICIT_TIME {
+            // Outer direction 0 on t: r.eps[0].eps[i] = d2T/dt dq'_i.
+            let rt = self.lagrangian.kinetic(
+                D2::variable(D1::constant(s.t), 0),
+                &s.q.map(d2_constant),
+                &inner_qd,
+            );
+            if let Some(dt) = rt.eps.first() {
+                f -= SVector::<T, N>::from(dt.eps);
+            }
+        }
+        f
+    }
+
+    fn generalized_force(&self, state: &State<T, N>) -> SVector<T, N> {
+        self.lagrangian.non_conservative_force(state)
+    }
+
+    fn kinetic_energy(&self, s: &State<T, N>) -> T {
+        self.lagrangian.kinetic(s.t, &s.q, &s.qd)
+    }
+
+    fn potential_energy(&self, s: &State<T, N>) -> T {
+        self.lagrangian.potential(s.t, &s.q)
+    }
+}
+
+/// Checks used by the tests of this module and by the doc example.
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::Error;
+
+    /// A bead on a hoop spinning about the vertical, written in the fixed frame with an
+    /// explicit time dependence that the time term must cancel exactly.
+    struct TimeShifted;
+    impl Lagrangian<f64, 1> for TimeShifted {
+        const EXPLICIT_TIME: bool = true;
+        fn kinetic<S: Scalar<Real = f64>>(
+            &self,
+            t: S,
+            _q: &SVector<S, 1>,
+            qd: &SVector<S, 1>,
+        ) -> S {
+            // T = (q' + t)^2 / 2: d/dt dT/dq' = q'' + 1, dT/dq = 0, so q'' = -1 - dV/dq.
+            let v = qd[0] + t;
+            S::from_f64(0.5) * v * v
+        }
+        fn potential<S: Scalar<Real = f64>>(&self, _t: S, q: &SVector<S, 1>) -> S {
+            S::from_f64(0.5) * q[0] * q[0]
+        }
+    }
+
+    #[test]
+    fn explicit_time_term_enters() -> Result<(), Error> {
+        let m = EulerLagrange::new(TimeShifted);
+        let a = m.acceleration(&State::new(3.0, [2.0], [0.5]))?;
+        assert!((a[0] - (-1.0 - 2.0)).abs() < 1e-15, "{a}");
+        Ok(())
+    }
+
+    /// `Error` must not be constructed out of nothing: a zero kinetic energy is singular.
+    struct Massless;
+    impl Lagrangian<f64, 2> for Massless {
+        fn kinetic<S: Scalar<Real = f64>>(
+            &self,
+            _t: S,
+            _q: &SVector<S, 2>,
+            qd: &SVector<S, 2>,
+        ) -> S {
+            qd[0] * qd[0]
+        }
+        fn potential<S: Scalar<Real = f64>>(&self, _t: S, q: &SVector<S, 2>) -> S {
+            q[1]
+        }
+    }
+
+    #[test]
+    fn singular_mass_matrix_is_reported() {
+        let m = EulerLagrange::new(Massless);
+        assert_eq!(
+            m.acceleration(&State::new(0.0, [0.0, 0.0], [1.0, 1.0])),
+            Err(Error::SingularMassMatrix { pivot: 1 })
+        );
+    }
+}

@@ -1,0 +1,60 @@
+//! # lagrange-core
+//!
+//! The core of lagrange: `no_std`, allocation-free Lagrangian mechanics.
+//!
+//! - [`Real`] (`f32`, `f64`) and [`Scalar`] (those and [`Dual`] numbers): every computation is
+//!   generic over the scalar, and all math goes through `libm`.
+//! - [`State`]: time, coordinates and velocities, `N` a const generic.
+//! - [`Mechanism`]: `M(q) q'' = f + Q`, energies, and `acceleration()` by a fixed-size Cholesky
+//!   solve ([`solve_spd`]) unless a system gives a closed form.
+//! - [`Lagrangian`] and [`EulerLagrange`]: write `T` and `V` once and get the equations of
+//!   motion by automatic differentiation.
+//! - [`GeneralizedForce`], [`ViscousDamping`], [`Input`], [`Forced`]: forces added by wrapping.
+//! - [`Error`]: one small `Copy` error type for every crate.
+//!
+//! ```
+//! use lagrange_core::{EulerLagrange, Lagrangian, Mechanism, Scalar, State, ViscousDamping};
+//! use nalgebra::SVector;
+//!
+//! /// A unit mass on a spring of stiffness `k`.
+//! struct Oscillator { k: f64 }
+//!
+//! impl Lagrangian<f64, 1> for Oscillator {
+//!     fn kinetic<S: Scalar<Real = f64>>(&self, _t: S, _q: &SVector<S, 1>, qd: &SVector<S, 1>) -> S {
+//!         S::from_f64(0.5) * qd[0] * qd[0]
+//!     }
+//!     fn potential<S: Scalar<Real = f64>>(&self, _t: S, q: &SVector<S, 1>) -> S {
+//!         S::from_f64(0.5) * S::from_real(self.k) * q[0] * q[0]
+//!     }
+//! }
+//!
+//! let system = EulerLagrange::new(Oscillator { k: 4.0 }).with_force(ViscousDamping::uniform(0.1)?);
+//! let state = State::new(0.0, [1.0], [0.0]);
+//! let qdd = system.acceleration(&state)?;
+//! assert!((qdd[0] + 4.0).abs() < 1e-15);
+//! assert!((system.energy(&state) - 2.0).abs() < 1e-15);
+//! # Ok::<(), lagrange_core::Error>(())
+//! ```
+
+#![no_std]
+#![forbid(unsafe_code)]
+
+mod cholesky;
+mod dual;
+mod error;
+mod forces;
+mod lagrangian;
+mod mechanism;
+mod scalar;
+mod state;
+pub mod validate;
+
+pub use cholesky::solve_spd;
+pub use dual::Dual;
+pub use error::Error;
+pub use forces::{Forced, GeneralizedForce, Input, ViscousDamping};
+pub use lagrangian::{EulerLagrange, Lagrangian};
+pub use mechanism::Mechanism;
+pub use nalgebra;
+pub use scalar::{Real, Scalar};
+pub use state::State;

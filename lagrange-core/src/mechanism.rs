@@ -1,0 +1,87 @@
+//! The [`Mechanism`] contract: what an integrator needs to know about a system.
+
+use crate::forces::Forced;
+use crate::{solve_spd, Error, Real, State};
+use nalgebra::{SMatrix, SVector};
+
+/// A mechanical system with `N` generalized coordinates, in the form
+///
+/// ```text
+/// M(t, q, q') q'' = f(t, q, q') + Q(t, q, q')
+/// ```
+///
+/// where `M` is the mass matrix, `f` ([`Mechanism::rhs`]) everything else the Euler-Lagrange
+/// equations give (`dL/dq` less the velocity-product terms of `d/dt dL/dq'`) and `Q`
+/// ([`Mechanism::generalized_force`]) the non-conservative generalized forces.
+///
+/// Implementors give `M`, `f` and the energies; [`Mechanism::acceleration`] solves for `q''`
+/// through [`Mechanism::solve_mass`], whose default is a fixed-size Cholesky solve. A
+/// hand-derived system overrides `solve_mass` with its closed-form inverse; wrappers such as
+/// [`Forced`] add to `Q` and keep that fast path.
+///
+/// Energies are computed only when asked, never inside a step.
+pub trait Mechanism<T: Real, const N: usize> {
+    /// The mass matrix `M = d2L/dq'2`, symmetric positive definite away from singular
+    /// configurations.
+    fn mass_matrix(&self, state: &State<T, N>) -> SMatrix<T, N, N>;
+
+    /// The right-hand side `f` of `M q'' = f + Q`, without the generalized forces `Q`.
+    fn rhs(&self, state: &State<T, N>) -> SVector<T, N>;
+
+    /// The non-conservative generalized forces `Q` (damping, drives, inputs); zero by default.
+    fn generalized_force(&self, state: &State<T, N>) -> SVector<T, N> {
+        let _ = state;
+        SVector::zeros()
+    }
+
+    /// Kinetic energy `T`.
+    fn kinetic_energy(&self, state: &State<T, N>) -> T;
+
+    /// Potential energy `V`.
+    fn potential_energy(&self, state: &State<T, N>) -> T;
+
+    /// Total energy `T + V`.
+    fn energy(&self, state: &State<T, N>) -> T {
+        self.kinetic_energy(state) + self.potential_energy(state)
+    }
+
+    /// Solves `M x = b` at `state`.
+    ///
+    /// # Errors
+    /// [`Error::SingularMassMatrix`] where `M` is singular or indefinite, or a system's own
+    /// [`Error::Singularity`] at a singular configuration.
+    fn solve_mass(&self, state: &State<T, N>, b: &SVector<T, N>) -> Result<SVector<T, N>, Error> {
+        solve_spd(&self.mass_matrix(state), b)
+    }
+
+    /// The generalized accelerations `q''`.
+    ///
+    /// # Errors
+    /// As [`Mechanism::solve_mass`].
+    fn acceleration(&self, state: &State<T, N>) -> Result<SVector<T, N>, Error> {
+        self.solve_mass(state, &(self.rhs(state) + self.generalized_force(state)))
+    }
+
+    /// This mechanism with `force` added to its generalized forces.
+    ///
+    /// ```
+    /// use lagrange_core::{Mechanism, ViscousDamping};
+    /// # use lagrange_core::{EulerLagrange, Lagrangian, Scalar, State};
+    /// # use nalgebra::SVector;
+    /// # struct Spring;
+    /// # impl Lagrangian<f64, 1> for Spring {
+    /// #     fn kinetic<S: Scalar<Real = f64>>(&self, _: S, _: &SVector<S, 1>, qd: &SVector<S, 1>) -> S { qd[0] * qd[0] * S::from_f64(0.5) }
+    /// #     fn potential<S: Scalar<Real = f64>>(&self, _: S, q: &SVector<S, 1>) -> S { q[0] * q[0] * S::from_f64(0.5) }
+    /// # }
+    /// let damped = EulerLagrange::new(Spring).with_force(ViscousDamping::uniform(0.5)?);
+    /// let a = damped.acceleration(&State::new(0.0, [1.0], [2.0]))?;
+    /// assert!((a[0] - (-1.0 - 0.5 * 2.0)).abs() < 1e-15);
+    /// # Ok::<(), lagrange_core::Error>(())
+    /// ```
+    fn with_force<F>(self, force: F) -> Forced<Self, F>
+    where
+        Self: Sized,
+    {
+        Forced::new(self, force)
+    }
+}

@@ -1,0 +1,242 @@
+//! Scalars: [`Scalar`], what a Lagrangian is written over, and [`Real`], `f32` or `f64`.
+//!
+//! All math goes through these traits to `libm`, never to `std`'s inherent float methods, so the
+//! same code gives the same bits on a desktop and on a Cortex-M.
+
+use core::fmt::{Debug, Display, LowerExp};
+use core::ops::{Add, AddAssign, Div, DivAssign, Mul, MulAssign, Neg, Sub, SubAssign};
+use num_traits::{One, Zero};
+
+/// A number a Lagrangian can be evaluated in: `f32`, `f64`, or a [`Dual`](crate::Dual) number
+/// built on one of them (which is how the equations of motion are derived automatically).
+///
+/// Write kinetic and potential energies generic over `S: Scalar<Real = T>` with parameters
+/// converted by [`Scalar::from_real`], and they can be both evaluated and differentiated.
+pub trait Scalar:
+    Copy
+    + Debug
+    + PartialEq
+    + 'static
+    + Add<Output = Self>
+    + Sub<Output = Self>
+    + Mul<Output = Self>
+    + Div<Output = Self>
+    + Neg<Output = Self>
+    + AddAssign
+    + SubAssign
+    + MulAssign
+    + DivAssign
+    + Zero
+    + One
+{
+    /// The floating-point type underneath (`f32` or `f64`).
+    type Real: Real;
+    /// A constant: a parameter of the mechanism, with zero derivative.
+    fn from_real(x: Self::Real) -> Self;
+    /// A literal, rounded to the underlying precision (`0.5`, `2.0`, ...).
+    fn from_f64(x: f64) -> Self;
+    /// The plain value, with every derivative part dropped.
+    fn value(self) -> Self::Real;
+    /// Sine.
+    fn sin(self) -> Self;
+    /// Cosine.
+    fn cos(self) -> Self;
+    /// Sine and cosine together (cheaper than both apart for dual numbers).
+    fn sin_cos(self) -> (Self, Self);
+    /// Tangent.
+    fn tan(self) -> Self;
+    /// Square root.
+    fn sqrt(self) -> Self;
+    /// Natural exponential.
+    fn exp(self) -> Self;
+    /// Natural logarithm.
+    fn ln(self) -> Self;
+    /// Integer power, by repeated squaring (exact sequence of products on every target).
+    fn powi(self, n: i32) -> Self;
+    /// Absolute value.
+    fn abs(self) -> Self;
+    /// Four-quadrant arctangent of `self / x`.
+    fn atan2(self, x: Self) -> Self;
+    /// `1 / self`.
+    fn recip(self) -> Self;
+}
+
+mod sealed {
+    pub trait Sealed {}
+    impl Sealed for f32 {}
+    impl Sealed for f64 {}
+}
+
+/// A floating-point type the library computes in: `f32` or `f64` (sealed).
+pub trait Real:
+    Scalar<Real = Self> + PartialOrd + Default + Display + LowerExp + sealed::Sealed
+{
+    /// 1/2.
+    const HALF: Self;
+    /// 2.
+    const TWO: Self;
+    /// pi.
+    const PI: Self;
+    /// Machine epsilon.
+    const EPSILON: Self;
+    /// Positive infinity.
+    const INFINITY: Self;
+    /// Neither NaN nor infinite.
+    fn is_finite(self) -> bool;
+    /// Widen to `f64` (for reports and logs).
+    fn to_f64(self) -> f64;
+    /// The larger of two values (the other one where one is NaN).
+    fn max(self, other: Self) -> Self;
+    /// The smaller of two values (the other one where one is NaN).
+    fn min(self, other: Self) -> Self;
+    /// Largest integer not above `self`.
+    fn floor(self) -> Self;
+    /// Nearest integer, halves away from zero.
+    fn round(self) -> Self;
+    /// Arcsine.
+    fn asin(self) -> Self;
+    /// Arccosine.
+    fn acos(self) -> Self;
+    /// Arctangent.
+    fn atan(self) -> Self;
+    /// `self` to a real power.
+    fn powf(self, e: Self) -> Self;
+}
+
+/// `x^n` by binary powering, shared by every scalar so all give the same sequence of products.
+pub(crate) fn powi_by_squaring<S: Scalar>(x: S, n: i32) -> S {
+    let mut base = if n < 0 { x.recip() } else { x };
+    let mut e = n.unsigned_abs();
+    let mut acc = S::one();
+    while e > 0 {
+        if e & 1 == 1 {
+            acc *= base;
+        }
+        e >>= 1;
+        if e > 0 {
+            base = base * base;
+        }
+    }
+    acc
+}
+
+macro_rules! impl_real {
+    ($t:ident, $sin:ident, $cos:ident, $tan:ident, $sqrt:ident, $exp:ident,
+     $ln:ident, $fabs:ident, $atan2:ident, $floor:ident, $round:ident, $asin:ident,
+     $acos:ident, $atan:ident, $pow:ident) => {
+        impl Scalar for $t {
+            type Real = $t;
+            #[inline]
+            fn from_real(x: $t) -> $t {
+                x
+            }
+            #[inline]
+            #[allow(clippy::cast_possible_truncation)]
+            fn from_f64(x: f64) -> $t {
+                x as $t
+            }
+            #[inline]
+            fn value(self) -> $t {
+                self
+            }
+            #[inline]
+            fn sin(self) -> $t {
+                libm::$sin(self)
+            }
+            #[inline]
+            fn cos(self) -> $t {
+                libm::$cos(self)
+            }
+            #[inline]
+            fn sin_cos(self) -> ($t, $t) {
+                (libm::$sin(self), libm::$cos(self))
+            }
+            #[inline]
+            fn tan(self) -> $t {
+                libm::$tan(self)
+            }
+            #[inline]
+            fn sqrt(self) -> $t {
+                libm::$sqrt(self)
+            }
+            #[inline]
+            fn exp(self) -> $t {
+                libm::$exp(self)
+            }
+            #[inline]
+            fn ln(self) -> $t {
+                libm::$ln(self)
+            }
+            #[inline]
+            fn powi(self, n: i32) -> $t {
+                powi_by_squaring(self, n)
+            }
+            #[inline]
+            fn abs(self) -> $t {
+                libm::$fabs(self)
+            }
+            #[inline]
+            fn atan2(self, x: $t) -> $t {
+                libm::$atan2(self, x)
+            }
+            #[inline]
+            fn recip(self) -> $t {
+                1.0 / self
+            }
+        }
+
+        impl Real for $t {
+            const HALF: $t = 0.5;
+            const TWO: $t = 2.0;
+            const PI: $t = core::$t::consts::PI;
+            const EPSILON: $t = $t::EPSILON;
+            const INFINITY: $t = $t::INFINITY;
+            #[inline]
+            fn is_finite(self) -> bool {
+                $t::is_finite(self)
+            }
+            #[inline]
+            fn to_f64(self) -> f64 {
+                f64::from(self)
+            }
+            #[inline]
+            fn max(self, other: $t) -> $t {
+                $t::max(self, other)
+            }
+            #[inline]
+            fn min(self, other: $t) -> $t {
+                $t::min(self, other)
+            }
+            #[inline]
+            fn floor(self) -> $t {
+                libm::$floor(self)
+            }
+            #[inline]
+            fn round(self) -> $t {
+                libm::$round(self)
+            }
+            #[inline]
+            fn asin(self) -> $t {
+                libm::$asin(self)
+            }
+            #[inline]
+            fn acos(self) -> $t {
+                libm::$acos(self)
+            }
+            #[inline]
+            fn atan(self) -> $t {
+                libm::$atan(self)
+            }
+            #[inline]
+            fn powf(self, e: $t) -> $t {
+                libm::$pow(self, e)
+            }
+        }
+    };
+}
+
+impl_real!(f64, sin, cos, tan, sqrt, exp, log, fabs, atan2, floor, round, asin, acos, atan, pow);
+impl_real!(
+    f32, sinf, cosf, tanf, sqrtf, expf, logf, fabsf, atan2f, floorf, roundf, asinf, acosf, atanf,
+    powf
+);

@@ -1,0 +1,35 @@
+//! Explicit (forward) Euler.
+
+use crate::integrator::{check_dt, finish};
+use crate::Integrator;
+use lagrange_core::{Error, Mechanism, Real, State};
+
+/// Forward Euler: `q1 = q0 + h q'0`, `q'1 = q'0 + h q''0`.
+///
+/// Order 1, explicit, 1 acceleration evaluation per step. Not symplectic: an undamped
+/// oscillator gains energy every step (by a factor `1 + (h w)^2` per step for a linear one), so
+/// it is here as a baseline, not for long runs.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct ExplicitEuler;
+
+impl<T: Real, const N: usize> Integrator<T, N> for ExplicitEuler {
+    const NAME: &'static str = "explicit Euler";
+    const ORDER: u32 = 1;
+    const EVALS_PER_STEP: u32 = 1;
+
+    fn step<M: Mechanism<T, N>>(
+        &mut self,
+        m: &M,
+        s: &State<T, N>,
+        dt: T,
+    ) -> Result<State<T, N>, Error> {
+        let h = check_dt(dt)?;
+        let a = m.acceleration(s)?;
+        finish(State {
+            t: s.t + h,
+            q: s.q + s.qd * h,
+            qd: s.qd + a * h,
+        })
+    }
+}

@@ -1,0 +1,143 @@
+//! [`DoublePendulum`]: two point masses on two massless rods, a planar chain.
+
+use lagrange_core::nalgebra::{Matrix2, SVector, Vector2};
+use lagrange_core::{validate, Error, Lagrangian, Mechanism, Real, Scalar, State};
+
+/// Point masses `m1`, `m2` on massless rods `l1`, `l2`: the first hangs from a fixed pivot,
+/// the second from the first mass, in gravity `g`.
+///
+/// ```text
+/// q = [th1, th2]   absolute angles from the downward vertical, rad
+///                  mass 1 at l1 (sin th1, -cos th1), mass 2 at that plus l2 (sin th2, -cos th2)
+/// T = (m1 + m2) l1^2 th1'^2 / 2 + m2 l2^2 th2'^2 / 2 + m2 l1 l2 th1' th2' cos(th1 - th2)
+/// V = -(m1 + m2) g l1 cos th1 - m2 g l2 cos th2
+///
+/// M = | (m1 + m2) l1^2           m2 l1 l2 cos(th1 - th2) |
+///     | m2 l1 l2 cos(th1 - th2)  m2 l2^2                 |
+/// f = | -m2 l1 l2 sin(th1 - th2) th2'^2 - (m1 + m2) g l1 sin th1 |
+///     |  m2 l1 l2 sin(th1 - th2) th1'^2 - m2 g l2 sin th2        |
+/// ```
+///
+/// `det M = m2 l1^2 l2^2 (m1 + m2 sin^2(th1 - th2)) > 0`: no singular configurations, and the
+/// accelerations come from the closed-form 2x2 inverse. Chaotic for large energies.
+///
+/// ```
+/// use lagrange_core::{Mechanism, State};
+/// use lagrange_systems::DoublePendulum;
+/// let dp = DoublePendulum::new(1.0, 1.0, 1.0, 1.0, 9.81)?;
+/// let hanging = State::new(0.0, [0.0, 0.0], [0.0, 0.0]);
+/// let a = dp.acceleration(&hanging)?;
+/// assert_eq!((a[0], a[1]), (0.0, 0.0));
+/// # Ok::<(), lagrange_core::Error>(())
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct DoublePendulum<T: Real> {
+    m1: T,
+    m2: T,
+    l1: T,
+    l2: T,
+    gravity: T,
+}
+
+impl<T: Real> DoublePendulum<T> {
+    /// Masses `m1`, `m2` (kg, > 0), rod lengths `l1`, `l2` (m, > 0), `gravity` (m/s^2, >= 0).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming the first parameter out of range or not finite.
+    pub fn new(m1: T, m2: T, l1: T, l2: T, gravity: T) -> Result<Self, Error> {
+        Ok(Self {
+            m1: validate::positive("m1", m1)?,
+            m2: validate::positive("m2", m2)?,
+            l1: validate::positive("l1", l1)?,
+            l2: validate::positive("l2", l2)?,
+            gravity: validate::non_negative("gravity", gravity)?,
+        })
+    }
+    /// Masses `[m1, m2]`, kg.
+    #[must_use]
+    pub fn masses(&self) -> [T; 2] {
+        [self.m1, self.m2]
+    }
+    /// Rod lengths `[l1, l2]`, m.
+    #[must_use]
+    pub fn lengths(&self) -> [T; 2] {
+        [self.l1, self.l2]
+    }
+    /// Gravity, m/s^2.
+    #[must_use]
+    pub fn gravity(&self) -> T {
+        self.gravity
+    }
+
+    /// The mass matrix and right-hand side together, sharing one `sin_cos(th1 - th2)`.
+    fn terms(&self, s: &State<T, 2>) -> (Matrix2<T>, Vector2<T>) {
+        let (sin, cos) = (s.q[0] - s.q[1]).sin_cos();
+        let mu = self.m1 + self.m2;
+        let c = self.m2 * self.l1 * self.l2;
+        let m = Matrix2::new(
+            mu * self.l1 * self.l1,
+            c * cos,
+            c * cos,
+            self.m2 * self.l2 * self.l2,
+        );
+        let g = self.gravity;
+        let f = Vector2::new(
+            -c * sin * s.qd[1] * s.qd[1] - mu * g * self.l1 * s.q[0].sin(),
+            c * sin * s.qd[0] * s.qd[0] - self.m2 * g * self.l2 * s.q[1].sin(),
+        );
+        (m, f)
+    }
+}
+
+/// Solves the symmetric 2x2 system `m x = b` by its closed-form inverse.
+fn solve_2x2<T: Real>(m: &Matrix2<T>, b: &Vector2<T>) -> Result<Vector2<T>, Error> {
+    let det = m[(0, 0)] * m[(1, 1)] - m[(0, 1)] * m[(1, 0)];
+    if !(det > T::zero()) || !det.is_finite() {
+        return Err(Error::SingularMassMatrix { pivot: 1 });
+    }
+    Ok(Vector2::new(
+        m[(1, 1)] * b[0] - m[(0, 1)] * b[1],
+        m[(0, 0)] * b[1] - m[(1, 0)] * b[0],
+    ) / det)
+}
+
+impl<T: Real> Mechanism<T, 2> for DoublePendulum<T> {
+    fn mass_matrix(&self, s: &State<T, 2>) -> Matrix2<T> {
+        self.terms(s).0
+    }
+    fn rhs(&self, s: &State<T, 2>) -> Vector2<T> {
+        self.terms(s).1
+    }
+    fn kinetic_energy(&self, s: &State<T, 2>) -> T {
+        let (a, b) = (s.qd[0], s.qd[1]);
+        let mu = self.m1 + self.m2;
+        T::HALF * (mu * self.l1 * self.l1 * a * a + self.m2 * self.l2 * self.l2 * b * b)
+            + self.m2 * self.l1 * self.l2 * a * b * (s.q[0] - s.q[1]).cos()
+    }
+    fn potential_energy(&self, s: &State<T, 2>) -> T {
+        let mu = self.m1 + self.m2;
+        -self.gravity * (mu * self.l1 * s.q[0].cos() + self.m2 * self.l2 * s.q[1].cos())
+    }
+    fn solve_mass(&self, s: &State<T, 2>, b: &Vector2<T>) -> Result<Vector2<T>, Error> {
+        solve_2x2(&self.mass_matrix(s), b)
+    }
+    fn acceleration(&self, s: &State<T, 2>) -> Result<Vector2<T>, Error> {
+        let (m, f) = self.terms(s);
+        solve_2x2(&m, &f)
+    }
+}
+
+impl<T: Real> Lagrangian<T, 2> for DoublePendulum<T> {
+    fn kinetic<S: Scalar<Real = T>>(&self, _t: S, q: &SVector<S, 2>, qd: &SVector<S, 2>) -> S {
+        let mu_l1l1 = S::from_real(T::HALF * (self.m1 + self.m2) * self.l1 * self.l1);
+        let m2_l2l2 = S::from_real(T::HALF * self.m2 * self.l2 * self.l2);
+        let c = S::from_real(self.m2 * self.l1 * self.l2);
+        mu_l1l1 * qd[0] * qd[0] + m2_l2l2 * qd[1] * qd[1] + c * qd[0] * qd[1] * (q[0] - q[1]).cos()
+    }
+    fn potential<S: Scalar<Real = T>>(&self, _t: S, q: &SVector<S, 2>) -> S {
+        let g = self.gravity;
+        -S::from_real(g * (self.m1 + self.m2) * self.l1) * q[0].cos()
+            - S::from_real(g * self.m2 * self.l2) * q[1].cos()
+    }
+}

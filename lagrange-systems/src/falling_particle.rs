@@ -1,0 +1,79 @@
+//! [`FallingParticle`]: a point mass in uniform gravity.
+
+use lagrange_core::nalgebra::{Matrix1, SMatrix, SVector, Vector1};
+use lagrange_core::{validate, Error, Lagrangian, Mechanism, Real, Scalar, State};
+
+/// A point mass `m` falling in uniform gravity `g` along -y.
+///
+/// ```text
+/// q = [y]            height, m (up is positive)
+/// L = m y'^2 / 2 - m g y
+/// y'' = -g
+/// ```
+///
+/// No singular configurations. The acceleration is constant, so RK4 and velocity Verlet are
+/// exact to rounding.
+///
+/// ```
+/// use lagrange_core::{Mechanism, State};
+/// use lagrange_systems::FallingParticle;
+/// let p = FallingParticle::new(2.0, 9.81)?;
+/// assert_eq!(p.acceleration(&State::new(0.0, [10.0], [0.0]))?[0], -9.81);
+/// # Ok::<(), lagrange_core::Error>(())
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct FallingParticle<T: Real> {
+    mass: T,
+    gravity: T,
+}
+
+impl<T: Real> FallingParticle<T> {
+    /// A particle of `mass` (kg, > 0) in `gravity` (m/s^2, >= 0).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming `mass` or `gravity`.
+    pub fn new(mass: T, gravity: T) -> Result<Self, Error> {
+        Ok(Self {
+            mass: validate::positive("mass", mass)?,
+            gravity: validate::non_negative("gravity", gravity)?,
+        })
+    }
+    /// Mass, kg.
+    #[must_use]
+    pub fn mass(&self) -> T {
+        self.mass
+    }
+    /// Gravity, m/s^2.
+    #[must_use]
+    pub fn gravity(&self) -> T {
+        self.gravity
+    }
+}
+
+impl<T: Real> Mechanism<T, 1> for FallingParticle<T> {
+    fn mass_matrix(&self, _s: &State<T, 1>) -> SMatrix<T, 1, 1> {
+        Matrix1::new(self.mass)
+    }
+    fn rhs(&self, _s: &State<T, 1>) -> SVector<T, 1> {
+        Vector1::new(-self.mass * self.gravity)
+    }
+    fn kinetic_energy(&self, s: &State<T, 1>) -> T {
+        T::HALF * self.mass * s.qd[0] * s.qd[0]
+    }
+    fn potential_energy(&self, s: &State<T, 1>) -> T {
+        self.mass * self.gravity * s.q[0]
+    }
+    fn solve_mass(&self, _s: &State<T, 1>, b: &SVector<T, 1>) -> Result<SVector<T, 1>, Error> {
+        Ok(b / self.mass)
+    }
+}
+
+impl<T: Real> Lagrangian<T, 1> for FallingParticle<T> {
+    fn kinetic<S: Scalar<Real = T>>(&self, _t: S, _q: &SVector<S, 1>, qd: &SVector<S, 1>) -> S {
+        S::from_real(T::HALF * self.mass) * qd[0] * qd[0]
+    }
+    fn potential<S: Scalar<Real = T>>(&self, _t: S, q: &SVector<S, 1>) -> S {
+        S::from_real(self.mass * self.gravity) * q[0]
+    }
+}

@@ -1,0 +1,39 @@
+//! # lagrange-systems
+//!
+//! Hand-derived standard mechanisms, `no_std` and allocation-free, each generic over `f32` and
+//! `f64`, each implementing both [`Mechanism`](lagrange_core::Mechanism) (closed-form
+//! equations, the fast path) and [`Lagrangian`](lagrange_core::Lagrangian) (so the automatic
+//! Euler-Lagrange path can check it). Conventions: gravity `g > 0` along -y, angles in radians
+//! from the downward vertical.
+//!
+//! | type | q | parameters |
+//! |---|---|---|
+//! | [`FallingParticle`] | `[y]` | mass, gravity |
+//! | [`SimplePendulum`] | `[th]` | mass, length, gravity, damping |
+//! | [`BeadOnRotatingHoop`] | `[th]` | mass, radius, omega, gravity |
+//! | [`DoublePendulum`] | `[th1, th2]` | m1, m2, l1, l2, gravity |
+//!
+//! [`exact`] holds closed-form solutions used as references.
+//!
+//! ```
+//! use lagrange_core::{Mechanism, State};
+//! use lagrange_systems::DoublePendulum;
+//! let dp = DoublePendulum::new(1.0_f32, 1.0, 1.0, 1.0, 9.81)?;
+//! let a = dp.acceleration(&State::new(0.0, [0.5, -0.5], [0.0, 0.0]))?;
+//! assert!(a[0] < 0.0 && a[1] > 0.0);
+//! # Ok::<(), lagrange_core::Error>(())
+//! ```
+
+#![no_std]
+#![forbid(unsafe_code)]
+
+mod bead_on_rotating_hoop;
+mod double_pendulum;
+pub mod exact;
+mod falling_particle;
+mod simple_pendulum;
+
+pub use bead_on_rotating_hoop::BeadOnRotatingHoop;
+pub use double_pendulum::DoublePendulum;
+pub use falling_particle::FallingParticle;
+pub use simple_pendulum::SimplePendulum;

@@ -1,0 +1,107 @@
+//! [`SimplePendulum`]: a point mass on a massless rod, with optional viscous damping.
+
+use lagrange_core::nalgebra::{Matrix1, SMatrix, SVector, Vector1};
+use lagrange_core::{validate, Error, Lagrangian, Mechanism, Real, Scalar, State};
+
+/// A point mass `m` on a massless rod of length `l` about a fixed pivot, in gravity `g`, with
+/// viscous damping `b` at the pivot.
+///
+/// ```text
+/// q = [th]     angle from the downward vertical, rad; the bob is at (l sin th, -l cos th)
+/// L = m l^2 th'^2 / 2 + m g l cos th
+/// Q = -b th'
+/// m l^2 th'' = -m g l sin th - b th'
+/// ```
+///
+/// No singular configurations. Energy `T + V` is conserved when `b = 0` and never increases
+/// otherwise.
+///
+/// ```
+/// use lagrange_core::{Mechanism, State};
+/// use lagrange_systems::SimplePendulum;
+/// let p = SimplePendulum::new(1.0, 1.0, 9.81, 0.0)?;
+/// let a = p.acceleration(&State::new(0.0, [0.1], [0.0]))?;
+/// assert!((a[0] + 9.81 * 0.1f64.sin()).abs() < 1e-15);
+/// # Ok::<(), lagrange_core::Error>(())
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct SimplePendulum<T: Real> {
+    mass: T,
+    length: T,
+    gravity: T,
+    damping: T,
+}
+
+impl<T: Real> SimplePendulum<T> {
+    /// A pendulum of `mass` (kg, > 0), `length` (m, > 0), `gravity` (m/s^2, >= 0) and
+    /// `damping` (N m s/rad, >= 0).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming the first parameter out of range or not finite.
+    pub fn new(mass: T, length: T, gravity: T, damping: T) -> Result<Self, Error> {
+        Ok(Self {
+            mass: validate::positive("mass", mass)?,
+            length: validate::positive("length", length)?,
+            gravity: validate::non_negative("gravity", gravity)?,
+            damping: validate::non_negative("damping", damping)?,
+        })
+    }
+    /// Mass, kg.
+    #[must_use]
+    pub fn mass(&self) -> T {
+        self.mass
+    }
+    /// Length, m.
+    #[must_use]
+    pub fn length(&self) -> T {
+        self.length
+    }
+    /// Gravity, m/s^2.
+    #[must_use]
+    pub fn gravity(&self) -> T {
+        self.gravity
+    }
+    /// Damping, N m s/rad.
+    #[must_use]
+    pub fn damping(&self) -> T {
+        self.damping
+    }
+    /// Moment of inertia about the pivot, `m l^2`.
+    fn inertia(&self) -> T {
+        self.mass * self.length * self.length
+    }
+}
+
+impl<T: Real> Mechanism<T, 1> for SimplePendulum<T> {
+    fn mass_matrix(&self, _s: &State<T, 1>) -> SMatrix<T, 1, 1> {
+        Matrix1::new(self.inertia())
+    }
+    fn rhs(&self, s: &State<T, 1>) -> SVector<T, 1> {
+        Vector1::new(-self.mass * self.gravity * self.length * s.q[0].sin())
+    }
+    fn generalized_force(&self, s: &State<T, 1>) -> SVector<T, 1> {
+        Vector1::new(-self.damping * s.qd[0])
+    }
+    fn kinetic_energy(&self, s: &State<T, 1>) -> T {
+        T::HALF * self.inertia() * s.qd[0] * s.qd[0]
+    }
+    fn potential_energy(&self, s: &State<T, 1>) -> T {
+        -self.mass * self.gravity * self.length * s.q[0].cos()
+    }
+    fn solve_mass(&self, _s: &State<T, 1>, b: &SVector<T, 1>) -> Result<SVector<T, 1>, Error> {
+        Ok(b / self.inertia())
+    }
+}
+
+impl<T: Real> Lagrangian<T, 1> for SimplePendulum<T> {
+    fn kinetic<S: Scalar<Real = T>>(&self, _t: S, _q: &SVector<S, 1>, qd: &SVector<S, 1>) -> S {
+        S::from_real(T::HALF * self.inertia()) * qd[0] * qd[0]
+    }
+    fn potential<S: Scalar<Real = T>>(&self, _t: S, q: &SVector<S, 1>) -> S {
+        -S::from_real(self.mass * self.gravity * self.length) * q[0].cos()
+    }
+    fn non_conservative_force(&self, s: &State<T, 1>) -> SVector<T, 1> {
+        Mechanism::generalized_force(self, s)
+    }
+}
