@@ -1,0 +1,235 @@
+//! `cargo xtask cross`: the library crates built for a Cortex-M4F, and the size of a linked
+//! `no_std` binary that uses them with no global allocator.
+//!
+//! Each library crate is built on its own with `-p`, so that workspace feature unification (a
+//! `std` feature turned on by `tests` or `xtask`) cannot hide a `no_std` failure. The smoke
+//! binary in `embedded/smoke` is a standalone crate: its `.cargo/config.toml` (target and
+//! `-Tlink.x`) is only read when cargo runs from that directory.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use crate::cmd;
+
+/// The embedded target every build in this task uses.
+const TARGET: &str = "thumbv7em-none-eabihf";
+
+/// The library crates, each built for [`TARGET`] with every entry of [`FEATURE_SETS`].
+const CRATES: [&str; 3] = ["lagrange-core", "lagrange-integrators", "lagrange-systems"];
+
+/// The extra cargo arguments of each feature set: default features, then `defmt` on top.
+const FEATURE_SETS: [&[&str]; 2] = [&[], &["--features", "defmt"]];
+
+/// The smoke firmware's directory, relative to the project root.
+const SMOKE_DIR: &str = "embedded/smoke";
+
+/// The smoke firmware's binary name (its package name).
+const SMOKE_BIN: &str = "lagrange-smoke";
+
+/// The sections whose sizes are reported.
+const SECTIONS: [&str; 4] = [".text", ".rodata", ".data", ".bss"];
+
+/// Installs the target if needed, builds the matrix and the smoke binary, and prints its size;
+/// every step runs and every failure is reported at the end.
+pub fn run() -> Result<(), String> {
+    let mut failures = Vec::new();
+    if let Err(e) = ensure_target() {
+        failures.push(e);
+    }
+    for krate in CRATES {
+        for features in FEATURE_SETS {
+            let built = cmd::run(
+                cmd::cargo()
+                    .args(["build", "--quiet", "-p", krate, "--target", TARGET])
+                    .args(features),
+            );
+            if let Err(e) = built {
+                failures.push(e);
+            }
+        }
+    }
+    match build_smoke() {
+        Ok(elf) => match section_sizes(&elf) {
+            Ok(sizes) => print_sizes(&elf, &sizes),
+            Err(e) => failures.push(format!("{}: {e}", elf.display())),
+        },
+        Err(e) => failures.push(e),
+    }
+    if failures.is_empty() {
+        println!("xtask cross: all builds passed");
+        Ok(())
+    } else {
+        Err(failures.join("\n"))
+    }
+}
+
+/// Runs `rustup target add` for [`TARGET`] when `rustup target list --installed` lacks it.
+///
+/// Without a working `rustup` (a toolchain from a distribution, say) it warns and goes on:
+/// the builds then show whether the target is there.
+fn ensure_target() -> Result<(), String> {
+    let mut list = Command::new("rustup");
+    list.args(["target", "list", "--installed"]);
+    println!("$ {}", shown(&list));
+    let installed = match list.output() {
+        Ok(out) if out.status.success() => String::from_utf8_lossy(&out.stdout).into_owned(),
+        Ok(out) => {
+            println!(
+                "warning: `rustup target list` failed ({}); not installing {TARGET}",
+                out.status
+            );
+            return Ok(());
+        }
+        Err(e) => {
+            println!("warning: could not run rustup ({e}); not installing {TARGET}");
+            return Ok(());
+        }
+    };
+    if installed.lines().any(|line| line.trim() == TARGET) {
+        Ok(())
+    } else {
+        cmd::run(Command::new("rustup").args(["target", "add", TARGET]))
+    }
+}
+
+/// A command as `cmd::run` echoes it.
+fn shown(command: &Command) -> String {
+    format!("{command:?}").replace('"', "")
+}
+
+/// Builds the smoke firmware in release and returns the path of its ELF.
+///
+/// Cargo runs from the crate's directory so that its `.cargo/config.toml` applies; the target
+/// and target directory are also passed explicitly, so that `CARGO_BUILD_TARGET` or
+/// `CARGO_TARGET_DIR` in the environment cannot move the ELF.
+fn build_smoke() -> Result<PathBuf, String> {
+    let dir = cmd::project_root().join(SMOKE_DIR);
+    let target_dir = dir.join("target");
+    cmd::run(
+        cmd::cargo()
+            .current_dir(&dir)
+            .args(["build", "--quiet", "--release", "--target", TARGET])
+            .arg("--target-dir")
+            .arg(&target_dir),
+    )?;
+    Ok(target_dir.join(TARGET).join("release").join(SMOKE_BIN))
+}
+
+/// Prints each of [`SECTIONS`] with its size in bytes, and the flash and RAM they take.
+fn print_sizes(elf: &Path, sizes: &[(&str, Option<u32>)]) {
+    println!("{} ({TARGET}, release):", elf.display());
+    for (name, size) in sizes {
+        match size {
+            Some(bytes) => println!("  {name:<8} {bytes:>8} B"),
+            None => println!("  {name:<8} {:>8}", "absent"),
+        }
+    }
+    let size = |wanted: &str| {
+        sizes
+            .iter()
+            .find(|(name, _)| *name == wanted)
+            .and_then(|(_, size)| *size)
+            .unwrap_or(0)
+    };
+    let flash = size(".text") + size(".rodata") + size(".data");
+    let ram = size(".data") + size(".bss");
+    println!("  flash (.text + .rodata + .data) {flash} B, static RAM (.data + .bss) {ram} B");
+}
+
+/// The size of each of [`SECTIONS`] in the ELF file at `path` (`None` when it has none).
+fn section_sizes(path: &Path) -> Result<Vec<(&'static str, Option<u32>)>, String> {
+    let bytes = std::fs::read(path).map_err(|e| format!("cannot read: {e}"))?;
+    let sections = elf32_sections(&bytes)?;
+    Ok(SECTIONS
+        .iter()
+        .map(|&wanted| {
+            let size = sections
+                .iter()
+                .find(|(name, _)| name == wanted)
+                .map(|&(_, size)| size);
+            (wanted, size)
+        })
+        .collect())
+}
+
+/// Name and size of every section of a little-endian ELF32 image, from its section headers.
+fn elf32_sections(elf: &[u8]) -> Result<Vec<(String, u32)>, String> {
+    /// `e_ident`: magic, `ELFCLASS32`, `ELFDATA2LSB`.
+    const IDENT: [u8; 6] = [0x7f, b'E', b'L', b'F', 1, 1];
+    /// Offset of `e_shoff` in the ELF32 header.
+    const E_SHOFF: usize = 0x20;
+    /// Offset of `e_shentsize`.
+    const E_SHENTSIZE: usize = 0x2e;
+    /// Offset of `e_shnum`.
+    const E_SHNUM: usize = 0x30;
+    /// Offset of `e_shstrndx`.
+    const E_SHSTRNDX: usize = 0x32;
+    /// Offset of `sh_name` in an ELF32 section header.
+    const SH_NAME: usize = 0x00;
+    /// Offset of `sh_offset`.
+    const SH_OFFSET: usize = 0x10;
+    /// Offset of `sh_size`.
+    const SH_SIZE: usize = 0x14;
+    /// The smallest valid `e_shentsize`.
+    const SH_MIN_SIZE: usize = 0x28;
+
+    if elf.get(..IDENT.len()) != Some(&IDENT[..]) {
+        return Err("not a little-endian ELF32 file".into());
+    }
+    let shoff = to_usize(read_u32(elf, E_SHOFF)?)?;
+    let shentsize = usize::from(read_u16(elf, E_SHENTSIZE)?);
+    let shnum = usize::from(read_u16(elf, E_SHNUM)?);
+    let shstrndx = usize::from(read_u16(elf, E_SHSTRNDX)?);
+    if shentsize < SH_MIN_SIZE {
+        return Err(format!(
+            "section header entry size {shentsize} is too small"
+        ));
+    }
+    let header = |index: usize| -> Result<usize, String> {
+        index
+            .checked_mul(shentsize)
+            .and_then(|offset| offset.checked_add(shoff))
+            .ok_or_else(|| "section header offset overflows".to_string())
+    };
+    let strtab = header(shstrndx)?;
+    let names = to_usize(read_u32(elf, strtab + SH_OFFSET)?)?;
+    (0..shnum)
+        .map(|index| {
+            let at = header(index)?;
+            let name_at = names
+                .checked_add(to_usize(read_u32(elf, at + SH_NAME)?)?)
+                .ok_or("section name offset overflows")?;
+            let name = elf
+                .get(name_at..)
+                .and_then(|rest| rest.split(|&b| b == 0).next())
+                .ok_or_else(|| format!("section name at {name_at} is out of bounds"))?;
+            Ok((
+                String::from_utf8_lossy(name).into_owned(),
+                read_u32(elf, at + SH_SIZE)?,
+            ))
+        })
+        .collect()
+}
+
+/// The little-endian `u16` at `offset`.
+fn read_u16(bytes: &[u8], offset: usize) -> Result<u16, String> {
+    bytes
+        .get(offset..)
+        .and_then(|rest| rest.first_chunk::<2>())
+        .map(|b| u16::from_le_bytes(*b))
+        .ok_or_else(|| format!("truncated at byte {offset}"))
+}
+
+/// The little-endian `u32` at `offset`.
+fn read_u32(bytes: &[u8], offset: usize) -> Result<u32, String> {
+    bytes
+        .get(offset..)
+        .and_then(|rest| rest.first_chunk::<4>())
+        .map(|b| u32::from_le_bytes(*b))
+        .ok_or_else(|| format!("truncated at byte {offset}"))
+}
+
+/// A file offset as an index.
+fn to_usize(value: u32) -> Result<usize, String> {
+    usize::try_from(value).map_err(|e| format!("offset {value}: {e}"))
+}

@@ -1,0 +1,67 @@
+//! `cargo xtask`: the project's automation, in Rust so that it runs wherever cargo does.
+//!
+//! - `demo`: the origin's pendulum and a double pendulum with every integrator, a table and an
+//!   SVG plot under `target/lagrange-demo/`.
+//! - `test`: host tests of every crate, f32 and f64.
+//! - `cross`: thumbv7em-none-eabihf builds of the library crates, with and without `defmt`,
+//!   and a linked no_std binary with no allocator, with its size.
+//! - `ci`: format check, clippy with `-D warnings`, test, cross.
+
+mod cmd;
+mod cross;
+mod demo;
+mod svg;
+
+use std::process::ExitCode;
+
+fn main() -> ExitCode {
+    let task = std::env::args().nth(1).unwrap_or_default();
+    let result = match task.as_str() {
+        "demo" => demo::run(),
+        "test" => cmd::run_all(&TEST),
+        "cross" => cross::run(),
+        "ci" => ci(),
+        _ => {
+            eprintln!("usage: cargo xtask <demo | test | cross | ci>");
+            return ExitCode::from(2);
+        }
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("xtask {task} failed:\n{e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+/// Host tests of the whole workspace: unit, integration and doc tests, f32 and f64 alike.
+const TEST: [&[&str]; 1] = [&["test", "--workspace", "--all-targets", "--quiet"]];
+
+/// Static checks run before the tests.
+const CHECKS: [&[&str]; 2] = [
+    &["fmt", "--all", "--", "--check"],
+    &["clippy", "--workspace", "--all-targets", "--quiet", "--", "-D", "warnings"],
+];
+
+/// Doc tests are not part of `--all-targets`.
+const DOC_TEST: [&[&str]; 1] = [&["test", "--workspace", "--doc", "--quiet"]];
+
+/// Everything CI checks; every step runs and every failure is reported at the end.
+fn ci() -> Result<(), String> {
+    let failures: Vec<String> = [
+        cmd::run_all(&CHECKS),
+        cmd::run_all(&TEST),
+        cmd::run_all(&DOC_TEST),
+        cross::run(),
+    ]
+    .into_iter()
+    .filter_map(Result::err)
+    .collect();
+    if failures.is_empty() {
+        println!("xtask ci: all steps passed");
+        Ok(())
+    } else {
+        Err(failures.join("\n"))
+    }
+}
