@@ -8,6 +8,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let out = PathBuf::from(env::var_os("OUT_DIR").ok_or("OUT_DIR is not set")?);
     fs::write(out.join("memory.x"), include_bytes!("memory.x"))?;
     println!("cargo:rustc-link-search={}", out.display());
+    // Here rather than in .cargo/config.toml, where a RUSTFLAGS variable would replace it.
+    println!("cargo:rustc-link-arg=-Tlink.x");
     println!("cargo:rerun-if-changed=memory.x");
     println!("cargo:rerun-if-changed=build.rs");
     Ok(())

@@ -10,7 +10,8 @@ use nalgebra::{SMatrix, SVector};
 /// (below `EPSILON` times its diagonal entry), means `m` is singular or indefinite.
 ///
 /// # Errors
-/// [`Error::SingularMassMatrix`] with the index of the failing pivot.
+/// [`Error::SingularMassMatrix`] with the index of the failing pivot;
+/// [`Error::NonFiniteState`] when `m` holds NaN or infinity (a non-finite state).
 ///
 /// ```
 /// use lagrange_core::{solve_spd, Error};
@@ -33,8 +34,10 @@ pub fn solve_spd<T: Real, const N: usize>(
         for k in 0..j {
             d -= l[(j, k)] * l[(j, k)];
         }
-        // `!(d > tol)` also catches NaN.
-        if !(d > m[(j, j)].abs() * T::EPSILON) {
+        if !d.is_finite() {
+            return Err(Error::NonFiniteState);
+        }
+        if d <= m[(j, j)].abs() * T::EPSILON {
             return Err(Error::SingularMassMatrix { pivot: j });
         }
         let ljj = d.sqrt();

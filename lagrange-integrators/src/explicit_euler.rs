@@ -1,6 +1,6 @@
 //! Explicit (forward) Euler.
 
-use crate::integrator::{check_dt, finish};
+use crate::integrator::{check_step, finish};
 use crate::Integrator;
 use lagrange_core::{Error, Mechanism, Real, State};
 
@@ -24,7 +24,7 @@ impl<T: Real, const N: usize> Integrator<T, N> for ExplicitEuler {
         s: &State<T, N>,
         dt: T,
     ) -> Result<State<T, N>, Error> {
-        let h = check_dt(dt)?;
+        let h = check_step(s, dt)?;
         let a = m.acceleration(s)?;
         finish(State {
             t: s.t + h,

@@ -17,9 +17,9 @@ pub trait Integrator<T: Real, const N: usize> {
     /// Advances `state` by `dt` (which may be negative, to integrate backwards).
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] `dt` when `dt` is zero or not finite; whatever
-    /// [`Mechanism::acceleration`] returns; [`Error::NonFiniteState`] when the new state is not
-    /// finite (a step past the stability limit, or a non-finite start).
+    /// [`Error::InvalidParameter`] `dt` when `dt` is zero or not finite;
+    /// [`Error::NonFiniteState`] when `state` is not finite, or the new state is not (a step past
+    /// the stability limit); whatever [`Mechanism::acceleration`] returns.
     fn step<M: Mechanism<T, N>>(
         &mut self,
         mechanism: &M,
@@ -62,16 +62,15 @@ pub trait Integrator<T: Real, const N: usize> {
     }
 }
 
-/// `dt` when it is finite and not zero.
-pub(crate) fn check_dt<T: Real>(dt: T) -> Result<T, Error> {
-    if dt.is_finite() && dt != T::zero() {
-        Ok(dt)
-    } else {
-        Err(Error::InvalidParameter {
+/// `dt` when it is finite and not zero and the state it is to step from is finite.
+pub(crate) fn check_step<T: Real, const N: usize>(s: &State<T, N>, dt: T) -> Result<T, Error> {
+    if !(dt.is_finite() && dt != T::zero()) {
+        return Err(Error::InvalidParameter {
             name: "dt",
             reason: "must be finite and not zero",
-        })
+        });
     }
+    s.check_finite().map(|()| dt)
 }
 
 /// The state a step produced, or [`Error::NonFiniteState`] when it blew up.

@@ -1,6 +1,6 @@
 //! The classical fourth-order Runge-Kutta method.
 
-use crate::integrator::{check_dt, finish};
+use crate::integrator::{check_step, finish};
 use crate::Integrator;
 use lagrange_core::{Error, Mechanism, Real, State};
 
@@ -34,7 +34,7 @@ impl<T: Real, const N: usize> Integrator<T, N> for Rk4 {
         s: &State<T, N>,
         dt: T,
     ) -> Result<State<T, N>, Error> {
-        let h = check_dt(dt)?;
+        let h = check_step(s, dt)?;
         let half = h * T::HALF;
         let sixth = h / T::from_f64(6.0);
         let t_mid = s.t + half;

@@ -1,6 +1,6 @@
 //! Semi-implicit (symplectic) Euler.
 
-use crate::integrator::{check_dt, finish};
+use crate::integrator::{check_step, finish};
 use crate::Integrator;
 use lagrange_core::{Error, Mechanism, Real, State};
 
@@ -26,7 +26,7 @@ impl<T: Real, const N: usize> Integrator<T, N> for SemiImplicitEuler {
         s: &State<T, N>,
         dt: T,
     ) -> Result<State<T, N>, Error> {
-        let h = check_dt(dt)?;
+        let h = check_step(s, dt)?;
         let qd = s.qd + m.acceleration(s)? * h;
         finish(State {
             t: s.t + h,

@@ -1,6 +1,6 @@
 //! Velocity Verlet (Stormer-Verlet, kick-drift-kick).
 
-use crate::integrator::{check_dt, finish};
+use crate::integrator::{check_step, finish};
 use crate::Integrator;
 use lagrange_core::{Error, Mechanism, Real, State};
 
@@ -36,7 +36,7 @@ impl<T: Real, const N: usize> Integrator<T, N> for VelocityVerlet {
         s: &State<T, N>,
         dt: T,
     ) -> Result<State<T, N>, Error> {
-        let h = check_dt(dt)?;
+        let h = check_step(s, dt)?;
         let half = h * T::HALF;
         let a0 = m.acceleration(s)?;
         let v = s.qd + a0 * half;

@@ -93,7 +93,10 @@ impl<T: Real> DoublePendulum<T> {
 /// Solves the symmetric 2x2 system `m x = b` by its closed-form inverse.
 fn solve_2x2<T: Real>(m: &Matrix2<T>, b: &Vector2<T>) -> Result<Vector2<T>, Error> {
     let det = m[(0, 0)] * m[(1, 1)] - m[(0, 1)] * m[(1, 0)];
-    if !(det > T::zero()) || !det.is_finite() {
+    if !det.is_finite() {
+        return Err(Error::NonFiniteState);
+    }
+    if det <= T::zero() {
         return Err(Error::SingularMassMatrix { pivot: 1 });
     }
     Ok(Vector2::new(

@@ -87,7 +87,7 @@ pub fn pendulum_from_rest<T: Real>(theta0: T, omega: T, t: T) -> Result<(T, T), 
     let omega = validate::positive("omega", omega)?;
     let t = validate::finite("t", t)?;
     let theta0 = validate::finite("theta0", theta0)?;
-    if !(theta0.abs() < T::PI) {
+    if theta0.abs() >= T::PI {
         return Err(Error::InvalidParameter {
             name: "theta0",
             reason: "must be strictly between -pi and pi (a rotating or inverted start)",

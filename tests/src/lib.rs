@@ -82,3 +82,8 @@ macro_rules! for_f32_and_f64 {
         )*
     };
 }
+
+/// The README's example, compiled and run as a doc test.
+#[cfg(doctest)]
+#[doc = include_str!("../../README.md")]
+pub struct ReadmeDoctests;

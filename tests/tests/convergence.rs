@@ -25,7 +25,11 @@ fn measured_order<I: Integrator<f64, N> + Default, M: Mechanism<f64, N>, const N
         errs.push(state_error(&end, reference));
     }
     let order = fitted_order(dts, &errs);
-    println!("{:<20} errors {errs:?} -> order {order:.3} (stated {})", I::NAME, I::ORDER);
+    println!(
+        "{:<20} errors {errs:?} -> order {order:.3} (stated {})",
+        I::NAME,
+        I::ORDER
+    );
     assert!(
         (order - f64::from(I::ORDER)).abs() < ORDER_TOLERANCE,
         "{}: measured order {order}, stated {}",

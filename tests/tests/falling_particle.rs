@@ -20,8 +20,18 @@ fn exact_to_rounding<T: Real, I: Integrator<T, 1>>(mut integrator: I) -> Result<
     let y = 100.0 + 3.0 * t - 0.5 * 9.81 * t * t;
     let v = 3.0 - 9.81 * t;
     let tol = STEPS as f64 * 4.0 * T::EPSILON.to_f64() * 100.0;
-    assert!((end.q[0].to_f64() - y).abs() < tol, "{}: y = {}, exact {y}", I::NAME, end.q[0]);
-    assert!((end.qd[0].to_f64() - v).abs() < tol, "{}: v = {}, exact {v}", I::NAME, end.qd[0]);
+    assert!(
+        (end.q[0].to_f64() - y).abs() < tol,
+        "{}: y = {}, exact {y}",
+        I::NAME,
+        end.q[0]
+    );
+    assert!(
+        (end.qd[0].to_f64() - v).abs() < tol,
+        "{}: v = {}, exact {v}",
+        I::NAME,
+        end.qd[0]
+    );
     assert!((t - 1.0).abs() < tol);
     // And the acceleration itself is -g exactly.
     assert_eq!(p.acceleration(&end)?[0], -g);

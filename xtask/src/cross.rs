@@ -115,7 +115,7 @@ fn build_smoke() -> Result<PathBuf, String> {
     Ok(target_dir.join(TARGET).join("release").join(SMOKE_BIN))
 }
 
-/// Prints each of [`SECTIONS`] with its size in bytes, and the flash and RAM they take.
+/// Prints each of [`SECTIONS`] with its size in bytes.
 fn print_sizes(elf: &Path, sizes: &[(&str, Option<u32>)]) {
     println!("{} ({TARGET}, release):", elf.display());
     for (name, size) in sizes {
@@ -124,31 +124,34 @@ fn print_sizes(elf: &Path, sizes: &[(&str, Option<u32>)]) {
             None => println!("  {name:<8} {:>8}", "absent"),
         }
     }
-    let size = |wanted: &str| {
-        sizes
-            .iter()
-            .find(|(name, _)| *name == wanted)
-            .and_then(|(_, size)| *size)
-            .unwrap_or(0)
-    };
-    let flash = size(".text") + size(".rodata") + size(".data");
-    let ram = size(".data") + size(".bss");
-    println!("  flash (.text + .rodata + .data) {flash} B, static RAM (.data + .bss) {ram} B");
 }
 
 /// The size of each of [`SECTIONS`] in the ELF file at `path` (`None` when it has none).
+///
+/// # Errors
+/// When the file cannot be read or parsed, or was not linked with cortex-m-rt's `link.x` (no
+/// `.vector_table`, or an empty `.text`): `RUSTFLAGS` in the environment, for one, replaces the
+/// `-Tlink.x` of `embedded/smoke/.cargo/config.toml`, and the linker then silently drops every
+/// section.
 fn section_sizes(path: &Path) -> Result<Vec<(&'static str, Option<u32>)>, String> {
     let bytes = std::fs::read(path).map_err(|e| format!("cannot read: {e}"))?;
     let sections = elf32_sections(&bytes)?;
+    let size_of = |wanted: &str| {
+        sections
+            .iter()
+            .find(|(name, _)| name == wanted)
+            .map(|&(_, size)| size)
+    };
+    if size_of(".vector_table").is_none() || size_of(".text").unwrap_or(0) == 0 {
+        return Err(
+            "no .vector_table or an empty .text: not linked with cortex-m-rt's link.x \
+             (RUSTFLAGS, when set, overrides embedded/smoke/.cargo/config.toml's -Tlink.x)"
+                .into(),
+        );
+    }
     Ok(SECTIONS
         .iter()
-        .map(|&wanted| {
-            let size = sections
-                .iter()
-                .find(|(name, _)| name == wanted)
-                .map(|&(_, size)| size);
-            (wanted, size)
-        })
+        .map(|&wanted| (wanted, size_of(wanted)))
         .collect())
 }
 

@@ -23,6 +23,7 @@ const TIMING_RUNS: usize = 5;
 
 /// Problem P2 of shared/BENCH_PROBLEMS.md: both angles pi/2 at rest, T = 10 s; its state at
 /// T from a 1e-27 reference solve (th1, th2, th1', th2').
+#[allow(clippy::excessive_precision)] // the digits as published
 const P2_REFERENCE: [f64; 4] = [
     -0.568_474_664_015_950_2,
     -0.526_393_727_932_404_7,
@@ -42,7 +43,14 @@ struct Run<const N: usize> {
 
 /// Integrates `mechanism` from `start` over `steps` steps of `dt`, sampling, then times the
 /// same run without sampling. Energy error is relative to `start`'s energy above `rest`.
-fn simulate<I, M, const N: usize>(mut integrator: I, mechanism: &M, start: State<f64, N>, dt: f64, steps: u64, rest: &State<f64, N>) -> Run<N>
+fn simulate<I, M, const N: usize>(
+    mut integrator: I,
+    mechanism: &M,
+    start: State<f64, N>,
+    dt: f64,
+    steps: u64,
+    rest: &State<f64, N>,
+) -> Run<N>
 where
     I: Integrator<f64, N> + Copy,
     M: Mechanism<f64, N>,
@@ -66,7 +74,8 @@ where
     let mut times: Vec<f64> = (0..TIMING_RUNS)
         .map(|_| {
             let clock = Instant::now();
-            let _ = black_box(integrator.integrate(black_box(mechanism), black_box(&start), dt, steps));
+            let _ =
+                black_box(integrator.integrate(black_box(mechanism), black_box(&start), dt, steps));
             clock.elapsed().as_secs_f64() * 1e9 / steps as f64
         })
         .collect();
@@ -81,7 +90,12 @@ where
 }
 
 /// The four integrators on one problem.
-fn all_integrators<M: Mechanism<f64, N>, const N: usize>(m: &M, start: State<f64, N>, dt: f64, rest: &State<f64, N>) -> [Run<N>; 4] {
+fn all_integrators<M: Mechanism<f64, N>, const N: usize>(
+    m: &M,
+    start: State<f64, N>,
+    dt: f64,
+    rest: &State<f64, N>,
+) -> [Run<N>; 4] {
     let steps = (T_END / dt).round() as u64;
     [
         simulate(ExplicitEuler, m, start, dt, steps, rest),
@@ -93,12 +107,19 @@ fn all_integrators<M: Mechanism<f64, N>, const N: usize>(m: &M, start: State<f64
 
 /// The sampled state nearest to time `t`.
 fn at<const N: usize>(run: &Run<N>, t: f64) -> Option<&State<f64, N>> {
-    run.samples.iter().map(|(s, _)| s).min_by(|a, b| (a.t - t).abs().total_cmp(&(b.t - t).abs()))
+    run.samples
+        .iter()
+        .map(|(s, _)| s)
+        .min_by(|a, b| (a.t - t).abs().total_cmp(&(b.t - t).abs()))
 }
 
 /// `max_i |x_i - y_i|` over angles and rates.
 fn state_error<const N: usize>(s: &State<f64, N>, reference: &[f64]) -> f64 {
-    s.q.iter().chain(s.qd.iter()).zip(reference).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max)
+    s.q.iter()
+        .chain(s.qd.iter())
+        .zip(reference)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0, f64::max)
 }
 
 fn pendulum_table(dt: f64) -> Result<[Run<1>; 4], String> {
@@ -106,12 +127,17 @@ fn pendulum_table(dt: f64) -> Result<[Run<1>; 4], String> {
     let exact = |t: f64| pendulum_from_rest(TH0, G.sqrt(), t).map_err(|e| e.to_string());
     let runs = all_integrators(&p, State::at_rest([TH0]), dt, &State::at_rest([0.0]));
 
-    println!("\nThe origin's pendulum: L = 1 m, g = 9.81 m/s^2, 30 deg at rest, 10 s, dt = {dt:e} s");
+    println!(
+        "\nThe origin's pendulum: L = 1 m, g = 9.81 m/s^2, 30 deg at rest, 10 s, dt = {dt:e} s"
+    );
     print!("{:<20}", "integrator");
     for t in TABLE_TIMES {
         print!(" {:>12}", format!("th({t}) deg"));
     }
-    println!(" {:>12} {:>11} {:>11} {:>8}", "th'(10) r/s", "err(10)", "max dE/E", "ns/step");
+    println!(
+        " {:>12} {:>11} {:>11} {:>8}",
+        "th'(10) r/s", "err(10)", "max dE/E", "ns/step"
+    );
     print!("{:<20}", "exact (Jacobi sn)");
     for t in TABLE_TIMES {
         print!(" {:>12.6}", exact(t)?.0.to_degrees());
@@ -143,14 +169,29 @@ fn pendulum_table(dt: f64) -> Result<[Run<1>; 4], String> {
 fn double_pendulum_table(dt: f64) -> Result<[Run<2>; 4], String> {
     let dp = DoublePendulum::new(1.0, 1.0, 1.0, 1.0, G).map_err(|e| e.to_string())?;
     let half_pi = std::f64::consts::FRAC_PI_2;
-    let runs = all_integrators(&dp, State::at_rest([half_pi, half_pi]), dt, &State::at_rest([0.0, 0.0]));
+    let runs = all_integrators(
+        &dp,
+        State::at_rest([half_pi, half_pi]),
+        dt,
+        &State::at_rest([0.0, 0.0]),
+    );
     println!("\nChaotic double pendulum (P2): m = l = 1, both angles 90 deg at rest, 10 s, dt = {dt:e} s");
     println!(
         "{:<20} {:>10} {:>10} {:>10} {:>10} {:>11} {:>11} {:>8}",
-        "integrator", "th1(10)", "th2(10)", "th1'(10)", "th2'(10)", "err(10)", "max dE/E", "ns/step"
+        "integrator",
+        "th1(10)",
+        "th2(10)",
+        "th1'(10)",
+        "th2'(10)",
+        "err(10)",
+        "max dE/E",
+        "ns/step"
     );
     let [a, b, c, d] = P2_REFERENCE;
-    println!("{:<20} {a:>10.6} {b:>10.6} {c:>10.6} {d:>10.6}", "reference");
+    println!(
+        "{:<20} {a:>10.6} {b:>10.6} {c:>10.6} {d:>10.6}",
+        "reference"
+    );
     for run in &runs {
         match &run.last {
             Ok(s) => println!(
@@ -171,7 +212,10 @@ fn double_pendulum_table(dt: f64) -> Result<[Run<2>; 4], String> {
 }
 
 /// Plot lines of `(t, f(sample))` for every run.
-fn series<const N: usize>(runs: &[Run<N>], f: impl Fn(&(State<f64, N>, f64)) -> f64) -> Vec<Series> {
+fn series<const N: usize>(
+    runs: &[Run<N>],
+    f: impl Fn(&(State<f64, N>, f64)) -> f64,
+) -> Vec<Series> {
     runs.iter()
         .map(|r| Series {
             name: r.name.to_string(),
@@ -193,7 +237,9 @@ pub fn run() -> Result<(), String> {
         points: (0..=1000)
             .filter_map(|i| {
                 let t = T_END * f64::from(i) / 1000.0;
-                pendulum_from_rest(TH0, G.sqrt(), t).ok().map(|(th, _)| (t, th))
+                pendulum_from_rest(TH0, G.sqrt(), t)
+                    .ok()
+                    .map(|(th, _)| (t, th))
             })
             .collect(),
     });
@@ -202,9 +248,24 @@ pub fn run() -> Result<(), String> {
     let doc = svg::panels(
         "t (s)",
         &[
-            ("Origin's pendulum, dt = 1e-3: angle", "th (rad)", Scale::Linear, &angle),
-            ("Origin's pendulum, dt = 1e-3: energy error", "|dE|/E", Scale::Log, &energy),
-            ("Chaotic double pendulum, dt = 1e-3: energy error", "|dE|/E", Scale::Log, &dp_energy),
+            (
+                "Origin's pendulum, dt = 1e-3: angle",
+                "th (rad)",
+                Scale::Linear,
+                &angle,
+            ),
+            (
+                "Origin's pendulum, dt = 1e-3: energy error",
+                "|dE|/E",
+                Scale::Log,
+                &energy,
+            ),
+            (
+                "Chaotic double pendulum, dt = 1e-3: energy error",
+                "|dE|/E",
+                Scale::Log,
+                &dp_energy,
+            ),
         ],
     );
     let dir = project_root().join("target").join("lagrange-demo");

@@ -41,7 +41,15 @@ const TEST: [&[&str]; 1] = [&["test", "--workspace", "--all-targets", "--quiet"]
 /// Static checks run before the tests.
 const CHECKS: [&[&str]; 2] = [
     &["fmt", "--all", "--", "--check"],
-    &["clippy", "--workspace", "--all-targets", "--quiet", "--", "-D", "warnings"],
+    &[
+        "clippy",
+        "--workspace",
+        "--all-targets",
+        "--quiet",
+        "--",
+        "-D",
+        "warnings",
+    ],
 ];
 
 /// Doc tests are not part of `--all-targets`.

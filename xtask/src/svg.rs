@@ -26,7 +26,9 @@ const LEFT: f64 = 70.0;
 const RIGHT: f64 = 170.0;
 const TOP: f64 = 30.0;
 const BOTTOM: f64 = 45.0;
-const COLOURS: [&str; 6] = ["#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b"];
+const COLOURS: [&str; 6] = [
+    "#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b",
+];
 
 /// An SVG document with one panel per `(title, y label, y scale, series)`, stacked vertically,
 /// sharing the x label.
@@ -37,7 +39,15 @@ pub fn panels(x_label: &str, panels: &[(&str, &str, Scale, &[Series])]) -> Strin
          font-family=\"sans-serif\" font-size=\"12\">\n<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n"
     );
     for (i, (title, y_label, scale, series)) in panels.iter().enumerate() {
-        panel(&mut s, H * i as f64, title, x_label, y_label, *scale, series);
+        panel(
+            &mut s,
+            H * i as f64,
+            title,
+            x_label,
+            y_label,
+            *scale,
+            series,
+        );
     }
     s.push_str("</svg>\n");
     s
@@ -51,13 +61,25 @@ fn scaled(y: f64, scale: Scale) -> Option<f64> {
     }
 }
 
-fn panel(s: &mut String, y0: f64, title: &str, x_label: &str, y_label: &str, scale: Scale, series: &[Series]) {
+fn panel(
+    s: &mut String,
+    y0: f64,
+    title: &str,
+    x_label: &str,
+    y_label: &str,
+    scale: Scale,
+    series: &[Series],
+) {
     let pts = || series.iter().flat_map(|r| r.points.iter());
     let xs = pts().map(|p| p.0);
     let ys = pts().filter_map(|p| scaled(p.1, scale));
-    let (x_min, x_max) = xs.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| (a.min(x), b.max(x)));
-    let (mut y_min, mut y_max) = ys.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), y| (a.min(y), b.max(y)));
-    if !(y_max > y_min) {
+    let (x_min, x_max) = xs.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
+        (a.min(x), b.max(x))
+    });
+    let (mut y_min, mut y_max) = ys.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), y| {
+        (a.min(y), b.max(y))
+    });
+    if y_max.partial_cmp(&y_min) != Some(std::cmp::Ordering::Greater) {
         y_min -= 1.0;
         y_max += 1.0;
     }
@@ -66,7 +88,12 @@ fn panel(s: &mut String, y0: f64, title: &str, x_label: &str, y_label: &str, sca
     let px = |x: f64| LEFT + (x - x_min) / x_span * pw;
     let py = |y: f64| y0 + TOP + (y_max - y) / (y_max - y_min) * ph;
 
-    let _ = writeln!(s, "<text x=\"{}\" y=\"{}\" font-weight=\"bold\">{title}</text>", LEFT, y0 + 18.0);
+    let _ = writeln!(
+        s,
+        "<text x=\"{}\" y=\"{}\" font-weight=\"bold\">{title}</text>",
+        LEFT,
+        y0 + 18.0
+    );
     let _ = writeln!(
         s,
         "<rect x=\"{LEFT}\" y=\"{}\" width=\"{pw}\" height=\"{ph}\" fill=\"none\" stroke=\"black\"/>",
@@ -79,10 +106,25 @@ fn panel(s: &mut String, y0: f64, title: &str, x_label: &str, y_label: &str, sca
             Scale::Linear => format!("{y:.3}"),
             Scale::Log => format!("1e{y:.1}"),
         };
-        let _ = writeln!(s, "<text x=\"{}\" y=\"{}\" text-anchor=\"middle\">{x:.3}</text>", px(x), y0 + H - BOTTOM + 16.0);
-        let _ = writeln!(s, "<text x=\"{}\" y=\"{}\" text-anchor=\"end\">{y_text}</text>", LEFT - 4.0, py(y) + 4.0);
+        let _ = writeln!(
+            s,
+            "<text x=\"{}\" y=\"{}\" text-anchor=\"middle\">{x:.3}</text>",
+            px(x),
+            y0 + H - BOTTOM + 16.0
+        );
+        let _ = writeln!(
+            s,
+            "<text x=\"{}\" y=\"{}\" text-anchor=\"end\">{y_text}</text>",
+            LEFT - 4.0,
+            py(y) + 4.0
+        );
     }
-    let _ = writeln!(s, "<text x=\"{}\" y=\"{}\" text-anchor=\"middle\">{x_label}</text>", LEFT + pw / 2.0, y0 + H - 8.0);
+    let _ = writeln!(
+        s,
+        "<text x=\"{}\" y=\"{}\" text-anchor=\"middle\">{x_label}</text>",
+        LEFT + pw / 2.0,
+        y0 + H - 8.0
+    );
     let _ = writeln!(
         s,
         "<text transform=\"translate(14 {}) rotate(-90)\" text-anchor=\"middle\">{y_label}</text>",

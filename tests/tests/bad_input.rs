@@ -1,0 +1,169 @@
+//! Bad parameters and bad states give specific errors, never a panic or a silent NaN.
+
+use lagrange_core::nalgebra::SVector;
+use lagrange_core::{
+    Error, EulerLagrange, Lagrangian, Mechanism, Real, Scalar, State, ViscousDamping,
+};
+use lagrange_integrators::{ExplicitEuler, Integrator, Rk4, SemiImplicitEuler, VelocityVerlet};
+use lagrange_systems::exact::{jacobi_sn_cn, pendulum_from_rest};
+use lagrange_systems::{BeadOnRotatingHoop, DoublePendulum, FallingParticle, SimplePendulum};
+use lagrange_tests::for_f32_and_f64;
+
+/// The values no positive parameter may take.
+fn not_positive<T: Real>() -> [T; 5] {
+    [
+        T::zero(),
+        -T::one(),
+        T::from_f64(f64::NAN),
+        T::INFINITY,
+        -T::INFINITY,
+    ]
+}
+
+/// `Err(InvalidParameter { name, .. })` with exactly this name.
+fn refuses<V: core::fmt::Debug>(result: Result<V, Error>, expected: &str) {
+    assert!(
+        matches!(result, Err(Error::InvalidParameter { name, .. }) if name == expected),
+        "expected InvalidParameter {{ name: {expected} }}, got {result:?}"
+    );
+}
+
+fn constructors_name_the_bad_parameter<T: Real>() -> Result<(), Error> {
+    let one = T::one();
+    let g = T::from_f64(9.81);
+    for bad in not_positive::<T>() {
+        refuses(FallingParticle::new(bad, g), "mass");
+        refuses(SimplePendulum::new(bad, one, g, T::zero()), "mass");
+        refuses(SimplePendulum::new(one, bad, g, T::zero()), "length");
+        refuses(BeadOnRotatingHoop::new(bad, one, one, g), "mass");
+        refuses(BeadOnRotatingHoop::new(one, bad, one, g), "radius");
+        refuses(DoublePendulum::new(bad, one, one, one, g), "m1");
+        refuses(DoublePendulum::new(one, bad, one, one, g), "m2");
+        refuses(DoublePendulum::new(one, one, bad, one, g), "l1");
+        refuses(DoublePendulum::new(one, one, one, bad, g), "l2");
+    }
+    // Zero gravity and zero damping are valid; negative or non-finite are not.
+    for bad in [-T::one(), T::from_f64(f64::NAN), T::INFINITY] {
+        refuses(FallingParticle::new(one, bad), "gravity");
+        refuses(SimplePendulum::new(one, one, bad, T::zero()), "gravity");
+        refuses(SimplePendulum::new(one, one, g, bad), "damping");
+        refuses(BeadOnRotatingHoop::new(one, one, one, bad), "gravity");
+        refuses(DoublePendulum::new(one, one, one, one, bad), "gravity");
+        refuses(
+            ViscousDamping::<T, 2>::new([T::zero(), bad]),
+            "coefficients",
+        );
+        refuses(ViscousDamping::<T, 2>::uniform(bad), "coefficient");
+    }
+    refuses(
+        BeadOnRotatingHoop::new(one, one, T::from_f64(f64::NAN), g),
+        "omega",
+    );
+    SimplePendulum::new(one, one, T::zero(), T::zero())?;
+    BeadOnRotatingHoop::new(one, one, -T::from_f64(3.0), g)?;
+    Ok(())
+}
+
+/// Every integrator refuses a NaN or infinite state with `NonFiniteState` and a zero or
+/// non-finite step with `InvalidParameter { name: "dt" }`.
+fn check_integrator<T: Real, I: Integrator<T, 2>>(mut i: I) -> Result<(), Error> {
+    let dp = DoublePendulum::new(T::one(), T::one(), T::one(), T::one(), T::from_f64(9.81))?;
+    let nan = T::from_f64(f64::NAN);
+    let good = State::new(T::zero(), [T::HALF, T::zero()], [T::zero(); 2]);
+    for bad in [
+        State::new(T::zero(), [nan, T::zero()], [T::zero(); 2]),
+        State::new(T::zero(), [T::zero(); 2], [T::zero(), nan]),
+        State::new(T::zero(), [T::zero(); 2], [T::INFINITY, T::zero()]),
+        State::new(nan, [T::zero(); 2], [T::zero(); 2]),
+    ] {
+        assert_eq!(
+            i.step(&dp, &bad, T::from_f64(1e-3)),
+            Err(Error::NonFiniteState),
+            "{}",
+            I::NAME
+        );
+    }
+    for dt in [T::zero(), nan, T::INFINITY] {
+        refuses(i.step(&dp, &good, dt), "dt");
+    }
+    i.step(&dp, &good, -T::from_f64(1e-3))?;
+    Ok(())
+}
+
+fn integrators_refuse_bad_states_and_steps<T: Real>() -> Result<(), Error> {
+    check_integrator::<T, _>(ExplicitEuler)?;
+    check_integrator::<T, _>(SemiImplicitEuler)?;
+    check_integrator::<T, _>(VelocityVerlet)?;
+    check_integrator::<T, _>(Rk4)
+}
+
+/// A unit mass on a spring of stiffness `k`, through the automatic path.
+struct Spring<T> {
+    k: T,
+}
+
+impl<T: Real> Lagrangian<T, 1> for Spring<T> {
+    fn kinetic<S: Scalar<Real = T>>(&self, _t: S, _q: &SVector<S, 1>, qd: &SVector<S, 1>) -> S {
+        S::from_f64(0.5) * qd[0] * qd[0]
+    }
+    fn potential<S: Scalar<Real = T>>(&self, _t: S, q: &SVector<S, 1>) -> S {
+        S::from_f64(0.5) * S::from_real(self.k) * q[0] * q[0]
+    }
+}
+
+/// Far past the stability limit an explicit method blows up (explicit Euler multiplies the
+/// amplitude of an oscillator by `sqrt(1 + (h w)^2)` per step, here ~100): the outcome is
+/// `NonFiniteState` once the state overflows, never a state with NaN or infinity in it.
+fn blow_up_is_an_error<T: Real>() -> Result<(), Error> {
+    let spring = EulerLagrange::new(Spring {
+        k: T::from_f64(1e4),
+    });
+    let start = State::new(T::zero(), [T::one()], [T::zero()]);
+    for steps in [1, 10] {
+        let s = ExplicitEuler.integrate(&spring, &start, T::one(), steps)?;
+        assert!(s.is_finite());
+    }
+    let result = ExplicitEuler.integrate(&spring, &start, T::one(), 1000);
+    assert_eq!(result, Err(Error::NonFiniteState));
+    Ok(())
+}
+
+for_f32_and_f64!(
+    constructors_name_the_bad_parameter,
+    integrators_refuse_bad_states_and_steps,
+    blow_up_is_an_error
+);
+
+/// A Lagrangian whose mass matrix is singular is reported as such, through any integrator.
+#[test]
+fn singular_mass_matrix_through_an_integrator() {
+    struct OnlyFirst;
+    impl Lagrangian<f64, 2> for OnlyFirst {
+        fn kinetic<S: Scalar<Real = f64>>(
+            &self,
+            _t: S,
+            _q: &SVector<S, 2>,
+            qd: &SVector<S, 2>,
+        ) -> S {
+            qd[0] * qd[0]
+        }
+        fn potential<S: Scalar<Real = f64>>(&self, _t: S, _q: &SVector<S, 2>) -> S {
+            S::zero()
+        }
+    }
+    let m = EulerLagrange::new(OnlyFirst);
+    assert_eq!(
+        Rk4.step(&m, &State::at_rest([0.0, 0.0]), 1e-3),
+        Err(Error::SingularMassMatrix { pivot: 1 })
+    );
+    assert!(m.mass_matrix(&State::at_rest([0.0, 0.0]))[(1, 1)] == 0.0);
+}
+
+#[test]
+fn reference_solutions_refuse_bad_arguments() {
+    refuses(pendulum_from_rest(4.0, 1.0, 0.0), "theta0");
+    refuses(pendulum_from_rest(0.5, 0.0, 0.0), "omega");
+    refuses(pendulum_from_rest(0.5, 1.0, f64::NAN), "t");
+    refuses(jacobi_sn_cn(0.5, 1.0), "k");
+    refuses(jacobi_sn_cn(f64::INFINITY, 0.5), "u");
+}
