@@ -3,7 +3,7 @@
 
 use crate::cmd::project_root;
 use crate::svg::{self, Scale, Series};
-use lagrange_core::{Error, Mechanism, State};
+use lagrange_core::{Error, Mechanism, Real, State};
 use lagrange_integrators::{ExplicitEuler, Integrator, Rk4, SemiImplicitEuler, VelocityVerlet};
 use lagrange_systems::exact::pendulum_from_rest;
 use lagrange_systems::{DoublePendulum, SimplePendulum};
@@ -30,6 +30,42 @@ const P2_REFERENCE: [f64; 4] = [
     6.078_384_885_761_965,
     -9.681_360_681_708_879,
 ];
+
+/// Median wall time per step of `steps` steps, over `TIMING_RUNS` whole runs.
+fn ns_per_step<T, I, M, const N: usize>(
+    mut integrator: I,
+    mechanism: &M,
+    start: &State<T, N>,
+    dt: T,
+    steps: u64,
+) -> f64
+where
+    T: Real,
+    I: Integrator<T, N>,
+    M: Mechanism<T, N>,
+{
+    let mut times: Vec<f64> = (0..TIMING_RUNS)
+        .map(|_| {
+            let clock = Instant::now();
+            let _ =
+                black_box(integrator.integrate(black_box(mechanism), black_box(start), dt, steps));
+            clock.elapsed().as_secs_f64() * 1e9 / steps as f64
+        })
+        .collect();
+    times.sort_by(f64::total_cmp);
+    times[TIMING_RUNS / 2]
+}
+
+/// RK4's cost per step on the pendulum and the double pendulum in `T`.
+fn rk4_cost<T: Real>() -> Result<(f64, f64), Error> {
+    let (one, g, dt) = (T::one(), T::from_f64(G), T::from_f64(1e-3));
+    let p = SimplePendulum::new(one, one, g, T::zero())?;
+    let dp = DoublePendulum::new(one, one, one, one, g)?;
+    Ok((
+        ns_per_step(Rk4, &p, &State::at_rest([T::from_f64(TH0)]), dt, 10_000),
+        ns_per_step(Rk4, &dp, &State::at_rest([T::from_f64(TH0); 2]), dt, 10_000),
+    ))
+}
 
 /// One integrator's run: samples for the table and plot, and its figures.
 struct Run<const N: usize> {
@@ -71,21 +107,12 @@ where
         }
     });
 
-    let mut times: Vec<f64> = (0..TIMING_RUNS)
-        .map(|_| {
-            let clock = Instant::now();
-            let _ =
-                black_box(integrator.integrate(black_box(mechanism), black_box(&start), dt, steps));
-            clock.elapsed().as_secs_f64() * 1e9 / steps as f64
-        })
-        .collect();
-    times.sort_by(f64::total_cmp);
     Run {
         name: I::NAME,
         samples,
         last,
         max_energy_error,
-        ns_per_step: times[TIMING_RUNS / 2],
+        ns_per_step: ns_per_step(integrator, mechanism, &start, dt, steps),
     }
 }
 
@@ -230,6 +257,12 @@ pub fn run() -> Result<(), String> {
     let fine = pendulum_table(1e-3)?;
     let chaotic = double_pendulum_table(1e-3)?;
     drop(coarse);
+    let (p32, dp32) = rk4_cost::<f32>().map_err(|e| e.to_string())?;
+    let (p64, dp64) = rk4_cost::<f64>().map_err(|e| e.to_string())?;
+    println!("\nRK4, ns per step (median of {TIMING_RUNS} runs of 10^4 steps):");
+    println!("{:<20} {:>8} {:>8}", "", "f32", "f64");
+    println!("{:<20} {p32:>8.1} {p64:>8.1}", "pendulum");
+    println!("{:<20} {dp32:>8.1} {dp64:>8.1}", "double pendulum");
 
     let mut angle = series(&fine, |s| s.0.q[0]);
     angle.push(Series {
