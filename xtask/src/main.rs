@@ -2,7 +2,7 @@
 //!
 //! - `demo`: the origin's pendulum and a double pendulum with every integrator, a table and an
 //!   SVG plot under `target/lagrange-demo/`.
-//! - `test`: host tests of every crate, f32 and f64.
+//! - `test`: host tests of every crate, f32 and f64, the long runs (`#[ignore]`d) in release.
 //! - `cross`: thumbv7em-none-eabihf builds of the library crates, with and without `defmt`,
 //!   and a linked no_std binary with no allocator, with its size.
 //! - `ci`: format check, clippy with `-D warnings`, test, cross.
@@ -18,7 +18,7 @@ fn main() -> ExitCode {
     let task = std::env::args().nth(1).unwrap_or_default();
     let result = match task.as_str() {
         "demo" => demo::run(),
-        "test" => cmd::run_all(&TEST),
+        "test" => cmd::run_all(&TEST).and(cmd::run_all(&LONG_TEST)),
         "cross" => cross::run(),
         "ci" => ci(),
         _ => {
@@ -55,12 +55,17 @@ const CHECKS: [&[&str]; 2] = [
 /// Doc tests are not part of `--all-targets`.
 const DOC_TEST: [&[&str]; 1] = [&["test", "--workspace", "--doc", "--quiet"]];
 
+/// Long runs (10^6 steps and more) are `#[ignore]`d in the quick debug test run and run here,
+/// optimised.
+const LONG_TEST: [&[&str]; 1] = [&["test", "--workspace", "--release", "--quiet", "--", "--ignored"]];
+
 /// Everything CI checks; every step runs and every failure is reported at the end.
 fn ci() -> Result<(), String> {
     let failures: Vec<String> = [
         cmd::run_all(&CHECKS),
         cmd::run_all(&TEST),
         cmd::run_all(&DOC_TEST),
+        cmd::run_all(&LONG_TEST),
         cross::run(),
     ]
     .into_iter()
