@@ -1,0 +1,299 @@
+//! Accelerations with Lagrange multipliers: [`constrained_acceleration`], the [`Constrained`]
+//! mechanism wrapper, and [`Stabilization`] (Baumgarte) against drift.
+
+use super::{Constraints, Schur};
+use crate::{validate, Error, Mechanism, Real, State};
+use nalgebra::{SMatrix, SVector};
+
+/// Drift control folded into the acceleration-level constraint equation.
+///
+/// Integrating `J q'' + J'q' = 0` keeps `phi'' = 0` only: rounding and truncation errors in
+/// `phi` and `phi'` then grow (linearly in `phi'`, quadratically in `phi`). Baumgarte replaces
+/// the equation by
+///
+/// ```text
+/// J q'' + J'q' = -2 alpha (J q') - beta^2 phi      i.e.  e'' + 2 alpha e' + beta^2 e = 0
+/// ```
+///
+/// so that a constraint error `e` decays instead of drifting (for a Pfaffian row `phi = 0`
+/// and only `-2 alpha (J q')` acts). The residual is then bounded, not zero: it settles where
+/// the integrator's per-step error is balanced by the decay, so a larger rate gives a smaller
+/// residual, until `alpha dt` nears the integrator's stability limit on the real axis (RK4
+/// 2.78, explicit Euler 2). [`Stabilization::for_step`] picks critical damping
+/// `alpha = beta = 1 / (5 dt)`, a rate well inside every explicit method's limit (measured:
+/// see the tests). For residuals at rounding level use projection
+/// ([`Projection`](crate::constraints::Projection)) instead.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub enum Stabilization<T> {
+    /// No drift control: `J q'' + J'q' = 0` exactly.
+    #[default]
+    None,
+    /// Baumgarte stabilisation with gains `alpha` (1/s, on `phi'`) and `beta` (1/s, on `phi`).
+    Baumgarte {
+        /// Damping rate on the velocity residual, 1/s.
+        alpha: T,
+        /// Natural frequency on the position residual, 1/s.
+        beta: T,
+    },
+}
+
+/// `1 / (alpha dt)` of [`Stabilization::for_step`].
+const STEPS_PER_DECAY: f64 = 5.0;
+
+impl<T: Real> Stabilization<T> {
+    /// Baumgarte stabilisation with gains `alpha` and `beta` (1/s, each >= 0).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] `alpha` or `beta` when negative or not finite.
+    pub fn baumgarte(alpha: T, beta: T) -> Result<Self, Error> {
+        Ok(Self::Baumgarte {
+            alpha: validate::non_negative("alpha", alpha)?,
+            beta: validate::non_negative("beta", beta)?,
+        })
+    }
+
+    /// Critically damped Baumgarte stabilisation, `alpha = beta = rate` (1/s, > 0): a
+    /// constraint error decays like `(1 + rate t) exp(-rate t)`.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] `rate` when not positive and finite.
+    pub fn critical(rate: T) -> Result<Self, Error> {
+        let rate = validate::positive("rate", rate)?;
+        Ok(Self::Baumgarte {
+            alpha: rate,
+            beta: rate,
+        })
+    }
+
+    /// Critically damped Baumgarte stabilisation for a fixed step `dt` (s, > 0):
+    /// `rate = 1 / (5 dt)`, so a constraint error decays over about five steps while
+    /// `rate dt = 0.2` stays far inside every explicit integrator's stability limit.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] `dt` when not positive and finite.
+    pub fn for_step(dt: T) -> Result<Self, Error> {
+        let dt = validate::positive("dt", dt)?;
+        Self::critical((T::from_f64(STEPS_PER_DECAY) * dt).recip())
+    }
+}
+
+/// The constrained accelerations and the multipliers that produce them.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ConstrainedAcceleration<T: Real, const N: usize, const C: usize> {
+    /// `q''`.
+    pub acceleration: SVector<T, N>,
+    /// `lambda`: the constraint forces are `J^T lambda` (generalized forces), and each
+    /// `lambda_i` is the force along row `i`'s gradient (for a contact row, the normal force;
+    /// it pushes when positive). Zero on inactive rows.
+    pub multipliers: SVector<T, C>,
+}
+
+/// Solves the KKT system of `mechanism` under the `constraints` rows marked `active`:
+///
+/// ```text
+/// [ M  J^T ] [  q''    ]   [ f + Q + extra                 ]
+/// [ J   0  ] [ -lambda ] = [ -J'q' - 2 alpha J q' - beta^2 phi ]     (Baumgarte terms when chosen)
+/// ```
+///
+/// by its Schur complement: `a0 = M^-1 (f + Q + extra)`, `S lambda = r - J a0`,
+/// `q'' = a0 + M^-1 J^T lambda`. Cost: `C + 1` calls of [`Mechanism::solve_mass`], one
+/// Jacobian and one velocity-product evaluation (plus `phi` for Baumgarte), a `C x C` Cholesky.
+///
+/// `mechanism` supplies `M` (through `solve_mass`), `f` and `Q`; its own
+/// [`Mechanism::acceleration`] is never called, so a constrained mechanism may pass itself.
+/// It must not hold constraints of its own: put every constraint in one set.
+///
+/// # Errors
+/// [`Error::RedundantConstraints`] for dependent or singular active rows;
+/// [`Error::NonFiniteState`]; whatever [`Mechanism::solve_mass`] returns.
+pub fn constrained_acceleration<T, M, K, const N: usize, const C: usize>(
+    mechanism: &M,
+    constraints: &K,
+    stabilization: &Stabilization<T>,
+    state: &State<T, N>,
+    extra: &SVector<T, N>,
+    active: &[bool; C],
+) -> Result<ConstrainedAcceleration<T, N, C>, Error>
+where
+    T: Real,
+    M: Mechanism<T, N>,
+    K: Constraints<T, N, C>,
+{
+    let force = mechanism.rhs(state) + mechanism.generalized_force(state) + extra;
+    let a0 = mechanism.solve_mass(state, &force)?;
+    let schur = Schur::new(mechanism, constraints, state, active)?;
+    let j = schur.jacobian();
+    let mut target = -constraints.velocity_product(&state.q, &state.qd);
+    if let Stabilization::Baumgarte { alpha, beta } = *stabilization {
+        target -= j * state.qd * (T::TWO * alpha);
+        if beta != T::zero() {
+            target -= constraints.position_residual(&state.q) * (beta * beta);
+        }
+    }
+    let multipliers = schur.multipliers(&(target - j * a0));
+    let acceleration = a0 + schur.response(&multipliers);
+    if acceleration.iter().chain(multipliers.iter()).all(|x| x.is_finite()) {
+        Ok(ConstrainedAcceleration {
+            acceleration,
+            multipliers,
+        })
+    } else {
+        Err(Error::NonFiniteState)
+    }
+}
+
+/// A mechanism under `C` constraints: it moves as the KKT system of
+/// [`constrained_acceleration`] says, so every integrator steps it unchanged.
+///
+/// `mechanism` must be unconstrained (its acceleration `M^-1 (f + Q)`); mass matrix, `f`, `Q`,
+/// energies and `solve_mass` are its own, and [`Mechanism::acceleration`] adds the constraint
+/// forces. Forces added by [`Mechanism::with_force`], inside or outside this wrapper, act
+/// through the constraints. Drift control: [`Stabilization`] here, or projection after each
+/// step (`Projected` in lagrange-integrators).
+///
+/// ```
+/// use lagrange_core::constraints::{Constrained, Holonomic, HolonomicConstraints};
+/// use lagrange_core::{EulerLagrange, Lagrangian, Mechanism, Scalar, State};
+/// use nalgebra::{SVector, Vector1};
+///
+/// /// A unit point mass in the plane in gravity 9.81 along -y.
+/// struct Particle;
+/// impl Lagrangian<f64, 2> for Particle {
+///     fn kinetic<S: Scalar<Real = f64>>(&self, _t: S, _q: &SVector<S, 2>, v: &SVector<S, 2>) -> S {
+///         (v[0] * v[0] + v[1] * v[1]) * S::from_f64(0.5)
+///     }
+///     fn potential<S: Scalar<Real = f64>>(&self, _t: S, q: &SVector<S, 2>) -> S {
+///         q[1] * S::from_f64(9.81)
+///     }
+/// }
+/// /// On a rod of length 1 from the origin.
+/// struct Rod;
+/// impl HolonomicConstraints<f64, 2, 1> for Rod {
+///     fn phi<S: Scalar<Real = f64>>(&self, q: &SVector<S, 2>) -> SVector<S, 1> {
+///         Vector1::new((q[0] * q[0] + q[1] * q[1] - S::one()) * S::from_f64(0.5))
+///     }
+/// }
+///
+/// let pendulum = Constrained::new(EulerLagrange::new(Particle), Holonomic::new(Rod));
+/// // Hanging at rest: the rod carries the weight, nothing moves.
+/// let hanging = State::new(0.0, [0.0, -1.0], [0.0, 0.0]);
+/// let solved = pendulum.solve(&hanging)?;
+/// assert!(solved.acceleration.iter().all(|a| a.abs() < 1e-15));
+/// assert!((solved.multipliers[0] - 9.81).abs() < 1e-14);
+/// # Ok::<(), lagrange_core::Error>(())
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Constrained<M, K, T, const C: usize> {
+    mechanism: M,
+    constraints: K,
+    stabilization: Stabilization<T>,
+}
+
+impl<M, K, T: Real, const C: usize> Constrained<M, K, T, C> {
+    /// `mechanism` held by `constraints`, without drift control.
+    pub fn new(mechanism: M, constraints: K) -> Self {
+        Self {
+            mechanism,
+            constraints,
+            stabilization: Stabilization::None,
+        }
+    }
+
+    /// The same with `stabilization`.
+    #[must_use]
+    pub fn with_stabilization(self, stabilization: Stabilization<T>) -> Self {
+        Self {
+            stabilization,
+            ..self
+        }
+    }
+
+    /// The unconstrained mechanism.
+    #[must_use]
+    pub fn mechanism(&self) -> &M {
+        &self.mechanism
+    }
+
+    /// The constraints.
+    #[must_use]
+    pub fn constraints(&self) -> &K {
+        &self.constraints
+    }
+
+    /// The drift control in use.
+    #[must_use]
+    pub fn stabilization(&self) -> Stabilization<T> {
+        self.stabilization
+    }
+
+    /// Accelerations and multipliers at `state`.
+    ///
+    /// # Errors
+    /// As [`constrained_acceleration`].
+    pub fn solve<const N: usize>(
+        &self,
+        state: &State<T, N>,
+    ) -> Result<ConstrainedAcceleration<T, N, C>, Error>
+    where
+        M: Mechanism<T, N>,
+        K: Constraints<T, N, C>,
+    {
+        self.solve_with(state, &SVector::zeros())
+    }
+
+    /// As [`Constrained::solve`] with an extra generalized force.
+    fn solve_with<const N: usize>(
+        &self,
+        state: &State<T, N>,
+        extra: &SVector<T, N>,
+    ) -> Result<ConstrainedAcceleration<T, N, C>, Error>
+    where
+        M: Mechanism<T, N>,
+        K: Constraints<T, N, C>,
+    {
+        constrained_acceleration(
+            &self.mechanism,
+            &self.constraints,
+            &self.stabilization,
+            state,
+            extra,
+            &[true; C],
+        )
+    }
+}
+
+impl<T, M, K, const N: usize, const C: usize> Mechanism<T, N> for Constrained<M, K, T, C>
+where
+    T: Real,
+    M: Mechanism<T, N>,
+    K: Constraints<T, N, C>,
+{
+    fn mass_matrix(&self, state: &State<T, N>) -> SMatrix<T, N, N> {
+        self.mechanism.mass_matrix(state)
+    }
+    fn rhs(&self, state: &State<T, N>) -> SVector<T, N> {
+        self.mechanism.rhs(state)
+    }
+    fn generalized_force(&self, state: &State<T, N>) -> SVector<T, N> {
+        self.mechanism.generalized_force(state)
+    }
+    fn kinetic_energy(&self, state: &State<T, N>) -> T {
+        self.mechanism.kinetic_energy(state)
+    }
+    fn potential_energy(&self, state: &State<T, N>) -> T {
+        self.mechanism.potential_energy(state)
+    }
+    fn solve_mass(&self, state: &State<T, N>, b: &SVector<T, N>) -> Result<SVector<T, N>, Error> {
+        self.mechanism.solve_mass(state, b)
+    }
+    fn acceleration(&self, state: &State<T, N>) -> Result<SVector<T, N>, Error> {
+        Ok(self.solve(state)?.acceleration)
+    }
+    fn acceleration_with(
+        &self,
+        state: &State<T, N>,
+        extra: &SVector<T, N>,
+    ) -> Result<SVector<T, N>, Error> {
+        Ok(self.solve_with(state, extra)?.acceleration)
+    }
+}
