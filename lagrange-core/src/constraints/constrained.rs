@@ -175,11 +175,12 @@ where
 /// }
 ///
 /// let pendulum = Constrained::new(EulerLagrange::new(Particle), Holonomic::new(Rod));
-/// // Hanging at rest: the rod carries the weight, nothing moves.
+/// // Hanging at rest: the rod carries the weight, nothing moves. The force J^T lambda pulls
+/// // the bob up, against grad phi = (0, -1): lambda = -m g, the rod's tension with its sign.
 /// let hanging = State::new(0.0, [0.0, -1.0], [0.0, 0.0]);
 /// let solved = pendulum.solve(&hanging)?;
 /// assert!(solved.acceleration.iter().all(|a| a.abs() < 1e-15));
-/// assert!((solved.multipliers[0] - 9.81).abs() < 1e-14);
+/// assert!((solved.multipliers[0] + 9.81).abs() < 1e-14);
 /// # Ok::<(), lagrange_core::Error>(())
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
