@@ -10,6 +10,8 @@
 //! | [`VelocityVerlet`] | 2 | explicit | constant `M`, forces of `q` only | 2 | long conservative runs at moderate accuracy |
 //! | [`Rk4`] | 4 | explicit | no (slow drift) | 4 | accurate short and medium runs |
 //!
+//! [`Projected`] wraps any of them to project onto constraints after every step.
+//!
 //! ```
 //! use lagrange_core::{Mechanism, State};
 //! use lagrange_integrators::{Integrator, Rk4};
@@ -28,12 +30,14 @@
 
 mod explicit_euler;
 mod integrator;
+mod projected;
 mod rk4;
 mod semi_implicit_euler;
 mod velocity_verlet;
 
 pub use explicit_euler::ExplicitEuler;
 pub use integrator::Integrator;
+pub use projected::Projected;
 pub use rk4::Rk4;
 pub use semi_implicit_euler::SemiImplicitEuler;
 pub use velocity_verlet::VelocityVerlet;

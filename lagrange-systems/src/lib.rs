@@ -13,6 +13,17 @@
 //! | [`BeadOnRotatingHoop`] | `[th]` | mass, radius, omega, gravity |
 //! | [`DoublePendulum`] | `[th1, th2]` | m1, m2, l1, l2, gravity |
 //!
+//! Constrained mechanisms (Lagrange multipliers, see
+//! [`lagrange_core::constraints`]): each also implements
+//! [`Constraints`](lagrange_core::Constraints), hand-derived, and the generic form the dual
+//! numbers check it against; its `acceleration` includes the constraint forces.
+//!
+//! | type | q | constraints | parameters |
+//! |---|---|---|---|
+//! | [`CartesianPendulum`] | `[x, y]` | 1 holonomic: `x^2 + y^2 = l^2` | mass, length, gravity |
+//! | [`FourBarLinkage`] | `[th1, th2, th3]` | 2 holonomic: loop closure | 4 lengths, 3 masses, gravity |
+//! | [`RollingDisk`] | `[x, y, psi, phi]` | 2 Pfaffian: rolling without slipping | mass, radius |
+//!
 //! [`exact`] holds closed-form solutions used as references.
 //!
 //! ```
@@ -28,12 +39,18 @@
 #![forbid(unsafe_code)]
 
 mod bead_on_rotating_hoop;
+mod cartesian_pendulum;
 mod double_pendulum;
 pub mod exact;
 mod falling_particle;
+mod four_bar_linkage;
+mod rolling_disk;
 mod simple_pendulum;
 
 pub use bead_on_rotating_hoop::BeadOnRotatingHoop;
+pub use cartesian_pendulum::CartesianPendulum;
 pub use double_pendulum::DoublePendulum;
 pub use falling_particle::FallingParticle;
+pub use four_bar_linkage::{Branch, FourBarLinkage};
+pub use rolling_disk::RollingDisk;
 pub use simple_pendulum::SimplePendulum;

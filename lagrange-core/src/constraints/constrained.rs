@@ -24,6 +24,7 @@ use nalgebra::{SMatrix, SVector};
 /// see the tests). For residuals at rounding level use projection
 /// ([`Projection`](crate::constraints::Projection)) instead.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Stabilization<T> {
     /// No drift control: `J q'' + J'q' = 0` exactly.
     #[default]
@@ -132,7 +133,11 @@ where
     }
     let multipliers = schur.multipliers(&(target - j * a0));
     let acceleration = a0 + schur.response(&multipliers);
-    if acceleration.iter().chain(multipliers.iter()).all(|x| x.is_finite()) {
+    if acceleration
+        .iter()
+        .chain(multipliers.iter())
+        .all(|x| x.is_finite())
+    {
         Ok(ConstrainedAcceleration {
             acceleration,
             multipliers,
@@ -184,6 +189,7 @@ where
 /// # Ok::<(), lagrange_core::Error>(())
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Constrained<M, K, T, const C: usize> {
     mechanism: M,
     constraints: K,
@@ -296,5 +302,16 @@ where
         extra: &SVector<T, N>,
     ) -> Result<SVector<T, N>, Error> {
         Ok(self.solve_with(state, extra)?.acceleration)
+    }
+}
+
+#[cfg(feature = "defmt")]
+impl<T: Real, const N: usize, const C: usize> defmt::Format for ConstrainedAcceleration<T, N, C> {
+    fn format(&self, f: defmt::Formatter<'_>) {
+        defmt::write!(f, "ConstrainedAcceleration {{ acceleration: ");
+        crate::state::format_vector(f, &self.acceleration);
+        defmt::write!(f, ", multipliers: ");
+        crate::state::format_vector(f, &self.multipliers);
+        defmt::write!(f, " }}");
     }
 }

@@ -23,7 +23,7 @@ mod set;
 
 pub use automatic::{Holonomic, HolonomicConstraints, Pfaffian, PfaffianConstraints};
 pub use constrained::{
-    constrained_acceleration, ConstrainedAcceleration, Constrained, Stabilization,
+    constrained_acceleration, Constrained, ConstrainedAcceleration, Stabilization,
 };
 pub use projection::Projection;
 pub use schur::Schur;

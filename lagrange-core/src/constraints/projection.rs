@@ -24,6 +24,7 @@ use nalgebra::SVector;
 /// `tolerance` is in the units of `phi`; choose it above the rounding level of `phi` (about
 /// `EPSILON` times its largest term), or Newton cannot reach it.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Projection<T> {
     tolerance: T,
     max_iterations: u32,
@@ -127,16 +128,4 @@ fn masked<T: Real, const C: usize>(mut v: SVector<T, C>, active: &[bool; C]) -> 
         }
     }
     v
-}
-
-#[cfg(feature = "defmt")]
-impl<T: Real> defmt::Format for Projection<T> {
-    fn format(&self, f: defmt::Formatter<'_>) {
-        defmt::write!(
-            f,
-            "Projection {{ tolerance: {}, max_iterations: {} }}",
-            self.tolerance.to_f64(),
-            self.max_iterations
-        );
-    }
 }

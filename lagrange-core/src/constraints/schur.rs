@@ -151,3 +151,10 @@ fn cholesky<T: Real, const C: usize>(s: &SMatrix<T, C, C>) -> Result<SMatrix<T, 
     }
     Ok(l)
 }
+
+#[cfg(feature = "defmt")]
+impl<T: Real, const N: usize, const C: usize> defmt::Format for Schur<T, N, C> {
+    fn format(&self, f: defmt::Formatter<'_>) {
+        defmt::write!(f, "Schur {{ active: {} }}", self.active);
+    }
+}

@@ -58,7 +58,9 @@ pub trait Constraints<T: Real, const N: usize, const C: usize> {
         state.check_finite()?;
         let phi = self.position_residual(&state.q);
         let w = self.jacobian(&state.q) * state.qd;
-        match (0..C).find(|&i| !(phi[i].abs() <= tolerance && w[i].abs() <= tolerance)) {
+        // Written so that a NaN residual counts as a violation.
+        let within = |i: usize| phi[i].abs() <= tolerance && w[i].abs() <= tolerance;
+        match (0..C).find(|&i| !within(i)) {
             Some(row) => Err(Error::ConstraintViolated { row }),
             None => Ok(()),
         }
@@ -67,21 +69,10 @@ pub trait Constraints<T: Real, const N: usize, const C: usize> {
 
 /// How far a state is from satisfying its constraints, in the constraints' own units.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Residual<T> {
     /// `max_i |phi_i(q)|` over the holonomic rows (0 with only Pfaffian rows).
     pub position: T,
     /// `max_i |(J q')_i|`.
     pub velocity: T,
-}
-
-#[cfg(feature = "defmt")]
-impl<T: Real> defmt::Format for Residual<T> {
-    fn format(&self, f: defmt::Formatter<'_>) {
-        defmt::write!(
-            f,
-            "Residual {{ position: {}, velocity: {} }}",
-            self.position.to_f64(),
-            self.velocity.to_f64()
-        );
-    }
 }
