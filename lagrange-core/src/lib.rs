@@ -53,7 +53,10 @@ mod state;
 pub mod validate;
 
 pub use cholesky::solve_spd;
-pub use constraints::{Constrained, Constraints, Holonomic, Pfaffian, Projection, Stabilization};
+pub use constraints::{
+    Constrained, Constraints, Holonomic, HolonomicConstraints, Pfaffian, PfaffianConstraints,
+    Projection, Stabilization,
+};
 pub use dual::Dual;
 pub use error::Error;
 pub use forces::{Forced, GeneralizedForce, Input, ViscousDamping};

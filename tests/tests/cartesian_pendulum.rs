@@ -119,8 +119,14 @@ fn residual_figures(steps: u64) -> Result<(), Error> {
     assert!(with_projection < 1e-10, "{with_projection:e}");
     assert!(none > 20.0 * none_early, "{none_early:e} -> {none:e}");
     assert!(none > 10.0 * with_projection, "{none:e}");
-    assert!(b_end <= 1.5 * b_early && b_end < 2e-12, "{b_early:e} {b_end:e}");
-    assert!(vb_end <= 1.5 * vb_early && vb_end < 2e-8, "{vb_early:e} {vb_end:e}");
+    assert!(
+        b_end <= 1.5 * b_early && b_end < 2e-12,
+        "{b_early:e} {b_end:e}"
+    );
+    assert!(
+        vb_end <= 1.5 * vb_early && vb_end < 2e-8,
+        "{vb_early:e} {vb_end:e}"
+    );
     assert!(vb_end * 1e3 < verlet_none, "{vb_end:e} {verlet_none:e}");
     Ok(())
 }

@@ -72,7 +72,10 @@ where
             (hand.jacobian(&s.q), auto.constraints().jacobian(&s.q));
         let e = relative(ja.iter().copied(), jb.iter().copied(), 1.0);
         worst = worst.max(e);
-        assert!(e < tol, "jacobian at {s:?}: hand {ja:?} auto {jb:?} ({e:e})");
+        assert!(
+            e < tol,
+            "jacobian at {s:?}: hand {ja:?} auto {jb:?} ({e:e})"
+        );
         let a = hand.acceleration(&s)?;
         let b = auto.solve(&s)?;
         let e = relative(a.iter().copied(), b.acceleration.iter().copied(), scale);
@@ -84,7 +87,11 @@ where
 
 fn cartesian_pendulum_agrees<T: Real>() -> Result<(), Error> {
     let mut rng = Rng::new(61);
-    let p = CartesianPendulum::new(rng.uniform(0.5, 2.0), rng.uniform(0.5, 2.0), T::from_f64(9.81))?;
+    let p = CartesianPendulum::new(
+        rng.uniform(0.5, 2.0),
+        rng.uniform(0.5, 2.0),
+        T::from_f64(9.81),
+    )?;
     // Anywhere but near the pivot, on the circle or off it.
     let states = (0..STATES).map(|_| {
         let r: T = rng.uniform(0.3, 3.0);
@@ -96,7 +103,11 @@ fn cartesian_pendulum_agrees<T: Real>() -> Result<(), Error> {
         ))
     });
     let worst = agree(&p, Holonomic::new(p), states, 10.0)?;
-    let multipliers = p.solve(&State::new(T::zero(), [T::one(), T::zero()], [T::zero(); 2]))?;
+    let multipliers = p.solve(&State::new(
+        T::zero(),
+        [T::one(), T::zero()],
+        [T::zero(); 2],
+    ))?;
     assert!(multipliers.multipliers[0].abs() < T::EPSILON);
     println!("Cartesian pendulum: worst relative difference {worst:.1e}");
     Ok(())
@@ -105,19 +116,27 @@ fn cartesian_pendulum_agrees<T: Real>() -> Result<(), Error> {
 fn four_bar_agrees<T: Real>() -> Result<(), Error> {
     let mut rng = Rng::new(62);
     let linkage = FourBarLinkage::new(
+        [T::one(), T::from_f64(0.3), T::one(), T::from_f64(0.8)],
         [
-            T::one(),
-            T::from_f64(0.3),
-            T::one(),
-            T::from_f64(0.8),
+            rng.uniform(0.5, 2.0),
+            rng.uniform(0.5, 2.0),
+            rng.uniform(0.5, 2.0),
         ],
-        [rng.uniform(0.5, 2.0), rng.uniform(0.5, 2.0), rng.uniform(0.5, 2.0)],
         T::from_f64(9.81),
     )?;
     // Consistent states (a crank-rocker closes at every crank angle), both branches.
     let states = (0..STATES).map(|i| {
-        let branch = if i % 2 == 0 { Branch::Left } else { Branch::Right };
-        linkage.assemble(T::zero(), rng.uniform(-3.2, 3.2), rng.uniform(-8.0, 8.0), branch)
+        let branch = if i % 2 == 0 {
+            Branch::Left
+        } else {
+            Branch::Right
+        };
+        linkage.assemble(
+            T::zero(),
+            rng.uniform(-3.2, 3.2),
+            rng.uniform(-8.0, 8.0),
+            branch,
+        )
     });
     let worst = agree(&linkage, Holonomic::new(linkage), states, 100.0)?;
     println!("four-bar linkage: worst relative difference {worst:.1e}");
@@ -140,4 +159,8 @@ fn rolling_disk_agrees<T: Real>() -> Result<(), Error> {
     Ok(())
 }
 
-for_f32_and_f64!(cartesian_pendulum_agrees, four_bar_agrees, rolling_disk_agrees);
+for_f32_and_f64!(
+    cartesian_pendulum_agrees,
+    four_bar_agrees,
+    rolling_disk_agrees
+);

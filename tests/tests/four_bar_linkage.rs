@@ -4,8 +4,7 @@
 
 use lagrange_core::nalgebra::SVector;
 use lagrange_core::{
-    Constraints, Dual, Error, EulerLagrange, Lagrangian, Mechanism, Projection, Real, Scalar,
-    State,
+    Constraints, Dual, Error, EulerLagrange, Lagrangian, Mechanism, Projection, Real, Scalar, State,
 };
 use lagrange_integrators::{Integrator, Projected, Rk4};
 use lagrange_systems::{Branch, FourBarLinkage};
@@ -20,7 +19,11 @@ const CRANK_RATE: f64 = 12.0;
 const DT: f64 = 1e-3;
 
 fn linkage<T: Real>() -> Result<FourBarLinkage<T>, Error> {
-    FourBarLinkage::new(LENGTHS.map(T::from_f64), MASSES.map(T::from_f64), T::from_f64(G))
+    FourBarLinkage::new(
+        LENGTHS.map(T::from_f64),
+        MASSES.map(T::from_f64),
+        T::from_f64(G),
+    )
 }
 
 /// The same linkage with the crank angle as its only coordinate. Coupler and rocker follow
@@ -41,7 +44,10 @@ impl Reduced {
         let along = (b * b - c * c + e2) / (e + e);
         let h = (b * b - along * along).sqrt();
         // The right of B -> D: the direction (ex, ey) turned clockwise, (ey, -ex).
-        let (cx, cy) = (bx + (along * ex + h * ey) / e, by + (along * ey - h * ex) / e);
+        let (cx, cy) = (
+            bx + (along * ex + h * ey) / e,
+            by + (along * ey - h * ex) / e,
+        );
         ((cx - bx).atan2(by - cy), (cx - d).atan2(-cy))
     }
 }
@@ -59,9 +65,7 @@ impl Lagrangian<f64, 1> for Reduced {
         let crank = m1 * a * a * third * w1 * w1;
         let rocker = m3 * c * c * third * w3 * w3;
         let coupler = m2
-            * (a * a * w1 * w1
-                + b * b * third * w2 * w2
-                + a * b * (q[0] - th2.re).cos() * w1 * w2);
+            * (a * a * w1 * w1 + b * b * third * w2 * w2 + a * b * (q[0] - th2.re).cos() * w1 * w2);
         half * (crank + coupler + rocker)
     }
     fn potential<S: Scalar<Real = f64>>(&self, _t: S, q: &SVector<S, 1>) -> S {
