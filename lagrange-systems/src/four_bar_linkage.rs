@@ -2,8 +2,7 @@
 //! holonomic constraints.
 
 use lagrange_core::constraints::{
-    constrained_acceleration, ConstrainedAcceleration, Constraints, HolonomicConstraints,
-    Stabilization,
+    solve_kkt, ConstrainedAcceleration, Constraints, HolonomicConstraints, Schur, Stabilization,
 };
 use lagrange_core::nalgebra::{Matrix2x3, SMatrix, SVector, Vector2, Vector3};
 use lagrange_core::{validate, Error, Lagrangian, Mechanism, Real, Scalar, State};
@@ -180,12 +179,101 @@ impl<T: Real> FourBarLinkage<T> {
         self.solve_with(state, &SVector::zeros())
     }
 
+    /// The hand-derived fast path: every trigonometric term computed once, then the shared
+    /// Schur-complement solve.
     fn solve_with(
         &self,
         state: &State<T, 3>,
         extra: &Vector3<T>,
     ) -> Result<ConstrainedAcceleration<T, 3, 2>, Error> {
-        constrained_acceleration(self, self, &self.stabilization, state, extra, &[true; 2])
+        let trig = Trig::new(&state.q);
+        let force = self.rhs_from(&trig, &state.qd) + self.generalized_force(state) + extra;
+        let solve = |b: &Vector3<T>| self.solve_mass_from(&trig, b);
+        let a0 = solve(&force)?;
+        let jacobian = self.jacobian_from(&trig);
+        let target = self.stabilization.target(
+            &self.velocity_product_from(&trig, &state.qd),
+            &(jacobian * state.qd),
+            || self.phi_from(&trig),
+        );
+        let schur = Schur::from_parts(jacobian, solve, &[true; 2])?;
+        solve_kkt(&schur, &a0, &target)
+    }
+
+    /// `M`, from the angles' sines and cosines.
+    fn mass_matrix_from(&self, t: &Trig<T>) -> SMatrix<T, 3, 3> {
+        let (i1, i2, i3, k) = self.inertias();
+        let kc = k * t.cos12;
+        SMatrix::<T, 3, 3>::new(
+            i1,
+            kc,
+            T::zero(),
+            kc,
+            i2,
+            T::zero(),
+            T::zero(),
+            T::zero(),
+            i3,
+        )
+    }
+
+    /// `f`, from the angles' sines and cosines and the rates.
+    fn rhs_from(&self, t: &Trig<T>, qd: &Vector3<T>) -> Vector3<T> {
+        let (_, _, _, k) = self.inertias();
+        let [w1, w2, w3] = self.weights();
+        let ks = k * t.sin12;
+        Vector3::new(
+            -ks * qd[1] * qd[1] - w1 * t.sin[0],
+            ks * qd[0] * qd[0] - w2 * t.sin[1],
+            -w3 * t.sin[2],
+        )
+    }
+
+    /// `M^-1 b` in closed form: a 2x2 block (crank, coupler) and the rocker's inertia.
+    fn solve_mass_from(&self, t: &Trig<T>, b: &Vector3<T>) -> Result<Vector3<T>, Error> {
+        let (i1, i2, i3, k) = self.inertias();
+        let kc = k * t.cos12;
+        let det = i1 * i2 - kc * kc;
+        if !det.is_finite() {
+            return Err(Error::NonFiniteState);
+        }
+        Ok(Vector3::new(
+            (i2 * b[0] - kc * b[1]) / det,
+            (i1 * b[1] - kc * b[0]) / det,
+            b[2] / i3,
+        ))
+    }
+
+    /// `phi`.
+    fn phi_from(&self, t: &Trig<T>) -> Vector2<T> {
+        let [d, a, b, c] = self.lengths;
+        Vector2::new(
+            a * t.sin[0] + b * t.sin[1] - c * t.sin[2] - d,
+            -a * t.cos[0] - b * t.cos[1] + c * t.cos[2],
+        )
+    }
+
+    /// `J`.
+    fn jacobian_from(&self, t: &Trig<T>) -> Matrix2x3<T> {
+        let [_, a, b, c] = self.lengths;
+        Matrix2x3::new(
+            a * t.cos[0],
+            b * t.cos[1],
+            -c * t.cos[2],
+            a * t.sin[0],
+            b * t.sin[1],
+            -c * t.sin[2],
+        )
+    }
+
+    /// `J'q'`.
+    fn velocity_product_from(&self, t: &Trig<T>, qd: &Vector3<T>) -> Vector2<T> {
+        let [_, a, b, c] = self.lengths;
+        let (w1, w2, w3) = (qd[0] * qd[0], qd[1] * qd[1], qd[2] * qd[2]);
+        Vector2::new(
+            -a * t.sin[0] * w1 - b * t.sin[1] * w2 + c * t.sin[2] * w3,
+            a * t.cos[0] * w1 + b * t.cos[1] * w2 - c * t.cos[2] * w3,
+        )
     }
 
     /// `(I1, I2, I3, k)` of the mass matrix.
@@ -216,29 +304,10 @@ impl<T: Real> FourBarLinkage<T> {
 
 impl<T: Real> Mechanism<T, 3> for FourBarLinkage<T> {
     fn mass_matrix(&self, s: &State<T, 3>) -> SMatrix<T, 3, 3> {
-        let (i1, i2, i3, k) = self.inertias();
-        let kc = k * (s.q[0] - s.q[1]).cos();
-        SMatrix::<T, 3, 3>::new(
-            i1,
-            kc,
-            T::zero(),
-            kc,
-            i2,
-            T::zero(),
-            T::zero(),
-            T::zero(),
-            i3,
-        )
+        self.mass_matrix_from(&Trig::new(&s.q))
     }
     fn rhs(&self, s: &State<T, 3>) -> Vector3<T> {
-        let (_, _, _, k) = self.inertias();
-        let [w1, w2, w3] = self.weights();
-        let ks = k * (s.q[0] - s.q[1]).sin();
-        Vector3::new(
-            -ks * s.qd[1] * s.qd[1] - w1 * s.q[0].sin(),
-            ks * s.qd[0] * s.qd[0] - w2 * s.q[1].sin(),
-            -w3 * s.q[2].sin(),
-        )
+        self.rhs_from(&Trig::new(&s.q), &s.qd)
     }
     fn kinetic_energy(&self, s: &State<T, 3>) -> T {
         let (i1, i2, i3, k) = self.inertias();
@@ -250,19 +319,8 @@ impl<T: Real> Mechanism<T, 3> for FourBarLinkage<T> {
         let [w1, w2, w3] = self.weights();
         -(w1 * s.q[0].cos() + w2 * s.q[1].cos() + w3 * s.q[2].cos())
     }
-    /// The closed-form inverse: a 2x2 block (crank, coupler) and the rocker's inertia.
     fn solve_mass(&self, s: &State<T, 3>, b: &Vector3<T>) -> Result<Vector3<T>, Error> {
-        let (i1, i2, i3, k) = self.inertias();
-        let kc = k * (s.q[0] - s.q[1]).cos();
-        let det = i1 * i2 - kc * kc;
-        if !det.is_finite() {
-            return Err(Error::NonFiniteState);
-        }
-        Ok(Vector3::new(
-            (i2 * b[0] - kc * b[1]) / det,
-            (i1 * b[1] - kc * b[0]) / det,
-            b[2] / i3,
-        ))
+        self.solve_mass_from(&Trig::new(&s.q), b)
     }
     fn acceleration(&self, s: &State<T, 3>) -> Result<Vector3<T>, Error> {
         Ok(self.solve(s)?.acceleration)
@@ -274,25 +332,35 @@ impl<T: Real> Mechanism<T, 3> for FourBarLinkage<T> {
 
 impl<T: Real> Constraints<T, 3, 2> for FourBarLinkage<T> {
     fn position_residual(&self, q: &Vector3<T>) -> Vector2<T> {
-        self.phi(q)
+        self.phi_from(&Trig::new(q))
     }
     fn jacobian(&self, q: &Vector3<T>) -> Matrix2x3<T> {
-        let [_, a, b, c] = self.lengths;
-        let (s1, c1) = q[0].sin_cos();
-        let (s2, c2) = q[1].sin_cos();
-        let (s3, c3) = q[2].sin_cos();
-        Matrix2x3::new(a * c1, b * c2, -c * c3, a * s1, b * s2, -c * s3)
+        self.jacobian_from(&Trig::new(q))
     }
     fn velocity_product(&self, q: &Vector3<T>, qd: &Vector3<T>) -> Vector2<T> {
-        let [_, a, b, c] = self.lengths;
+        self.velocity_product_from(&Trig::new(q), qd)
+    }
+}
+
+/// Sines and cosines of the three angles and of `th1 - th2`, computed once per evaluation.
+struct Trig<T> {
+    sin: [T; 3],
+    cos: [T; 3],
+    sin12: T,
+    cos12: T,
+}
+
+impl<T: Real> Trig<T> {
+    fn new(q: &Vector3<T>) -> Self {
         let (s1, c1) = q[0].sin_cos();
         let (s2, c2) = q[1].sin_cos();
         let (s3, c3) = q[2].sin_cos();
-        let (w1, w2, w3) = (qd[0] * qd[0], qd[1] * qd[1], qd[2] * qd[2]);
-        Vector2::new(
-            -a * s1 * w1 - b * s2 * w2 + c * s3 * w3,
-            a * c1 * w1 + b * c2 * w2 - c * c3 * w3,
-        )
+        Self {
+            sin: [s1, s2, s3],
+            cos: [c1, c2, c3],
+            sin12: s1 * c2 - c1 * s2,
+            cos12: c1 * c2 + s1 * s2,
+        }
     }
 }
 

@@ -1,7 +1,8 @@
 //! `cargo xtask`: the project's automation, in Rust so that it runs wherever cargo does.
 //!
 //! - `demo`: the origin's pendulum and a double pendulum with every integrator, a table and an
-//!   SVG plot under `target/lagrange-demo/`.
+//!   SVG plot under `target/lagrange-demo/`; then a constrained and a colliding scene with
+//!   their plots.
 //! - `test`: host tests of every crate, f32 and f64, the long runs (`#[ignore]`d) in release.
 //! - `cross`: thumbv7em-none-eabihf builds of the library crates, with and without `defmt`,
 //!   and a linked no_std binary with no allocator, with its size.
@@ -10,6 +11,7 @@
 mod cmd;
 mod cross;
 mod demo;
+mod demo_constraints;
 mod svg;
 
 use std::process::ExitCode;

@@ -97,6 +97,27 @@ impl<T: Real> Stabilization<T> {
     }
 }
 
+impl<T: Real> Stabilization<T> {
+    /// The right-hand side of the acceleration-level constraint equation `J q'' = target`:
+    /// `-J'q'` without stabilisation, `-J'q' - 2 alpha (J q') - beta^2 phi` with Baumgarte.
+    /// `phi` is called only when `beta` is not zero.
+    pub fn target<const C: usize>(
+        &self,
+        velocity_product: &SVector<T, C>,
+        velocity_residual: &SVector<T, C>,
+        phi: impl FnOnce() -> SVector<T, C>,
+    ) -> SVector<T, C> {
+        let mut target = -velocity_product;
+        if let Self::Baumgarte { alpha, beta } = *self {
+            target -= velocity_residual * (T::TWO * alpha);
+            if beta != T::zero() {
+                target -= phi() * (beta * beta);
+            }
+        }
+        target
+    }
+}
+
 /// The constrained accelerations and the multipliers that produce them.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ConstrainedAcceleration<T: Real, const N: usize, const C: usize> {
@@ -141,17 +162,39 @@ where
 {
     let force = mechanism.rhs(state) + mechanism.generalized_force(state) + extra;
     let a0 = mechanism.solve_mass(state, &force)?;
+    if !active.iter().any(|&on| on) {
+        // No row in force (a contact set in free flight): the unconstrained motion.
+        return Ok(ConstrainedAcceleration {
+            acceleration: a0,
+            multipliers: SVector::zeros(),
+        });
+    }
     let schur = Schur::new(mechanism, constraints, state, active)?;
     let j = schur.jacobian();
-    let mut target = -constraints.velocity_product(&state.q, &state.qd);
-    if let Stabilization::Baumgarte { alpha, beta } = *stabilization {
-        target -= j * state.qd * (T::TWO * alpha);
-        if beta != T::zero() {
-            target -= constraints.position_residual(&state.q) * (beta * beta);
-        }
-    }
-    let multipliers = schur.multipliers(&(target - j * a0));
-    let acceleration = a0 + schur.response(&multipliers);
+    let target = stabilization.target(
+        &constraints.velocity_product(&state.q, &state.qd),
+        &(j * state.qd),
+        || constraints.position_residual(&state.q),
+    );
+    solve_kkt(&schur, &a0, &target)
+}
+
+/// The last stage of every constrained solve: with `S` factored in `schur`, the free
+/// acceleration `a0 = M^-1 (f + Q)` and the constraint equation `J q'' = target`,
+///
+/// ```text
+/// lambda = S^-1 (target - J a0),    q'' = a0 + M^-1 J^T lambda
+/// ```
+///
+/// # Errors
+/// [`Error::NonFiniteState`] when the result is not finite.
+pub fn solve_kkt<T: Real, const N: usize, const C: usize>(
+    schur: &Schur<T, N, C>,
+    free_acceleration: &SVector<T, N>,
+    target: &SVector<T, C>,
+) -> Result<ConstrainedAcceleration<T, N, C>, Error> {
+    let multipliers = schur.multipliers(&(target - schur.jacobian() * free_acceleration));
+    let acceleration = free_acceleration + schur.response(&multipliers);
     if acceleration
         .iter()
         .chain(multipliers.iter())

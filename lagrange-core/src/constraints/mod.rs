@@ -23,7 +23,7 @@ mod set;
 
 pub use automatic::{Holonomic, HolonomicConstraints, Pfaffian, PfaffianConstraints};
 pub use constrained::{
-    constrained_acceleration, Constrained, ConstrainedAcceleration, Stabilization,
+    constrained_acceleration, solve_kkt, Constrained, ConstrainedAcceleration, Stabilization,
 };
 pub use projection::Projection;
 pub use schur::Schur;

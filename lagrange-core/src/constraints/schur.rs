@@ -49,11 +49,31 @@ impl<T: Real, const N: usize, const C: usize> Schur<T, N, C> {
         M: Mechanism<T, N>,
         K: Constraints<T, N, C>,
     {
-        let mut jacobian = constraints.jacobian(&state.q);
+        Self::from_parts(
+            constraints.jacobian(&state.q),
+            |b| mechanism.solve_mass(state, b),
+            active,
+        )
+    }
+
+    /// The same from a Jacobian and a mass solve `b -> M^-1 b` already at hand: the fast path
+    /// of a hand-derived mechanism that computes its trigonometry once per evaluation.
+    ///
+    /// # Errors
+    /// As [`Schur::new`], with `solve_mass`'s errors.
+    pub fn from_parts<F>(
+        jacobian: SMatrix<T, C, N>,
+        mut solve_mass: F,
+        active: &[bool; C],
+    ) -> Result<Self, Error>
+    where
+        F: FnMut(&SVector<T, N>) -> Result<SVector<T, N>, Error>,
+    {
+        let mut jacobian = jacobian;
         let mut mobility = SMatrix::<T, N, C>::zeros();
         for (i, &on) in active.iter().enumerate() {
             if on {
-                let column = mechanism.solve_mass(state, &jacobian.row(i).transpose())?;
+                let column = solve_mass(&jacobian.row(i).transpose())?;
                 mobility.set_column(i, &column);
             } else {
                 jacobian.row_mut(i).fill(T::zero());

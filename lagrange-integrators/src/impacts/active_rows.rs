@@ -126,14 +126,24 @@ where
     fn solve_mass(&self, state: &State<T, N>, b: &SVector<T, N>) -> Result<SVector<T, N>, Error> {
         self.mechanism.solve_mass(state, b)
     }
+    /// In free flight (no row in force) the mechanism's own, possibly closed-form,
+    /// acceleration.
     fn acceleration(&self, state: &State<T, N>) -> Result<SVector<T, N>, Error> {
-        self.acceleration_with(state, &SVector::zeros())
+        if self.active.iter().any(|&on| on) {
+            self.acceleration_with(state, &SVector::zeros())
+        } else {
+            self.mechanism.acceleration(state)
+        }
     }
     fn acceleration_with(
         &self,
         state: &State<T, N>,
         extra: &SVector<T, N>,
     ) -> Result<SVector<T, N>, Error> {
-        Ok(self.solve(state, extra)?.0.acceleration)
+        if self.active.iter().any(|&on| on) {
+            Ok(self.solve(state, extra)?.0.acceleration)
+        } else {
+            self.mechanism.acceleration_with(state, extra)
+        }
     }
 }
