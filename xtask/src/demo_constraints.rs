@@ -208,9 +208,19 @@ fn contact_model(restitution: f64) -> Result<ContactModel<f64>, Error> {
     ContactModel::new(restitution, 0.05, 1e-10)
 }
 
-/// A ball dropped from 1 m with e = 0.8 for 6 s: `(t, y)` every step, the apexes between
-/// impacts, the impact count and the time it came to rest.
-fn ball() -> Result<(Vec<(f64, f64)>, Vec<f64>, u64, Option<f64>), Error> {
+/// What the ball's run measured.
+struct BallRun {
+    /// `(t, y)` every step.
+    path: Vec<(f64, f64)>,
+    /// The highest `y` between successive impacts.
+    apexes: Vec<f64>,
+    impacts: u64,
+    /// When the contact became resting.
+    rest: Option<f64>,
+}
+
+/// A ball dropped from 1 m with e = 0.8 for 6 s.
+fn ball() -> Result<BallRun, Error> {
     let ball = FallingParticle::new(1.0, G)?;
     let mut stepper = ContactStepper::new(
         Rk4,
@@ -234,12 +244,27 @@ fn ball() -> Result<(Vec<(f64, f64)>, Vec<f64>, u64, Option<f64>), Error> {
             rest = Some(s.t);
         }
     }
-    Ok((path, apexes, stepper.impacts(), rest))
+    Ok(BallRun {
+        path,
+        apexes,
+        impacts: stepper.impacts(),
+        rest,
+    })
 }
 
-/// The double pendulum thrown onto the floor (e = 0.8) for 20 s: `(t, E, gap 1, gap 2)`, the
-/// impacts, the deepest gap and whether energy ever rose at an impact.
-fn double_on_floor() -> Result<(Vec<[f64; 4]>, u64, f64, f64), Error> {
+/// What the double pendulum's run measured.
+struct FloorRun {
+    /// `(t, E, gap 1, gap 2)` every 20 steps.
+    samples: Vec<[f64; 4]>,
+    impacts: u64,
+    /// The lowest gap of any contact row after any step.
+    deepest: f64,
+    /// The largest change of kinetic energy across an impact (negative: always a loss).
+    gain: f64,
+}
+
+/// The double pendulum thrown onto the floor (e = 0.8) for 20 s.
+fn double_on_floor() -> Result<FloorRun, Error> {
     let dp = DoublePendulum::new(1.0, 1.0, 1.0, 1.0, G)?;
     let contacts = Holonomic::new(FloorAndLimits);
     let mut stepper = ContactStepper::new(
@@ -261,7 +286,12 @@ fn double_on_floor() -> Result<(Vec<[f64; 4]>, u64, f64, f64), Error> {
             out.push([s.t, dp.energy(&s), gaps[0], gaps[1]]);
         }
     }
-    Ok((out, stepper.impacts(), deepest, gain))
+    Ok(FloorRun {
+        samples: out,
+        impacts: stepper.impacts(),
+        deepest,
+        gain,
+    })
 }
 
 /// Nanoseconds per step of the ball's and the double pendulum's contact runs (events and
@@ -381,7 +411,12 @@ fn constrained_scene() -> Result<(), String> {
 
 /// The colliding scene: tables and `impacts.svg`.
 fn colliding_scene() -> Result<(), String> {
-    let (path, apexes, impacts, rest) = ball().map_err(|e| e.to_string())?;
+    let BallRun {
+        path,
+        apexes,
+        impacts,
+        rest,
+    } = ball().map_err(|e| e.to_string())?;
     println!(
         "\nBall dropped from 1 m on the ground, e = 0.8, RK4 at dt = 1e-3 s, contacts located \
          to 1e-10 s: {impacts} impacts, at rest from t = {} s",
@@ -398,7 +433,12 @@ fn colliding_scene() -> Result<(), String> {
         }
     }
 
-    let (dp, dp_impacts, deepest, gain) = double_on_floor().map_err(|e| e.to_string())?;
+    let FloorRun {
+        samples: dp,
+        impacts: dp_impacts,
+        deepest,
+        gain,
+    } = double_on_floor().map_err(|e| e.to_string())?;
     println!(
         "\nDouble pendulum thrown onto a floor 0.8 m below its pivot, joint limits |th2 - th1| \
          <= 2.5, e = 0.8, 20 s: {dp_impacts} impacts, deepest gap {deepest:.1e} m, largest \
