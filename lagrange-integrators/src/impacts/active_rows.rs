@@ -3,7 +3,7 @@
 
 use super::Contacts;
 use lagrange_core::constraints::{
-    constrained_acceleration, ConstrainedAcceleration, Stabilization,
+    constrained_acceleration, ConstrainedAcceleration, Schur, Stabilization,
 };
 use lagrange_core::nalgebra::{SMatrix, SVector};
 use lagrange_core::{Error, Mechanism, Real, State};
@@ -41,7 +41,15 @@ impl<T: Real, M, K, const C: usize> ActiveRows<'_, M, K, T, C> {
         let mut active = self.active;
         // Each pass either returns or drops at least one active row, so at most C + 1 passes.
         loop {
-            let mut solved = self.solve_rows(state, extra, &active)?;
+            let mut solved = match self.solve_rows(state, extra, &active) {
+                Err(Error::RedundantConstraints { row })
+                    if redundant_contact(row, &active, &self.unilateral) =>
+                {
+                    active[row] = false;
+                    continue;
+                }
+                other => other?,
+            };
             if self.friction > T::zero() {
                 if let Some(tangents) = self.contacts.tangent_jacobian(&state.q) {
                     let force =
@@ -99,6 +107,50 @@ impl<T: Real, M, K, const C: usize> ActiveRows<'_, M, K, T, C> {
             }
         }
         force
+    }
+}
+
+/// True when `row` is an active unilateral row: a contact that depends on the other rows
+/// carries no force of its own (they already hold the motion), so it can be left out, where
+/// a dependent bilateral row is the user's error.
+fn redundant_contact<const C: usize>(
+    row: usize,
+    active: &[bool; C],
+    unilateral: &[bool; C],
+) -> bool {
+    active.get(row).copied().unwrap_or(false) && unilateral.get(row).copied().unwrap_or(false)
+}
+
+/// The Schur complement of the `active` rows with every contact (row not in `bilateral`) that
+/// depends on the rows before it left out of `active`: several contacts holding the same
+/// freedom, or more resting contacts than degrees of freedom.
+///
+/// # Errors
+/// [`Error::RedundantConstraints`] when bilateral rows depend on each other; as
+/// [`Schur::new`] otherwise.
+pub(crate) fn independent<T, M, K, const N: usize, const C: usize>(
+    mechanism: &M,
+    contacts: &K,
+    state: &State<T, N>,
+    active: &mut [bool; C],
+    bilateral: &[bool; C],
+) -> Result<Schur<T, N, C>, Error>
+where
+    T: Real,
+    M: Mechanism<T, N>,
+    K: Contacts<T, N, C>,
+{
+    let unilateral: [bool; C] = core::array::from_fn(|i| !bilateral[i]);
+    // Each failed pass leaves out one more row, so at most C + 1 passes.
+    loop {
+        match Schur::new(mechanism, contacts, state, active) {
+            Err(Error::RedundantConstraints { row })
+                if redundant_contact(row, active, &unilateral) =>
+            {
+                active[row] = false;
+            }
+            other => return other,
+        }
     }
 }
 

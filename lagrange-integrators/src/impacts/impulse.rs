@@ -1,6 +1,7 @@
 //! Impacts: the jump of the generalized velocities by mass-weighted impulses, and the
 //! [`Impact`] record an observer receives.
 
+use super::active_rows::independent;
 use super::{ContactModel, Contacts};
 use lagrange_core::constraints::Schur;
 use lagrange_core::nalgebra::SVector;
@@ -155,7 +156,13 @@ impl<K, T: Real, const C: usize> Rows<'_, K, T, C> {
     {
         // Each pass either finishes or removes at least one row, so at most C + 1 passes.
         loop {
-            let schur = Schur::new(mechanism, self.contacts, state, &active)?;
+            let schur = independent(
+                mechanism,
+                self.contacts,
+                state,
+                &mut active,
+                &self.bilateral,
+            )?;
             let w = schur.jacobian() * state.qd;
             let change = SVector::<T, C>::from_fn(|i, _| {
                 if bounce[i] {

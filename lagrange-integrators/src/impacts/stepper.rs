@@ -1,7 +1,7 @@
 //! [`ContactStepper`]: fixed steps with contacts found inside the step, impacts at the contact
 //! time, and resting contacts held as constraints.
 
-use super::active_rows::ActiveRows;
+use super::active_rows::{independent, ActiveRows};
 use super::impulse::Rows;
 use super::{ContactModel, Contacts, Impact};
 use crate::Integrator;
@@ -31,6 +31,11 @@ use lagrange_core::{validate, Error, Mechanism, Real, State};
 /// resting one is projected to within the projection's tolerance. At most `4 C + 8` events per
 /// step: beyond that the step fails with [`Error::NoConvergence`] rather than loop, which
 /// with resting contacts (no Zeno) does not happen.
+///
+/// Contacts that depend on the other rows in force (several rows for one contact, more resting
+/// contacts than degrees of freedom) are left out of each solve: the others already hold the
+/// motion, and the force distribution among them is not determined. Dependent bilateral rows
+/// are an error ([`Error::RedundantConstraints`]).
 ///
 /// A start state must satisfy the bilateral rows to within the projection's tolerance and
 /// have every gap above `-tolerance`; the first step from any state other than this stepper's
@@ -212,6 +217,19 @@ where
                 bilateral: self.bilateral,
             };
             let (after, impact) = rows.impact(mechanism, &at, struck, &mut self.resting)?;
+            // Resting contacts that depend on the others (more of them than degrees of
+            // freedom) are left free: the others hold the motion.
+            let mut held = self.held();
+            independent(
+                mechanism,
+                &self.contacts,
+                &after,
+                &mut held,
+                &self.bilateral,
+            )?;
+            for (r, h) in self.resting.iter_mut().zip(held) {
+                *r = *r && h;
+            }
             observe(&impact);
             self.impacts += 1;
             events += 1;
