@@ -1,5 +1,6 @@
 //! [`SpringMassDamper`]: a mass on a linear spring with a linear viscous damper.
 
+use crate::small_solve::finite;
 use lagrange_core::nalgebra::{Matrix1, SMatrix, SVector, Vector1};
 use lagrange_core::{validate, Error, Lagrangian, Mechanism, Real, Scalar, State};
 
@@ -14,8 +15,8 @@ use lagrange_core::{validate, Error, Lagrangian, Mechanism, Real, Scalar, State}
 ///
 /// Under-damped for `c^2 < 4 k m`, critically damped at equality, over-damped above;
 /// [`exact::damped_oscillator`](crate::exact::damped_oscillator) gives the exact motion in every
-/// case. No singular configurations. Energy `T + V` is conserved when `c = 0` and never
-/// increases otherwise.
+/// case. No singular configurations; a non-finite state gives [`Error::NonFiniteState`]. Energy
+/// `T + V` is conserved when `c = 0` and never increases otherwise.
 ///
 /// ```
 /// use lagrange_core::{Mechanism, State};
@@ -79,7 +80,7 @@ impl<T: Real> Mechanism<T, 1> for SpringMassDamper<T> {
         T::HALF * self.stiffness * s.q[0] * s.q[0]
     }
     fn solve_mass(&self, _s: &State<T, 1>, b: &SVector<T, 1>) -> Result<SVector<T, 1>, Error> {
-        Ok(b / self.mass)
+        finite(b / self.mass, Error::NonFiniteState)
     }
 }
 
