@@ -53,6 +53,12 @@ use lagrange_core::{validate, Error, Lagrangian, Mechanism, Real, Scalar, State}
 /// assert!((a - b).amax() < 1e-13);
 /// # Ok::<(), lagrange_core::Error>(())
 /// ```
+///
+/// A chain needs a link:
+///
+/// ```compile_fail
+/// let none = lagrange_systems::NLinkPendulum::<f64, 0>::new([], [], 9.81);
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct NLinkPendulum<T: Real, const N: usize> {
