@@ -171,10 +171,7 @@ impl<T: Real> Acrobot<T> {
     pub fn tip(&self, s: &State<T, 2>) -> (T, T) {
         let (s1, c1) = s.q[0].sin_cos();
         let (s12, c12) = (s.q[0] + s.q[1]).sin_cos();
-        (
-            self.l1 * s1 + self.l2 * s12,
-            -self.l1 * c1 - self.l2 * c12,
-        )
+        (self.l1 * s1 + self.l2 * s12, -self.l1 * c1 - self.l2 * c12)
     }
 
     /// The mass matrix and right-hand side together, sharing the trigonometry.
@@ -190,9 +187,7 @@ impl<T: Real> Acrobot<T> {
         let d11 = self.m1 * self.lc1 * self.lc1 + m2 * l1 * l1 + self.i1 + d22 + T::TWO * k * c2;
         let phi2 = m2 * lc2 * g * s12;
         let f = Vector2::new(
-            k * s2 * (w2 * w2 + T::TWO * w1 * w2)
-                - (self.m1 * self.lc1 + m2 * l1) * g * s1
-                - phi2,
+            k * s2 * (w2 * w2 + T::TWO * w1 * w2) - (self.m1 * self.lc1 + m2 * l1) * g * s1 - phi2,
             -k * s2 * w1 * w1 - phi2,
         );
         (Matrix2::new(d11, d12, d12, d22), f)
@@ -246,7 +241,10 @@ impl<T: Real> Lagrangian<T, 2> for Acrobot<T> {
         );
         // d/dt of lc1 (sin th1, -cos th1) and of l1 (sin th1, -cos th1) + lc2 (sin th12, ...).
         let (v1x, v1y) = (lc1 * c1 * w1, lc1 * s1 * w1);
-        let (v2x, v2y) = (l1 * c1 * w1 + lc2 * c12 * w12, l1 * s1 * w1 + lc2 * s12 * w12);
+        let (v2x, v2y) = (
+            l1 * c1 * w1 + lc2 * c12 * w12,
+            l1 * s1 * w1 + lc2 * s12 * w12,
+        );
         let half = S::from_f64(0.5);
         half * S::from_real(self.m1) * (v1x * v1x + v1y * v1y)
             + half * S::from_real(self.m2) * (v2x * v2x + v2y * v2y)

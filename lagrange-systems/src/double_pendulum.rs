@@ -1,7 +1,7 @@
 //! [`DoublePendulum`]: two point masses on two massless rods, a planar chain.
 
-use lagrange_core::nalgebra::{Matrix2, SVector, Vector2};
 use crate::small_solve::solve_sym2;
+use lagrange_core::nalgebra::{Matrix2, SVector, Vector2};
 use lagrange_core::{validate, Error, Lagrangian, Mechanism, Real, Scalar, State};
 
 /// Point masses `m1`, `m2` on massless rods `l1`, `l2`: the first hangs from a fixed pivot,

@@ -80,10 +80,7 @@ impl<T: Real> Mechanism<T, 2> for Kepler<T> {
     }
     fn rhs(&self, s: &State<T, 2>) -> Vector2<T> {
         let (r, rd, phid) = (s.q[0], s.qd[0], s.qd[1]);
-        Vector2::new(
-            r * phid * phid - self.mu / (r * r),
-            -T::TWO * r * rd * phid,
-        )
+        Vector2::new(r * phid * phid - self.mu / (r * r), -T::TWO * r * rd * phid)
     }
     fn kinetic_energy(&self, s: &State<T, 2>) -> T {
         let (r, rd, phid) = (s.q[0], s.qd[0], s.qd[1]);
