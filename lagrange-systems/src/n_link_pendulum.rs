@@ -69,6 +69,8 @@ pub struct NLinkPendulum<T: Real, const N: usize> {
     mu: [T; N],
     /// `1 / m_j`.
     inv_masses: [T; N],
+    /// `1 / l_j`.
+    inv_lengths: [T; N],
 }
 
 /// Sines and cosines of every angle.
@@ -87,8 +89,8 @@ impl<T: Real, const N: usize> NLinkPendulum<T, N> {
     ///
     /// # Errors
     /// [`Error::InvalidParameter`] naming `masses`, `lengths` or `gravity` when an entry is out
-    /// of range or not finite, or `masses` when a mass is too small to invert or the total
-    /// overflows.
+    /// of range or not finite, `masses` when a mass is too small to invert or the total
+    /// overflows, `lengths` when a length is too small to invert.
     pub fn new(masses: [T; N], lengths: [T; N], gravity: T) -> Result<Self, Error> {
         const { assert!(N > 0, "an N-link pendulum needs at least one link") };
         for m in masses {
@@ -111,12 +113,20 @@ impl<T: Real, const N: usize> NLinkPendulum<T, N> {
                 reason: "each 1/m and the total mass must be finite",
             });
         }
+        let inv_lengths = lengths.map(T::recip);
+        if !inv_lengths.iter().all(|x| x.is_finite()) {
+            return Err(Error::InvalidParameter {
+                name: "lengths",
+                reason: "each 1/l must be finite",
+            });
+        }
         Ok(Self {
             masses,
             lengths,
             gravity,
             mu,
             inv_masses,
+            inv_lengths,
         })
     }
     /// Masses, kg, from the pivot outwards.
@@ -146,59 +156,42 @@ impl<T: Real, const N: usize> NLinkPendulum<T, N> {
         })
     }
 
-    /// `M^-1 b + (accelerations due to gravity and the rates)`: the tension recursion described
-    /// on the type, with generalized force `b`, rates `qd` and gravity `gravity`.
+    /// The tension recursion described on the type: `q''` of the chain at angles with sines
+    /// `sin` and cosines `cos`, rates `qd`, under external forces per unit mass `(px_j, py_j)`
+    /// on each mass (gravity is `(0, -g)` on every one).
     fn tension_solve(
         &self,
-        q: &SVector<T, N>,
+        (sin, cos): ([T; N], [T; N]),
         qd: &SVector<T, N>,
-        gravity: T,
-        b: &SVector<T, N>,
+        (px, py): ([T; N], [T; N]),
     ) -> Result<SVector<T, N>, Error> {
-        let (sin, cos) = sin_cos(q);
-        let l = &self.lengths;
-        let inv_m = &self.inv_masses;
-        // Cartesian external force on each mass: gravity plus the forces that realise b.
-        let g_vec = |j: usize| -> (T, T) {
-            if j < N {
-                let k = b[j] / l[j];
-                (k * cos[j], k * sin[j])
-            } else {
-                (T::zero(), T::zero())
-            }
-        };
-        let mut fx = [T::zero(); N];
-        let mut fy = [T::zero(); N];
-        for j in 0..N {
-            let (gx, gy) = g_vec(j);
-            let (hx, hy) = g_vec(j + 1);
-            fx[j] = gx - hx;
-            fy[j] = gy - hy - self.masses[j] * gravity;
-        }
+        let (l, inv_m) = (&self.lengths, &self.inv_masses);
         // K tau = r, K tridiagonal: diagonal `d`, super-diagonal `off` (off[j] = K_j,j+1).
         // e_j = (sin, -cos), n_j = (cos, sin); sn[j] = e_{j+1} . n_j = sin(th_{j+1} - th_j).
+        // Row j: r_j = l_j th_j'^2 + (p_j - p_{j-1}) . e_j, with p_{-1} = 0 at the pivot.
         let mut d = [T::zero(); N];
         let mut off = [T::zero(); N];
         let mut sn = [T::zero(); N];
         let mut r = [T::zero(); N];
         for j in 0..N {
-            let f_e = fx[j] * sin[j] - fy[j] * cos[j];
-            r[j] = l[j] * qd[j] * qd[j] + f_e * inv_m[j];
+            let (mut dpx, mut dpy) = (px[j], py[j]);
             d[j] = inv_m[j];
             if j > 0 {
-                let prev_e = fx[j - 1] * sin[j] - fy[j - 1] * cos[j];
-                r[j] -= prev_e * inv_m[j - 1];
+                dpx -= px[j - 1];
+                dpy -= py[j - 1];
                 d[j] += inv_m[j - 1];
             }
+            r[j] = l[j] * qd[j] * qd[j] + dpx * sin[j] - dpy * cos[j];
             if j + 1 < N {
                 off[j] = -(cos[j] * cos[j + 1] + sin[j] * sin[j + 1]) * inv_m[j];
                 sn[j] = sin[j + 1] * cos[j] - cos[j + 1] * sin[j];
             }
         }
-        // Thomas: eliminate below the diagonal, then back-substitute; d becomes the pivots.
+        // Thomas: eliminate below the diagonal, keeping the inverse pivots, then back-substitute.
+        let mut inv_d = [T::zero(); N];
         for j in 0..N {
             if j > 0 {
-                let factor = off[j - 1] / d[j - 1];
+                let factor = off[j - 1] * inv_d[j - 1];
                 d[j] -= factor * off[j - 1];
                 r[j] -= factor * r[j - 1];
             }
@@ -208,28 +201,27 @@ impl<T: Real, const N: usize> NLinkPendulum<T, N> {
             if d[j] <= T::zero() {
                 return Err(Error::SingularMassMatrix { pivot: j });
             }
+            inv_d[j] = d[j].recip();
         }
         let mut tau = [T::zero(); N];
+        let mut above = T::zero();
         for j in (0..N).rev() {
-            let above = if j + 1 < N {
-                off[j] * tau[j + 1]
-            } else {
-                T::zero()
-            };
-            tau[j] = (r[j] - above) / d[j];
-        }
-        // th_j'' = (a_j . n_j - a_{j-1} . n_j) / l_j.
-        let qdd = SVector::<T, N>::from_fn(|j, _| {
-            let mut own = fx[j] * cos[j] + fy[j] * sin[j];
-            if j + 1 < N {
-                own += tau[j + 1] * sn[j];
-            }
-            let mut prev = T::zero();
+            tau[j] = (r[j] - above) * inv_d[j];
             if j > 0 {
-                prev = (tau[j - 1] * sn[j - 1] + fx[j - 1] * cos[j] + fy[j - 1] * sin[j])
-                    * inv_m[j - 1];
+                above = off[j - 1] * tau[j];
             }
-            (own * inv_m[j] - prev) / l[j]
+        }
+        // th_j'' = (a_j - a_{j-1}) . n_j / l_j with m_j a_j = -tau_j e_j + tau_{j+1} e_{j+1} + F_j.
+        let qdd = SVector::<T, N>::from_fn(|j, _| {
+            let mut rel = px[j] * cos[j] + py[j] * sin[j];
+            if j + 1 < N {
+                rel += tau[j + 1] * sn[j] * inv_m[j];
+            }
+            if j > 0 {
+                rel -=
+                    tau[j - 1] * sn[j - 1] * inv_m[j - 1] + px[j - 1] * cos[j] + py[j - 1] * sin[j];
+            }
+            rel * self.inv_lengths[j]
         });
         finite(qdd, Error::NonFiniteState)
     }
@@ -292,12 +284,36 @@ impl<T: Real, const N: usize> Mechanism<T, N> for NLinkPendulum<T, N> {
         self.gravity * v
     }
 
+    /// `M^-1 b` by the tension recursion at rest without gravity, `b` realised as the Cartesian
+    /// forces `G_j - G_{j+1}`, `G_j = (b_j / l_j) (cos th_j, sin th_j)`.
     fn solve_mass(&self, s: &State<T, N>, b: &SVector<T, N>) -> Result<SVector<T, N>, Error> {
-        self.tension_solve(&s.q, &SVector::zeros(), T::zero(), b)
+        let (sin, cos) = sin_cos(&s.q);
+        let g = |j: usize| -> (T, T) {
+            match b.get(j) {
+                Some(bj) => {
+                    let k = *bj * self.inv_lengths[j];
+                    (k * cos[j], k * sin[j])
+                }
+                None => (T::zero(), T::zero()),
+            }
+        };
+        let mut px = [T::zero(); N];
+        let mut py = [T::zero(); N];
+        let mut next = g(0);
+        for j in 0..N {
+            let here = next;
+            next = g(j + 1);
+            px[j] = (here.0 - next.0) * self.inv_masses[j];
+            py[j] = (here.1 - next.1) * self.inv_masses[j];
+        }
+        self.tension_solve((sin, cos), &SVector::zeros(), (px, py))
     }
 
+    /// `q''` by the tension recursion under gravity alone (the chain has no generalized forces
+    /// of its own; a wrapper's go through [`Mechanism::solve_mass`]).
     fn acceleration(&self, s: &State<T, N>) -> Result<SVector<T, N>, Error> {
-        self.tension_solve(&s.q, &s.qd, self.gravity, &self.generalized_force(s))
+        let down = [-self.gravity; N];
+        self.tension_solve(sin_cos(&s.q), &s.qd, ([T::zero(); N], down))
     }
 }
 

@@ -34,7 +34,7 @@ fn same_accelerations<T: Real, const N: usize>(
 }
 
 /// `NLinkPendulum<1>` is the `SimplePendulum` (undamped): the same accelerations, mass matrix
-/// and energies to rounding. Measured worst: f64 1.8e-16, f32 9.5e-8 (about one ulp); bound
+/// and energies to rounding. Measured worst: f64 1.9e-16, f32 5.2e-8 (about one ulp); bound
 /// 4 ulps.
 fn one_link_is_the_pendulum<T: Real>() -> Result<(), Error> {
     let mut rng = Rng::new(11);
@@ -58,8 +58,8 @@ fn one_link_is_the_pendulum<T: Real>() -> Result<(), Error> {
 }
 
 /// `NLinkPendulum<2>` is the `DoublePendulum`: accelerations from the tension recursion against
-/// the closed-form 2x2 inverse, mass matrices and energies. Measured worst: f64 2.0e-15, f32
-/// 1.1e-6 (the 2x2 inverse cancels where the rods are nearly aligned); bounds 1e-14, 5e-6.
+/// the closed-form 2x2 inverse, mass matrices and energies. Measured worst: f64 1.9e-15, f32
+/// 1.2e-6 (the 2x2 inverse cancels where the rods are nearly aligned); bounds 1e-14, 5e-6.
 fn two_links_are_the_double_pendulum<T: Real>() -> Result<(), Error> {
     let mut rng = Rng::new(12);
     let tol = pick::<T>(5e-6, 1e-14);
@@ -91,7 +91,7 @@ fn two_links_are_the_double_pendulum<T: Real>() -> Result<(), Error> {
 
 /// A force added by wrapping reaches the chain through `solve_mass`, the tension recursion
 /// with a generalized force: it agrees with the automatic path wrapped with the same force.
-/// Measured worst: f64 9.4e-15, f32 5.2e-6 (N = 6); bounds 1e-12 and 5e-5 as for the chain's
+/// Measured worst: f64 9.2e-15, f32 5.1e-6 (N = 6); bounds 1e-12 and 5e-5 as for the chain's
 /// test against the automatic path, whose f32 Cholesky dominates the difference.
 fn wrapped_force_on_the_chain<T: Real>() -> Result<(), Error> {
     let mut rng = Rng::new(13);
