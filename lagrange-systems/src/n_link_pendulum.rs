@@ -40,7 +40,10 @@ use lagrange_core::{validate, Error, Lagrangian, Mechanism, Real, Scalar, State}
 /// pivot), solved by Thomas's algorithm. A generalized force `b` (conjugate to the angles)
 /// enters as the Cartesian forces `F_j = G_j - G_{j+1}`, `G_j = (b_j / l_j)
 /// (cos th_j, sin th_j)`, whose virtual work is `b . dth`; `solve_mass(b)` is the same
-/// recursion with gravity and rates set to zero, so it returns `M^-1 b`.
+/// recursion with gravity and rates set to zero, so it returns `M^-1 b`. Against forming `M`
+/// and `f` and solving by Cholesky (`O(N^3)`) it is about twice as fast at `N = 5` and four to
+/// five times at `N = 20` (`cargo xtask demo` prints both), and in f32 it loses less to
+/// rounding, since the tension system is far better conditioned than `M`.
 ///
 /// ```
 /// use lagrange_core::{Mechanism, State};
