@@ -12,7 +12,7 @@
 //! | [`SimplePendulum`] | `[th]` | mass, length, gravity, damping |
 //! | [`BeadOnRotatingHoop`] | `[th]` | mass, radius, omega, gravity |
 //! | [`DoublePendulum`] | `[th1, th2]` | m1, m2, l1, l2, gravity |
-//! | [`NLinkPendulum`] | `[th1..thN]` | masses[N], lengths[N], gravity |
+//! | [`NLinkPendulum`] | `[th1..thN]` | `masses: [T; N]`, `lengths: [T; N]`, gravity |
 //! | [`SpringMassDamper`] | `[x]` | mass, stiffness, damping |
 //! | [`ElasticPendulum`] | `[r, th]` | mass, stiffness, rest_length, gravity |
 //! | [`SphericalPendulum`] | `[th, phi]` | mass, length, gravity |
