@@ -172,7 +172,8 @@ fn crank_matches_reduced_model() -> Result<(), Error> {
 /// residual stays at the projection's tolerance and the energy (E0 = -0.61 J, up to 8 J of it
 /// kinetic) is conserved to RK4's truncation. f64: tolerance 1e-13 m (~500 ulps of the loop's
 /// terms), measured drift 1.8e-6 J, bound 4e-6 J. f32: tolerance 5e-6 m (~40 ulps), measured
-/// drift 4.5e-4 J from rounding, bound 1e-3 J.
+/// drift 7.0e-4 J from rounding (energy terms of ~10 J rounded at 6e-8 each, over 10^4
+/// steps), bound 2e-3 J.
 fn residual_and_energy<T: Real>() -> Result<(), Error> {
     let l = linkage::<T>()?;
     let tol = T::from_f64(pick::<T>(5e-6, 1e-13));
@@ -192,7 +193,7 @@ fn residual_and_energy<T: Real>() -> Result<(), Error> {
     )?;
     println!("four-bar, 10 s: E0 = {e0}, max |dE| = {worst_e:.2e} J, max residual {worst_r:.2e}");
     assert!(worst_r <= tol);
-    assert!(worst_e.to_f64() < pick::<T>(1e-3, 4e-6), "{worst_e:e}");
+    assert!(worst_e.to_f64() < pick::<T>(2e-3, 4e-6), "{worst_e:e}");
     Ok(())
 }
 

@@ -306,5 +306,6 @@ pub fn run() -> Result<(), String> {
     let path = dir.join("pendulum.svg");
     std::fs::write(&path, doc).map_err(|e| e.to_string())?;
     println!("\nPlot: {}", path.display());
+    crate::demo_systems::run()?;
     crate::demo_constraints::run()
 }
