@@ -37,6 +37,15 @@ pub enum Error {
     },
     /// An adaptive integrator needed a step smaller than its minimum.
     StepSizeUnderflow,
+    /// An adaptive integrator took its maximum number of steps without reaching the end time.
+    TooManySteps {
+        /// How many steps were taken.
+        steps: u64,
+    },
+    /// The Newton matrix of an implicit step is singular: a pivot of its LU factorisation
+    /// was zero (the step is too large for the mechanism's Jacobian, or the Jacobian is
+    /// degenerate).
+    SingularJacobian,
 }
 
 impl fmt::Display for Error {
@@ -55,6 +64,12 @@ impl fmt::Display for Error {
                 write!(f, "no convergence after {iterations} iterations")
             }
             Self::StepSizeUnderflow => f.write_str("step size fell below its minimum"),
+            Self::TooManySteps { steps } => {
+                write!(f, "end time not reached within the limit of {steps} steps")
+            }
+            Self::SingularJacobian => {
+                f.write_str("the Newton matrix of an implicit step is singular")
+            }
         }
     }
 }

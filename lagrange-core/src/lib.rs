@@ -10,6 +10,8 @@
 //! - [`Lagrangian`] and [`EulerLagrange`]: write `T` and `V` once and get the equations of
 //!   motion by automatic differentiation.
 //! - [`GeneralizedForce`], [`ViscousDamping`], [`Input`], [`Forced`]: forces added by wrapping.
+//! - [`Jacobian`]: `d/dq` and `d/dq'` of the equations of motion, exact from dual numbers for
+//!   [`EulerLagrange`], by [`central_difference_jacobian`] otherwise (for implicit integrators).
 //! - [`Error`]: one small `Copy` error type for every crate.
 //!
 //! ```
@@ -43,6 +45,7 @@ mod cholesky;
 mod dual;
 mod error;
 mod forces;
+mod jacobian;
 mod lagrangian;
 mod mechanism;
 mod scalar;
@@ -53,6 +56,7 @@ pub use cholesky::solve_spd;
 pub use dual::Dual;
 pub use error::Error;
 pub use forces::{Forced, GeneralizedForce, Input, ViscousDamping};
+pub use jacobian::{central_difference_jacobian, Jacobian};
 pub use lagrangian::{EulerLagrange, Lagrangian};
 pub use mechanism::Mechanism;
 pub use nalgebra;

@@ -57,7 +57,14 @@ const DOC_TEST: [&[&str]; 1] = [&["test", "--workspace", "--doc", "--quiet"]];
 
 /// Long runs (10^6 steps and more) are `#[ignore]`d in the quick debug test run and run here,
 /// optimised.
-const LONG_TEST: [&[&str]; 1] = [&["test", "--workspace", "--release", "--quiet", "--", "--ignored"]];
+const LONG_TEST: [&[&str]; 1] = [&[
+    "test",
+    "--workspace",
+    "--release",
+    "--quiet",
+    "--",
+    "--ignored",
+]];
 
 /// Everything CI checks; every step runs and every failure is reported at the end.
 fn ci() -> Result<(), String> {
