@@ -26,14 +26,41 @@
 #![no_std]
 #![forbid(unsafe_code)]
 
+mod adaptive;
+mod backward_euler;
 mod explicit_euler;
+mod fixed_timestep;
+mod gauss_legendre;
+mod implicit_midpoint;
+mod implicit_rk;
 mod integrator;
+mod lagrangian_system;
+mod newton;
+mod radau_iia;
 mod rk4;
 mod semi_implicit_euler;
+mod stormer_verlet;
+mod variational;
 mod velocity_verlet;
+mod yoshida;
 
+pub use adaptive::{
+    AdaptiveSettings, Dop853Pair, Dopri5Pair, DormandPrince54, DormandPrince853, EmbeddedPair,
+    EmbeddedRungeKutta, Statistics, Stop,
+};
+pub use backward_euler::{BackwardEuler, BackwardEulerTableau};
 pub use explicit_euler::ExplicitEuler;
+pub use fixed_timestep::{FixedTimestep, Frame};
+pub use gauss_legendre::{GaussLegendre2, GaussLegendre2Tableau};
+pub use implicit_midpoint::{ImplicitMidpoint, MidpointTableau};
+pub use implicit_rk::{ImplicitRungeKutta, ImplicitTableau};
 pub use integrator::Integrator;
+pub use lagrangian_system::LagrangianSystem;
+pub use newton::NewtonSettings;
+pub use radau_iia::{RadauIIA2, RadauIIA2Tableau};
 pub use rk4::Rk4;
 pub use semi_implicit_euler::SemiImplicitEuler;
+pub use stormer_verlet::StormerVerlet;
+pub use variational::{PhaseState, VariationalMidpoint};
 pub use velocity_verlet::VelocityVerlet;
+pub use yoshida::{SymmetricSecondOrder, Yoshida4, YOSHIDA4_WEIGHTS};
