@@ -34,7 +34,8 @@ fn invalid<V>(name: &'static str, reason: &'static str) -> Result<V, Error> {
 
 impl<T: Real> AdaptiveSettings<T> {
     /// Relative tolerance `rtol` (zero, or from `10 EPSILON` to below 1) and absolute
-    /// tolerance `atol` (zero or positive; positive where `rtol` is zero).
+    /// tolerance `atol` (positive: a coordinate or velocity passing through zero has no
+    /// relative scale).
     ///
     /// # Errors
     /// [`Error::InvalidParameter`] `rtol` or `atol` when out of range or not finite.
@@ -46,11 +47,8 @@ impl<T: Real> AdaptiveSettings<T> {
                 "must be zero, or at least 10 machine epsilons and below 1",
             );
         }
-        if !(atol.is_finite() && atol >= T::zero()) {
-            return invalid("atol", "must be zero or positive, and finite");
-        }
-        if rtol == T::zero() && atol == T::zero() {
-            return invalid("atol", "must be positive where rtol is zero");
+        if !(atol.is_finite() && atol > T::zero()) {
+            return invalid("atol", "must be positive and finite");
         }
         Ok(Self {
             rtol,
