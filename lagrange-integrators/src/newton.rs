@@ -9,9 +9,10 @@ use lagrange_core::{Error, Real};
 ///
 /// The iteration stops when every unknown's update is at most `tolerance` times that
 /// unknown's scale (its own size plus the size of the step's motion in it, as each method
-/// documents), or when a freshly factorised Newton matrix no longer shrinks an update that is
-/// already below `sqrt(tolerance)` (the residual's rounding floor: nothing more can be had).
-/// After `max_iterations` without either, the step fails with [`Error::NoConvergence`].
+/// documents), or when a Newton matrix factorised at most one iteration earlier no longer
+/// halves an update that is already below `tolerance^(2/3)`: that is the rounding floor of
+/// the residual, where the updates only bounce (nothing more can be had). After
+/// `max_iterations` without either, the step fails with [`Error::NoConvergence`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct NewtonSettings<T> {
@@ -283,23 +284,27 @@ where
     P: NewtonProblem<T, N, S>,
 {
     let slow = T::from_f64(SLOW_RATE);
-    let floor = settings.tolerance.sqrt();
+    let floor = settings.tolerance.powf(T::from_f64(2.0 / 3.0));
     let mut fixed_point = start == Start::FixedPoint;
     let mut lu: Option<Lu<T, N, S>> = None;
+    // Iterations since the Newton matrix in use was factorised (0: in this one).
+    let mut age = 0u32;
     let mut previous: Option<T> = None;
     for iteration in 1..=settings.max_iterations {
         let r = problem.residual(x)?;
         if !all_finite(&r) {
             return Err(Error::NonFiniteState);
         }
-        let mut fresh = false;
         let dx = if fixed_point {
             r
         } else {
             let factored = match lu {
-                Some(f) => f,
+                Some(f) => {
+                    age += 1;
+                    f
+                }
                 None => {
-                    fresh = true;
+                    age = 0;
                     Lu::factor(problem.newton_matrix(x)?)?
                 }
             };
@@ -322,10 +327,10 @@ where
             if !(rate <= slow) {
                 if fixed_point {
                     fixed_point = false;
-                } else if !fresh {
-                    lu = None;
-                } else if size <= floor {
+                } else if age <= 1 && size <= floor {
                     return Ok(iteration);
+                } else if age >= 1 {
+                    lu = None;
                 }
             }
         }

@@ -87,3 +87,41 @@ macro_rules! for_f32_and_f64 {
 #[cfg(doctest)]
 #[doc = include_str!("../../README.md")]
 pub struct ReadmeDoctests;
+
+/// The Kepler problem in polar coordinates, unit mass, through the automatic Euler-Lagrange
+/// path: `T = (r'^2 + r^2 phi'^2) / 2`, `V = -mu / r`, `q = [r, phi]`. `phi` is cyclic, so
+/// its momentum `r^2 phi'` (the angular momentum) is conserved.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct KeplerLagrangian {
+    /// The gravitational parameter.
+    pub mu: f64,
+}
+
+impl<T: Real> lagrange_core::Lagrangian<T, 2> for KeplerLagrangian {
+    fn kinetic<S: lagrange_core::Scalar<Real = T>>(
+        &self,
+        _t: S,
+        q: &lagrange_core::nalgebra::SVector<S, 2>,
+        qd: &lagrange_core::nalgebra::SVector<S, 2>,
+    ) -> S {
+        S::from_f64(0.5) * (qd[0] * qd[0] + q[0] * q[0] * qd[1] * qd[1])
+    }
+    fn potential<S: lagrange_core::Scalar<Real = T>>(
+        &self,
+        _t: S,
+        q: &lagrange_core::nalgebra::SVector<S, 2>,
+    ) -> S {
+        -S::from_f64(self.mu) / q[0]
+    }
+}
+
+/// Problem P4's start: `mu = 1`, `e = 0.5`, `a = 1` (period `2 pi`, energy -1/2), at
+/// periapsis: `r = 0.5`, `phi = 0`, `r' = 0`, `phi' = 2 sqrt(3)`.
+#[must_use]
+pub fn kepler_periapsis<T: Real>() -> State<T, 2> {
+    State::new(
+        T::zero(),
+        [T::HALF, T::zero()],
+        [T::zero(), T::from_f64(2.0 * 3.0f64.sqrt())],
+    )
+}
