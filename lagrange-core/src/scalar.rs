@@ -81,6 +81,8 @@ pub trait Real:
     const EPSILON: Self;
     /// Positive infinity.
     const INFINITY: Self;
+    /// The smallest positive normal number (below it, precision is lost to subnormals).
+    const MIN_POSITIVE: Self;
     /// Neither NaN nor infinite.
     fn is_finite(self) -> bool;
     /// Widen to `f64` (for reports and logs).
@@ -191,6 +193,7 @@ macro_rules! impl_real {
             const PI: $t = core::$t::consts::PI;
             const EPSILON: $t = $t::EPSILON;
             const INFINITY: $t = $t::INFINITY;
+            const MIN_POSITIVE: $t = $t::MIN_POSITIVE;
             #[inline]
             fn is_finite(self) -> bool {
                 $t::is_finite(self)

@@ -130,16 +130,14 @@ pub(crate) fn max_abs<T: Real, const N: usize, const S: usize>(x: &Blocks<T, N, 
         .fold(T::zero(), |m, v| m.max(v.abs()))
 }
 
-/// `max_i |dx_i| / w_i`, each weight floored at [`WEIGHT_FLOOR`] times the largest; with all
-/// weights zero, `max_i |dx_i|` (so only an exact zero update converges).
+/// `max_i |dx_i| / w_i`, each weight floored at [`WEIGHT_FLOOR`] times the largest and at
+/// `MIN_POSITIVE / EPSILON`: an unknown decaying into the subnormal range (a damped stiff
+/// mode) has no relative precision left, and an update there counts as converged.
 fn weighted_size<T: Real, const N: usize, const S: usize>(
     dx: &Blocks<T, N, S>,
     w: &Blocks<T, N, S>,
 ) -> T {
-    let floor = max_abs(w) * T::from_f64(WEIGHT_FLOOR);
-    if floor == T::zero() {
-        return max_abs(dx);
-    }
+    let floor = (max_abs(w) * T::from_f64(WEIGHT_FLOOR)).max(T::MIN_POSITIVE / T::EPSILON);
     dx.iter()
         .flat_map(|v| v.iter())
         .zip(w.iter().flat_map(|v| v.iter()))

@@ -125,3 +125,29 @@ pub fn kepler_periapsis<T: Real>() -> State<T, 2> {
         [T::zero(), T::from_f64(2.0 * 3.0f64.sqrt())],
     )
 }
+
+/// A unit mass on a linear spring of stiffness `k` (so `w^2 = k`), through the automatic
+/// path: `T = x'^2 / 2`, `V = k x^2 / 2`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SpringLagrangian<T> {
+    /// Stiffness per unit mass, `w^2`.
+    pub k: T,
+}
+
+impl<T: Real> lagrange_core::Lagrangian<T, 1> for SpringLagrangian<T> {
+    fn kinetic<S: lagrange_core::Scalar<Real = T>>(
+        &self,
+        _t: S,
+        _q: &lagrange_core::nalgebra::SVector<S, 1>,
+        qd: &lagrange_core::nalgebra::SVector<S, 1>,
+    ) -> S {
+        S::from_f64(0.5) * qd[0] * qd[0]
+    }
+    fn potential<S: lagrange_core::Scalar<Real = T>>(
+        &self,
+        _t: S,
+        q: &lagrange_core::nalgebra::SVector<S, 1>,
+    ) -> S {
+        S::from_f64(0.5) * S::from_real(self.k) * q[0] * q[0]
+    }
+}
