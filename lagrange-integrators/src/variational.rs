@@ -53,21 +53,26 @@ impl<T: Real, const N: usize> defmt::Format for PhaseState<T, N> {
 /// F-  = F+ = h/2 Q(t0 + h/2, (q0 + q1)/2, (q1 - q0)/h)          discrete forces
 ///
 /// p0 = -D1 L_d(q0, q1) - F-  =  dL/dq' - h/2 dL/dq - h/2 Q       solved for q1 (Newton)
-/// p1 =  D2 L_d(q0, q1) + F+  =  dL/dq' + h/2 dL/dq + h/2 Q       explicit
+/// p1 =  D2 L_d(q0, q1) + F+  =  p0 + h dL/dq + h Q               explicit
 ///                                 (all at the midpoint above)
 /// ```
 ///
 /// The first line of the position-momentum form is the discrete Euler-Lagrange equation
 /// `D2 L_d(q_{k-1}, q_k) + D1 L_d(q_k, q_{k+1}) + F+ + F- = 0` (the discrete
-/// Lagrange-d'Alembert principle when `Q` is not zero).
+/// Lagrange-d'Alembert principle when `Q` is not zero). The second is written as an impulse
+/// (`D1 L_d + D2 L_d = h dL/dq`, `F- + F+ = h Q`; equal to `D2 L_d + F+` where the first
+/// holds): then the momentum of a cyclic coordinate, which neither `L` nor `Q` changes, is
+/// carried over unchanged, whatever the Newton tolerance and the rounding of `q1`.
 ///
-/// Order 2, implicit (Newton on `N` unknowns, its residual and exact Jacobian from one
-/// second-order dual evaluation of `L`; one first-order evaluation for `p1`), fixed step.
+/// Order 2, implicit (Newton on `N` unknowns: a first-order dual evaluation of `L` per
+/// iteration for the residual, a second-order one for the exact Jacobian when it is
+/// factorised, one more first-order evaluation for `p1`), fixed step.
 /// Without forces the map `(q0, p0) -> (q1, p1)` is symplectic for any Lagrangian (a
 /// configuration-dependent mass matrix included), so the energy error stays bounded with no
-/// drift over very long runs, and it conserves exactly (to rounding) the discrete momentum
-/// `dL/dq'_i` of any cyclic coordinate `q_i` (one that `L` does not contain) and, by the
-/// discrete Noether theorem, the momentum map of any symmetry of `L`. With damping the
+/// drift over very long runs, and it conserves exactly the discrete momentum of any cyclic
+/// coordinate `q_i` (one that `L` does not contain, with no force on it): `p_i` is carried
+/// from step to step unchanged, bit for bit. (By the discrete Noether theorem it conserves the
+/// momentum map of any symmetry of `L`, there to the Newton tolerance.) With damping the
 /// discrete forces remove energy at the rate the continuous ones do, to `O(h^2)`.
 ///
 /// [`PhaseState`] carries the discrete momenta between steps; [`VariationalMidpoint::step`] and
@@ -124,6 +129,18 @@ fn directional<T: Real, Sys: LagrangianSystem<T, N>, const N: usize>(
         d
     });
     let qd = SVector::<Dual<T, N>, N>::from_fn(|k, _| Dual::variable(qd[k], k));
+    SVector::from(sys.lagrangian(Dual::constant(t), &q, &qd).eps)
+}
+
+/// `dL/dq` at `(t, q, q')`.
+fn coordinate_gradient<T: Real, Sys: LagrangianSystem<T, N>, const N: usize>(
+    sys: &Sys,
+    t: T,
+    q: &SVector<T, N>,
+    qd: &SVector<T, N>,
+) -> SVector<T, N> {
+    let q = SVector::<Dual<T, N>, N>::from_fn(|k, _| Dual::variable(q[k], k));
+    let qd = qd.map(Dual::constant);
     SVector::from(sys.lagrangian(Dual::constant(t), &q, &qd).eps)
 }
 
@@ -338,8 +355,7 @@ impl<T: Real, const N: usize> VariationalMidpoint<T, N> {
         self.iterations = newton::solve(&mut problem, &mut x, &self.newton, Start::Newton)?;
         let [q1] = x;
         let m = problem.midpoint(&q1);
-        let half = h * T::HALF;
-        let p1 = directional(sys, m.t, &m.q, &m.qd, half) + sys.force(&m) * half;
+        let p1 = phase.p + (coordinate_gradient(sys, m.t, &m.q, &m.qd) + sys.force(&m)) * h;
         let next = PhaseState {
             t: phase.t + h,
             q: q1,
