@@ -34,7 +34,7 @@ impl ImplicitTableau<1> for BackwardEulerTableau {
 /// use lagrange_core::State;
 /// use lagrange_integrators::{BackwardEuler, Integrator};
 /// use lagrange_systems::SimplePendulum;
-/// let p = SimplePendulum::new(1.0, 1.0, 9.81, 0.0)?;
+/// let p = SimplePendulum::new(1.0_f64, 1.0, 9.81, 0.0)?;
 /// let start = State::at_rest([0.5]);
 /// let end = BackwardEuler::default().integrate(&p, &start, 1e-2, 100)?;
 /// assert!(end.q[0].abs() < start.q[0]);

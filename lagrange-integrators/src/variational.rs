@@ -84,7 +84,7 @@ impl<T: Real, const N: usize> defmt::Format for PhaseState<T, N> {
 /// use lagrange_core::{EulerLagrange, Mechanism, State};
 /// use lagrange_integrators::VariationalMidpoint;
 /// use lagrange_systems::DoublePendulum;
-/// let dp = EulerLagrange::new(DoublePendulum::new(1.0, 1.0, 1.0, 1.0, 9.81)?);
+/// let dp = EulerLagrange::new(DoublePendulum::new(1.0_f64, 1.0, 1.0, 1.0, 9.81)?);
 /// let start = State::new(0.0, [0.6, -0.4], [0.5, 1.0]);
 /// let end = VariationalMidpoint::default().integrate(&dp, &start, 1e-2, 1000)?;
 /// assert!((dp.energy(&end) - dp.energy(&start)).abs() < 1e-3 * dp.energy(&start).abs());

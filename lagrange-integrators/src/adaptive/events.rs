@@ -118,6 +118,13 @@ where
         }
     }
 
+    /// The interval `[t0, t1]` that [`EmbeddedRungeKutta::dense_output`] can sample: the
+    /// last accepted step (up to an event that cut it short), `None` before any step.
+    #[must_use]
+    pub fn dense_interval(&self) -> Option<(T, T)> {
+        (self.h_last > T::zero()).then_some((self.previous.t, self.dense_end))
+    }
+
     /// The state at time `t` between the last two accepted points (from the start of the
     /// last step to the current time), by the method's continuous extension (order 4 for
     /// Dormand-Prince 5(4), 7 for DOP853, which evaluates 3 more stages once per step for it).
