@@ -18,6 +18,8 @@ use lagrange_core::{Error, Real};
 pub struct NewtonSettings<T> {
     tolerance: T,
     max_iterations: u32,
+    /// `tolerance^(2/3)`, the largest update accepted as the rounding floor.
+    floor: T,
 }
 
 /// Most iterations a caller may allow: beyond this a step that has not converged never will.
@@ -62,10 +64,16 @@ impl<T: Real> NewtonSettings<T> {
                 reason: "must be from 1 to 1000",
             });
         }
-        Ok(Self {
+        Ok(Self::unchecked(tolerance, max_iterations))
+    }
+
+    /// The settings, with the floor derived from the tolerance.
+    fn unchecked(tolerance: T, max_iterations: u32) -> Self {
+        Self {
             tolerance,
             max_iterations,
-        })
+            floor: tolerance.powf(T::from_f64(2.0 / 3.0)),
+        }
     }
 
     /// The relative tolerance.
@@ -84,10 +92,10 @@ impl<T: Real> NewtonSettings<T> {
 impl<T: Real> Default for NewtonSettings<T> {
     /// Tolerance `8 EPSILON` (converged to rounding), at most 20 iterations.
     fn default() -> Self {
-        Self {
-            tolerance: T::from_f64(DEFAULT_TOLERANCE_EPS) * T::EPSILON,
-            max_iterations: DEFAULT_MAX_ITERATIONS,
-        }
+        Self::unchecked(
+            T::from_f64(DEFAULT_TOLERANCE_EPS) * T::EPSILON,
+            DEFAULT_MAX_ITERATIONS,
+        )
     }
 }
 
@@ -288,7 +296,7 @@ where
 {
     let slow = T::from_f64(SLOW_RATE);
     let refresh = T::from_f64(REFRESH_RATE);
-    let floor = settings.tolerance.powf(T::from_f64(2.0 / 3.0));
+    let floor = settings.floor;
     let mut fixed_point = start == Start::FixedPoint;
     let mut lu: Option<Lu<T, N, S>> = None;
     // Iterations since the Newton matrix in use was factorised (0: in this one).

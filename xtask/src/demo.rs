@@ -2,13 +2,13 @@
 //! integrator, against exact or reference answers, with an SVG plot.
 
 use crate::cmd::project_root;
+use crate::demo_integrators::TIMING_RUNS;
 use crate::svg::{self, Scale, Series};
 use lagrange_core::{Error, Mechanism, Real, State};
 use lagrange_integrators::{ExplicitEuler, Integrator, Rk4, SemiImplicitEuler, VelocityVerlet};
 use lagrange_systems::exact::pendulum_from_rest;
 use lagrange_systems::{DoublePendulum, SimplePendulum};
 use std::hint::black_box;
-use std::time::Instant;
 
 /// The origin's pendulum: L = 1 m, g = 9.81 m/s^2, released at rest from 30 degrees.
 const G: f64 = 9.81;
@@ -18,8 +18,6 @@ const T_END: f64 = 10.0;
 const TABLE_TIMES: [f64; 4] = [2.5, 5.0, 7.5, 10.0];
 /// Points kept per run for the plot.
 const PLOT_POINTS: u64 = 1000;
-/// Timing: the median of this many whole runs.
-const TIMING_RUNS: usize = 5;
 
 /// Problem P2 of shared/BENCH_PROBLEMS.md: both angles pi/2 at rest, T = 10 s; its state at
 /// T from a 1e-27 reference solve (th1, th2, th1', th2').
@@ -44,16 +42,9 @@ where
     I: Integrator<T, N>,
     M: Mechanism<T, N>,
 {
-    let mut times: Vec<f64> = (0..TIMING_RUNS)
-        .map(|_| {
-            let clock = Instant::now();
-            let _ =
-                black_box(integrator.integrate(black_box(mechanism), black_box(start), dt, steps));
-            clock.elapsed().as_secs_f64() * 1e9 / steps as f64
-        })
-        .collect();
-    times.sort_by(f64::total_cmp);
-    times[TIMING_RUNS / 2]
+    crate::demo_integrators::median_ns(steps, || {
+        integrator.integrate(black_box(mechanism), black_box(start), dt, steps)
+    })
 }
 
 /// RK4's cost per step on the pendulum and the double pendulum in `T`.
@@ -306,5 +297,5 @@ pub fn run() -> Result<(), String> {
     let path = dir.join("pendulum.svg");
     std::fs::write(&path, doc).map_err(|e| e.to_string())?;
     println!("\nPlot: {}", path.display());
-    Ok(())
+    crate::demo_integrators::run()
 }

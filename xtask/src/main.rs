@@ -10,6 +10,7 @@
 mod cmd;
 mod cross;
 mod demo;
+mod demo_integrators;
 mod svg;
 
 use std::process::ExitCode;
