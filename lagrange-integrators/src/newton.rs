@@ -157,6 +157,14 @@ fn weighted_size<T: Real, const N: usize, const S: usize>(
         .fold(T::zero(), |m, (d, wi)| m.max(d.abs() / wi.abs().max(floor)))
 }
 
+/// True unless `x <= limit`: NaN exceeds every limit.
+fn exceeds<T: Real>(x: T, limit: T) -> bool {
+    !matches!(
+        x.partial_cmp(&limit),
+        Some(core::cmp::Ordering::Less | core::cmp::Ordering::Equal)
+    )
+}
+
 /// True when every entry is finite.
 fn all_finite<T: Real, const N: usize, const S: usize>(x: &Blocks<T, N, S>) -> bool {
     x.iter().flat_map(|v| v.iter()).all(|v| v.is_finite())
@@ -334,15 +342,15 @@ where
             return Ok(iteration);
         }
         if let Some(prev) = previous {
-            // NaN-safe: a rate that is not clearly fast counts as slow.
+            // A NaN rate counts as slow.
             let rate = size / prev;
             if fixed_point {
-                if !(rate <= slow) {
+                if exceeds(rate, slow) {
                     fixed_point = false;
                 }
-            } else if age <= 1 && size <= floor && !(rate <= slow) {
+            } else if age <= 1 && size <= floor && exceeds(rate, slow) {
                 return Ok(iteration);
-            } else if age >= 1 && !(rate <= refresh) {
+            } else if age >= 1 && exceeds(rate, refresh) {
                 lu = None;
             }
         }
@@ -404,7 +412,7 @@ mod tests {
             &mut self,
             x: &Blocks<f64, 1, 1>,
         ) -> Result<BlockMatrix<f64, 1, 1>, Error> {
-            Ok(BlockMatrix([[x[0].map(|v| 2.0 * v / 3.0).into()]]))
+            Ok(BlockMatrix([[x[0].map(|v| 2.0 * v / 3.0)]]))
         }
         fn weights(&self, x: &Blocks<f64, 1, 1>) -> Blocks<f64, 1, 1> {
             [x[0].map(f64::abs)]

@@ -209,9 +209,8 @@ where
         let dl = directional_jacobian(self.sys, m.t, &m.q, &m.qd, -half, T::HALF, self.h.recip());
         let dq = self.sys.force_jacobian(&m);
         // d/dq1 of h/2 Q(midpoint): h/2 (dQ/dq / 2 + dQ/dq' / h).
-        Ok(BlockMatrix([[dl
-            - dq.wrt_q * (half * T::HALF)
-            - dq.wrt_qd * T::HALF]]))
+        let force = dq.wrt_q * (half * T::HALF) + dq.wrt_qd * T::HALF;
+        Ok(BlockMatrix([[dl - force]]))
     }
 
     fn weights(&self, q1: &Blocks<T, N, 1>) -> Blocks<T, N, 1> {

@@ -50,6 +50,9 @@ pub struct Statistics {
     pub evaluations: u64,
 }
 
+/// The cubic Hermite part of a dense output: `(y1 - y0, c3, c4)`.
+pub(super) type Hermite<T, const N: usize> = [SVector<T, N>; 3];
+
 /// Safety factor of the step-size proposal.
 const SAFETY: f64 = 0.9;
 /// Smallest factor by which a step may shrink.
@@ -97,8 +100,9 @@ pub struct EmbeddedRungeKutta<T: Real, const N: usize, const S: usize, const R: 
     pub(super) h_last: T,
     /// The end of the interval the dense output may be sampled on (cut by an event).
     pub(super) dense_end: T,
-    /// Dense coefficients of the last step, when computed: `(y1 - y0, c3, c4)` and the rows.
-    pub(super) hermite: Option<([SVector<T, N>; 3], [SVector<T, N>; 3])>,
+    /// Dense coefficients of the last step, when computed: the cubic Hermite part of `q` and
+    /// of `q'`, then the rows.
+    pub(super) hermite: Option<(Hermite<T, N>, Hermite<T, N>)>,
     pub(super) rows_q: [SVector<T, N>; R],
     pub(super) rows_v: [SVector<T, N>; R],
     pub(super) stats: Statistics,

@@ -160,7 +160,7 @@ where
     /// non-zero value to zero or to the opposite sign; the located time is the first one known
     /// to be past the change (`g` there is zero or has the new sign), so continuing does not
     /// report the same event again. Events in which `g` touches zero or crosses twice within
-    /// one step are not seen: bound the step ([`AdaptiveSettings::with_step_bounds`]) below
+    /// one step are not seen: bound the step ([`with_step_bounds`](super::AdaptiveSettings::with_step_bounds)) below
     /// the shortest interval between sign changes.
     ///
     /// # Errors

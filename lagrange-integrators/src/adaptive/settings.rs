@@ -71,7 +71,7 @@ impl<T: Real> AdaptiveSettings<T> {
         if !(h_min.is_finite() && h_min >= T::zero()) {
             return invalid("h_min", "must be zero or positive, and finite");
         }
-        if !(h_max > h_min) {
+        if h_max.partial_cmp(&h_min) != Some(core::cmp::Ordering::Greater) {
             return invalid("h_max", "must be above h_min");
         }
         Ok(Self {
