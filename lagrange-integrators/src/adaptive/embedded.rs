@@ -93,7 +93,8 @@ pub struct EmbeddedRungeKutta<T: Real, const N: usize, const S: usize, const R: 
     pub(super) kv: [SVector<T, N>; S],
     /// The next step size to try.
     pub(super) h: T,
-    pub(super) error_previous: T,
+    /// `ln` of the previous accepted step's error (floored), the PI controller's memory.
+    pub(super) log_error_previous: T,
     pub(super) rejected_last: bool,
     /// The start of the last accepted step and its size (zero before any).
     pub(super) previous: State<T, N>,
@@ -152,7 +153,7 @@ where
             kq: [SVector::zeros(); S],
             kv: [SVector::zeros(); S],
             h: T::zero(),
-            error_previous: real(ERROR_FLOOR),
+            log_error_previous: real::<T>(ERROR_FLOOR).ln(),
             rejected_last: false,
             previous: *state,
             h_last: T::zero(),
@@ -179,7 +180,7 @@ where
         state.check_finite()?;
         self.state = *state;
         self.stats = Statistics::default();
-        self.error_previous = real(ERROR_FLOOR);
+        self.log_error_previous = real::<T>(ERROR_FLOOR).ln();
         self.rejected_last = false;
         self.h_last = T::zero();
         self.hermite = None;
@@ -373,10 +374,13 @@ where
             }
             let err = self.error_norm(h, &y1);
             if err <= T::one() {
+                // err^-alpha err_prev^beta, by one logarithm and one exponential.
+                let log_err = err.max(real(ERROR_FLOOR)).ln();
                 let growth = if err == T::zero() {
                     real(FAC_MAX)
                 } else {
-                    real::<T>(SAFETY) * err.powf(-alpha) * self.error_previous.powf(real(BETA))
+                    real::<T>(SAFETY)
+                        * (real::<T>(BETA) * self.log_error_previous - alpha * err.ln()).exp()
                 };
                 let mut factor = growth.max(real(FAC_MIN)).min(real(FAC_MAX));
                 if self.rejected_last {
@@ -390,7 +394,7 @@ where
                 } else {
                     proposal
                 };
-                self.error_previous = err.max(real(ERROR_FLOOR));
+                self.log_error_previous = log_err;
                 self.rejected_last = false;
                 self.previous = y0;
                 self.h_last = h;
@@ -403,7 +407,7 @@ where
             }
             // Rejected (a NaN error estimate from a blown-up stage counts as rejected).
             let shrink = if err.is_finite() {
-                (real::<T>(SAFETY) * err.powf(-k.recip())).max(real(FAC_MIN))
+                (real::<T>(SAFETY) * (-err.ln() / k).exp()).max(real(FAC_MIN))
             } else {
                 real(FAC_MIN)
             };
