@@ -41,8 +41,9 @@ pub trait ImplicitTableau<const S: usize> {
 /// the motion.
 ///
 /// Cost per step: one acceleration Jacobian, then `S` accelerations per Newton iteration
-/// ([`ImplicitRungeKutta::last_iterations`] tells how many the last step took; 2 to 4 for a
-/// smooth mechanism at a moderate step, 1 plus a check for a linear one).
+/// ([`ImplicitRungeKutta::last_iterations`] tells how many the last step took; measured on a
+/// double pendulum, the last iteration confirming convergence: 4 to 5 at `h = 1e-2`, 3 to 4
+/// at `h = 1e-3`; 2 for a linear mechanism).
 ///
 /// Use the aliases: [`ImplicitMidpoint`](crate::ImplicitMidpoint),
 /// [`GaussLegendre2`](crate::GaussLegendre2), [`BackwardEuler`](crate::BackwardEuler),
