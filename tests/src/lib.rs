@@ -3,6 +3,10 @@
 
 use lagrange_core::{Real, State};
 
+mod agreement;
+
+pub use agreement::{agrees_with_automatic, random_state, relative, Agreement, Scales};
+
 /// A small, seeded, reproducible generator (SplitMix64), so that random-state tests are the
 /// same on every run and every machine.
 pub struct Rng(u64);
@@ -88,33 +92,6 @@ macro_rules! for_f32_and_f64 {
 #[doc = include_str!("../../README.md")]
 pub struct ReadmeDoctests;
 
-/// The Kepler problem in polar coordinates, unit mass, through the automatic Euler-Lagrange
-/// path: `T = (r'^2 + r^2 phi'^2) / 2`, `V = -mu / r`, `q = [r, phi]`. `phi` is cyclic, so
-/// its momentum `r^2 phi'` (the angular momentum) is conserved.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct KeplerLagrangian {
-    /// The gravitational parameter.
-    pub mu: f64,
-}
-
-impl<T: Real> lagrange_core::Lagrangian<T, 2> for KeplerLagrangian {
-    fn kinetic<S: lagrange_core::Scalar<Real = T>>(
-        &self,
-        _t: S,
-        q: &lagrange_core::nalgebra::SVector<S, 2>,
-        qd: &lagrange_core::nalgebra::SVector<S, 2>,
-    ) -> S {
-        S::from_f64(0.5) * (qd[0] * qd[0] + q[0] * q[0] * qd[1] * qd[1])
-    }
-    fn potential<S: lagrange_core::Scalar<Real = T>>(
-        &self,
-        _t: S,
-        q: &lagrange_core::nalgebra::SVector<S, 2>,
-    ) -> S {
-        -S::from_f64(self.mu) / q[0]
-    }
-}
-
 /// Problem P4's start: `mu = 1`, `e = 0.5`, `a = 1` (period `2 pi`, energy -1/2), at
 /// periapsis: `r = 0.5`, `phi = 0`, `r' = 0`, `phi' = 2 sqrt(3)`.
 #[must_use]
@@ -124,30 +101,4 @@ pub fn kepler_periapsis<T: Real>() -> State<T, 2> {
         [T::HALF, T::zero()],
         [T::zero(), T::from_f64(2.0 * 3.0f64.sqrt())],
     )
-}
-
-/// A unit mass on a linear spring of stiffness `k` (so `w^2 = k`), through the automatic
-/// path: `T = x'^2 / 2`, `V = k x^2 / 2`.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct SpringLagrangian<T> {
-    /// Stiffness per unit mass, `w^2`.
-    pub k: T,
-}
-
-impl<T: Real> lagrange_core::Lagrangian<T, 1> for SpringLagrangian<T> {
-    fn kinetic<S: lagrange_core::Scalar<Real = T>>(
-        &self,
-        _t: S,
-        _q: &lagrange_core::nalgebra::SVector<S, 1>,
-        qd: &lagrange_core::nalgebra::SVector<S, 1>,
-    ) -> S {
-        S::from_f64(0.5) * qd[0] * qd[0]
-    }
-    fn potential<S: lagrange_core::Scalar<Real = T>>(
-        &self,
-        _t: S,
-        q: &lagrange_core::nalgebra::SVector<S, 1>,
-    ) -> S {
-        S::from_f64(0.5) * S::from_real(self.k) * q[0] * q[0]
-    }
 }

@@ -1,10 +1,10 @@
 //! The fixed-timestep driver: variable frame times, whole steps of `dt`, the cap on steps per
 //! frame, and the interpolated state for rendering.
 
-use lagrange_core::{Error, EulerLagrange, Real, State};
+use lagrange_core::{Error, Real, State};
 use lagrange_integrators::{ExplicitEuler, FixedTimestep, Integrator, StormerVerlet};
-use lagrange_systems::SimplePendulum;
-use lagrange_tests::{for_f32_and_f64, pick, Rng, SpringLagrangian};
+use lagrange_systems::{SimplePendulum, SpringMassDamper};
+use lagrange_tests::{for_f32_and_f64, pick, Rng};
 
 /// `Err(InvalidParameter { name, .. })` with exactly this name.
 fn refuses<V: core::fmt::Debug>(result: Result<V, Error>, expected: &str) {
@@ -118,9 +118,7 @@ fn bad_input_and_failed_steps<T: Real>() -> Result<(), Error> {
         refuses(sim.advance(&p, bad), "frame_time");
     }
     // Explicit Euler on a stiff spring (h w = 100) overflows within a few hundred steps.
-    let stiff = EulerLagrange::new(SpringLagrangian {
-        k: T::from_f64(1e8),
-    });
+    let stiff = SpringMassDamper::new(one, T::from_f64(1e8), T::zero())?;
     let mut sim = FixedTimestep::new(
         ExplicitEuler,
         T::from_f64(0.01),

@@ -2,6 +2,7 @@
 //! and cost per step at two step sizes, and the adaptive integrators' error against their
 //! tolerance and event location.
 
+use crate::demo::TIMING_RUNS;
 use lagrange_core::{Error, EulerLagrange, State};
 use lagrange_integrators::{
     AdaptiveSettings, BackwardEuler, EmbeddedPair, EmbeddedRungeKutta, ExplicitEuler,
@@ -17,8 +18,6 @@ use std::time::Instant;
 const G: f64 = 9.81;
 const TH0: f64 = std::f64::consts::FRAC_PI_6;
 const T_END: f64 = 10.0;
-/// Timing: the median of this many whole runs.
-pub const TIMING_RUNS: usize = 5;
 
 /// The median over [`TIMING_RUNS`] of the wall time of `run`, in nanoseconds per `per`.
 pub fn median_ns<R>(per: u64, mut run: impl FnMut() -> R) -> f64 {
