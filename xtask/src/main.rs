@@ -3,10 +3,13 @@
 //! - `demo`: the origin's pendulum and a double pendulum with every integrator, a table and an
 //!   SVG plot under `target/lagrange-demo/`.
 //! - `test`: host tests of every crate, f32 and f64, the long runs (`#[ignore]`d) in release.
+//! - `bench`: run time against error: every integrator on the standard problems, CSV,
+//!   Markdown and SVG work-precision plots under `target/lagrange-bench/` (not part of `ci`).
 //! - `cross`: thumbv7em-none-eabihf builds of the library crates, with and without `defmt`,
 //!   and a linked no_std binary with no allocator, with its size.
 //! - `ci`: format check, clippy with `-D warnings`, test, cross.
 
+mod bench;
 mod cmd;
 mod cross;
 mod demo;
@@ -20,9 +23,10 @@ fn main() -> ExitCode {
         "demo" => demo::run(),
         "test" => cmd::run_all(&TEST).and(cmd::run_all(&LONG_TEST)),
         "cross" => cross::run(),
+        "bench" => bench::run(&std::env::args().skip(2).collect::<Vec<_>>()),
         "ci" => ci(),
         _ => {
-            eprintln!("usage: cargo xtask <demo | test | cross | ci>");
+            eprintln!("usage: cargo xtask <demo | test | cross | bench | ci>");
             return ExitCode::from(2);
         }
     };
@@ -57,7 +61,14 @@ const DOC_TEST: [&[&str]; 1] = [&["test", "--workspace", "--doc", "--quiet"]];
 
 /// Long runs (10^6 steps and more) are `#[ignore]`d in the quick debug test run and run here,
 /// optimised.
-const LONG_TEST: [&[&str]; 1] = [&["test", "--workspace", "--release", "--quiet", "--", "--ignored"]];
+const LONG_TEST: [&[&str]; 1] = [&[
+    "test",
+    "--workspace",
+    "--release",
+    "--quiet",
+    "--",
+    "--ignored",
+]];
 
 /// Everything CI checks; every step runs and every failure is reported at the end.
 fn ci() -> Result<(), String> {

@@ -1,0 +1,114 @@
+//! P5, a stiff elastic pendulum: m = 1, l0 = 1, k = 1e6, g = 9.81, stretched 1e-3 beyond its
+//! static stretch, 0.3 rad from the vertical, at rest, T = 2 s; reference from the tightest run
+//! of the library's best method for it, with its estimated error.
+
+use crate::bench::problem::{Problem, Reference};
+use crate::bench::real::BenchReal;
+use lagrange_core::nalgebra::SVector;
+use lagrange_core::{Error, EulerLagrange, Lagrangian, Real, Scalar, State};
+use lagrange_integrators::{Integrator, Rk4};
+
+/// Mass, kg.
+const M: f64 = 1.0;
+/// Rest length, m.
+const L0: f64 = 1.0;
+/// Stiffness, N/m.
+const K: f64 = 1e6;
+/// Gravity, m/s^2.
+const G: f64 = 9.81;
+/// Steps of the finer reference run (the coarser takes half as many).
+const REFERENCE_STEPS: u64 = 1 << 19;
+
+/// A mass on a spring in the plane, `q = [r, th]`, `r` the spring length, `th` from the
+/// downward vertical:
+///
+/// ```text
+/// T = m (r'^2 + r^2 th'^2) / 2,   V = -m g r cos th + k (r - l0)^2 / 2
+/// ```
+///
+/// Until a hand-derived `ElasticPendulum` lands, P5 runs through `EulerLagrange` on this
+/// (automatic path: provisional timings).
+#[derive(Debug, Clone, Copy)]
+pub struct ElasticLagrangian<T> {
+    m: T,
+    l0: T,
+    k: T,
+    g: T,
+}
+
+impl<T: Real> Lagrangian<T, 2> for ElasticLagrangian<T> {
+    fn kinetic<S: Scalar<Real = T>>(&self, _t: S, q: &SVector<S, 2>, qd: &SVector<S, 2>) -> S {
+        S::from_real(T::HALF * self.m) * (qd[0] * qd[0] + q[0] * q[0] * qd[1] * qd[1])
+    }
+    fn potential<S: Scalar<Real = T>>(&self, _t: S, q: &SVector<S, 2>) -> S {
+        let stretch = q[0] - S::from_real(self.l0);
+        S::from_real(T::HALF * self.k) * stretch * stretch
+            - S::from_real(self.m * self.g) * q[0] * q[1].cos()
+    }
+}
+
+/// The elastic pendulum the bench runs.
+pub type ElasticMechanism<T> = EulerLagrange<ElasticLagrangian<T>>;
+
+/// P5.
+pub struct StiffElastic;
+
+impl Problem<2, 4> for StiffElastic {
+    type Mech<T: BenchReal> = ElasticMechanism<T>;
+
+    fn id(&self) -> &'static str {
+        "P5"
+    }
+    fn title(&self) -> &'static str {
+        "stiff elastic pendulum: m = 1, l0 = 1, k = 1e6, g = 9.81, r0 = 1 + mg/k + 1e-3, \
+         th0 = 0.3 at rest, T = 2 s"
+    }
+    fn mechanism_note(&self) -> &'static str {
+        "EulerLagrange on a bench-local elastic-pendulum Lagrangian (automatic path; \
+         provisional timings until ElasticPendulum lands)"
+    }
+    fn mechanism<T: BenchReal>(&self) -> Result<ElasticMechanism<T>, Error> {
+        Ok(EulerLagrange::new(ElasticLagrangian {
+            m: T::real(M),
+            l0: T::real(L0),
+            k: T::real(K),
+            g: T::real(G),
+        }))
+    }
+    fn start(&self) -> State<f64, 2> {
+        State::at_rest([L0 + M * G / K + 1e-3, 0.3])
+    }
+    fn t_end(&self) -> f64 {
+        2.0
+    }
+    fn energy_datum(&self) -> Option<State<f64, 2>> {
+        Some(State::at_rest([L0 + M * G / K, 0.0]))
+    }
+    fn reference(&self) -> Result<Reference<2>, String> {
+        // No library stiff method yet: the tightest RK4 runs, 2^18 and 2^19 steps (h w about
+        // 7.6e-3 and 3.8e-3), and Richardson's estimate of the finer one's error.
+        let m = self.mechanism::<f64>().map_err(|e| e.to_string())?;
+        let run = |steps: u64| {
+            Rk4.integrate(&m, &self.start(), self.t_end() / steps as f64, steps)
+                .map_err(|e| e.to_string())
+        };
+        let coarse = run(REFERENCE_STEPS / 2)?;
+        let fine = run(REFERENCE_STEPS)?;
+        let estimate = crate::bench::problem::state_error(&coarse, &fine) / 15.0;
+        Ok(Reference {
+            state: fine,
+            source: format!(
+                "tightest run: library RK4, {REFERENCE_STEPS} steps (h w = {:.1e}); error \
+                 estimated by Richardson from the run with half as many",
+                self.t_end() / REFERENCE_STEPS as f64 * self.fastest_frequency()
+            ),
+            error: estimate,
+        })
+    }
+    fn coarsest_dt(&self) -> f64 {
+        2e-3
+    }
+    fn fastest_frequency(&self) -> f64 {
+        (K / M).sqrt()
+    }
+}
