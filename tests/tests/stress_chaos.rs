@@ -114,7 +114,10 @@ fn nearby_starts_separate_exponentially() -> Result<(), Error> {
     let (t0, t1) = (window[0].0, window[window.len() - 1].0);
     assert!(t1 - t0 >= 8.0, "growth window {t0}..{t1} too short to fit");
     let lambda = slope(&window);
-    assert!((0.8..=1.25).contains(&lambda), "finite-time Lyapunov exponent {lambda}");
+    assert!(
+        (0.8..=1.25).contains(&lambda),
+        "finite-time Lyapunov exponent {lambda}"
+    );
     let reference = benettin(t0, t1, 1e-8)?;
     assert!(
         (lambda / reference - 1.0).abs() <= 0.1,

@@ -73,7 +73,11 @@ fn verlet_energy_bounded_without_drift<T: Real>(steps: u64) -> Result<(), Error>
     let bound = pick::<T>(5e-4, (DT * DT * G) / 4.0);
     let drift_bound = pick::<T>(5e-4, 1e-7);
     let worst = w.max.iter().copied().fold(0.0, f64::max);
-    assert!(worst <= bound, "max relative energy error {worst:e} > {bound:e}: {:?}", w.max);
+    assert!(
+        worst <= bound,
+        "max relative energy error {worst:e} > {bound:e}: {:?}",
+        w.max
+    );
     let (first, last) = (w.mean[0], w.mean[w.mean.len() - 1]);
     assert!(
         (last - first).abs() <= drift_bound,

@@ -76,15 +76,24 @@ fn linear_limits<T: Real>() -> Result<(), Error> {
     let rk4 = 2.0 * core::f64::consts::SQRT_2;
     let steps = 10_000;
     let inside = energy_growth::<T, _>(Rk4, 0.95 * rk4, steps)?;
-    assert!(inside <= 1.0 + pick::<T>(1e-4, 1e-12), "RK4 inside: {inside}");
+    assert!(
+        inside <= 1.0 + pick::<T>(1e-4, 1e-12),
+        "RK4 inside: {inside}"
+    );
     assert_eq!(
         energy_growth::<T, _>(Rk4, 1.05 * rk4, steps),
         Err(Error::NonFiniteState)
     );
     let euler = energy_growth::<T, _>(SemiImplicitEuler, 1.9, steps)?;
-    assert!((19.9..=20.01).contains(&euler), "symplectic Euler inside: {euler}");
+    assert!(
+        (19.9..=20.01).contains(&euler),
+        "symplectic Euler inside: {euler}"
+    );
     let verlet = energy_growth::<T, _>(VelocityVerlet, 1.9, steps)?;
-    assert!(verlet <= 1.0 + pick::<T>(1e-4, 1e-12), "Verlet inside: {verlet}");
+    assert!(
+        verlet <= 1.0 + pick::<T>(1e-4, 1e-12),
+        "Verlet inside: {verlet}"
+    );
     assert_eq!(
         energy_growth::<T, _>(SemiImplicitEuler, 2.1, steps),
         Err(Error::NonFiniteState)
@@ -195,10 +204,22 @@ fn pendulum_sweeps<T: Real>() -> Result<(), Error> {
     let one = T::one();
     let p = SimplePendulum::new(one, one, g, T::zero())?;
     let dts = geometric(1e-3, 10.0, 13);
-    sweep(&p, &State::at_rest([T::from_f64(0.5)]), &dts, 1_000, "pendulum");
+    sweep(
+        &p,
+        &State::at_rest([T::from_f64(0.5)]),
+        &dts,
+        1_000,
+        "pendulum",
+    );
     let dp = DoublePendulum::new(one, one, one, one, g)?;
     let half_pi = T::from_f64(core::f64::consts::FRAC_PI_2);
-    sweep(&dp, &State::at_rest([half_pi; 2]), &dts, 1_000, "double pendulum");
+    sweep(
+        &dp,
+        &State::at_rest([half_pi; 2]),
+        &dts,
+        1_000,
+        "double pendulum",
+    );
     Ok(())
 }
 
