@@ -128,9 +128,20 @@ impl ProblemVisitor for SweepProblems<'_> {
         };
         let datum = p.energy_datum();
         let e0 = energy(&m64, datum.as_ref(), &p.start());
+        // Whatever its source, the reference is held in f64: half an ulp of its largest
+        // component is part of its error.
+        let rounding = 0.5
+            * f64::EPSILON
+            * reference
+                .state
+                .q
+                .iter()
+                .chain(reference.state.qd.iter())
+                .fold(0.0f64, |m, x| m.max(x.abs()));
+        let reference_error = reference.error.max(rounding);
         println!(
-            "   reference: {} (its error {:.1e}); E(0) = {e0}",
-            reference.source, reference.error
+            "   reference: {} (its error {reference_error:.1e}); E(0) = {e0}",
+            reference.source
         );
         self.out.references.push(ReferenceInfo {
             problem: p.id(),
@@ -138,7 +149,7 @@ impl ProblemVisitor for SweepProblems<'_> {
             mechanism: p.mechanism_note(),
             t_end: p.t_end(),
             source: reference.source.clone(),
-            error: reference.error,
+            error: reference_error,
             e0,
         });
         let mut v = SweepMethods {
