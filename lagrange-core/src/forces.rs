@@ -143,6 +143,20 @@ where
     fn solve_mass(&self, state: &State<T, N>, b: &SVector<T, N>) -> Result<SVector<T, N>, Error> {
         self.mechanism.solve_mass(state, b)
     }
+    /// The inner mechanism's acceleration law with this force added, so that a constrained
+    /// mechanism keeps its constraint forces when wrapped.
+    fn acceleration(&self, state: &State<T, N>) -> Result<SVector<T, N>, Error> {
+        self.mechanism
+            .acceleration_with(state, &self.force.force(state))
+    }
+    fn acceleration_with(
+        &self,
+        state: &State<T, N>,
+        extra: &SVector<T, N>,
+    ) -> Result<SVector<T, N>, Error> {
+        self.mechanism
+            .acceleration_with(state, &(self.force.force(state) + extra))
+    }
 }
 
 #[cfg(feature = "defmt")]

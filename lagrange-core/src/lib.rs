@@ -10,6 +10,8 @@
 //! - [`Lagrangian`] and [`EulerLagrange`]: write `T` and `V` once and get the equations of
 //!   motion by automatic differentiation.
 //! - [`GeneralizedForce`], [`ViscousDamping`], [`Input`], [`Forced`]: forces added by wrapping.
+//! - [`constraints`]: holonomic and Pfaffian constraints with Lagrange multipliers
+//!   ([`Constrained`]), Baumgarte [`Stabilization`] and [`Projection`] against drift.
 //! - [`Error`]: one small `Copy` error type for every crate.
 //!
 //! ```
@@ -40,6 +42,7 @@
 #![forbid(unsafe_code)]
 
 mod cholesky;
+pub mod constraints;
 mod dual;
 mod error;
 mod forces;
@@ -50,6 +53,10 @@ mod state;
 pub mod validate;
 
 pub use cholesky::solve_spd;
+pub use constraints::{
+    Constrained, Constraints, Holonomic, HolonomicConstraints, Pfaffian, PfaffianConstraints,
+    Projection, Stabilization,
+};
 pub use dual::Dual;
 pub use error::Error;
 pub use forces::{Forced, GeneralizedForce, Input, ViscousDamping};

@@ -62,6 +62,27 @@ pub trait Mechanism<T: Real, const N: usize> {
         self.solve_mass(state, &(self.rhs(state) + self.generalized_force(state)))
     }
 
+    /// The generalized accelerations with the extra generalized force `extra` acting besides
+    /// `Q`: `M^-1 (f + Q + extra)` by default.
+    ///
+    /// [`Forced`] calls this, so that a mechanism whose acceleration law is more than
+    /// `M^-1 (f + Q)` keeps that law when a force is added by wrapping: a constrained mechanism
+    /// (see [`constraints`](crate::constraints)) overrides both this method and
+    /// [`Mechanism::acceleration`] to add its constraint forces.
+    ///
+    /// # Errors
+    /// As [`Mechanism::solve_mass`].
+    fn acceleration_with(
+        &self,
+        state: &State<T, N>,
+        extra: &SVector<T, N>,
+    ) -> Result<SVector<T, N>, Error> {
+        self.solve_mass(
+            state,
+            &(self.rhs(state) + self.generalized_force(state) + extra),
+        )
+    }
+
     /// This mechanism with `force` added to its generalized forces.
     ///
     /// ```

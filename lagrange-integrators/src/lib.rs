@@ -10,6 +10,10 @@
 //! | [`VelocityVerlet`] | 2 | explicit | constant `M`, forces of `q` only | 2 | long conservative runs at moderate accuracy |
 //! | [`Rk4`] | 4 | explicit | no (slow drift) | 4 | accurate short and medium runs |
 //!
+//! [`Projected`] wraps any of them to project onto constraints after every step;
+//! [`ContactStepper`] ([`impacts`]) wraps any of them to step through impacts and resting
+//! contacts.
+//!
 //! ```
 //! use lagrange_core::{Mechanism, State};
 //! use lagrange_integrators::{Integrator, Rk4};
@@ -27,13 +31,17 @@
 #![forbid(unsafe_code)]
 
 mod explicit_euler;
+pub mod impacts;
 mod integrator;
+mod projected;
 mod rk4;
 mod semi_implicit_euler;
 mod velocity_verlet;
 
 pub use explicit_euler::ExplicitEuler;
+pub use impacts::{ContactModel, ContactStepper, Contacts, Impact};
 pub use integrator::Integrator;
+pub use projected::Projected;
 pub use rk4::Rk4;
 pub use semi_implicit_euler::SemiImplicitEuler;
 pub use velocity_verlet::VelocityVerlet;

@@ -3,6 +3,10 @@
 
 use lagrange_core::{Real, State};
 
+mod agreement;
+
+pub use agreement::{agrees_with_automatic, random_state, relative, Agreement, Scales};
+
 /// A small, seeded, reproducible generator (SplitMix64), so that random-state tests are the
 /// same on every run and every machine.
 pub struct Rng(u64);

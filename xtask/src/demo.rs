@@ -19,7 +19,7 @@ const TABLE_TIMES: [f64; 4] = [2.5, 5.0, 7.5, 10.0];
 /// Points kept per run for the plot.
 const PLOT_POINTS: u64 = 1000;
 /// Timing: the median of this many whole runs.
-const TIMING_RUNS: usize = 5;
+pub(crate) const TIMING_RUNS: usize = 5;
 
 /// Problem P2 of shared/BENCH_PROBLEMS.md: both angles pi/2 at rest, T = 10 s; its state at
 /// T from a 1e-27 reference solve (th1, th2, th1', th2').
@@ -32,7 +32,7 @@ const P2_REFERENCE: [f64; 4] = [
 ];
 
 /// Median wall time per step of `steps` steps, over `TIMING_RUNS` whole runs.
-fn ns_per_step<T, I, M, const N: usize>(
+pub(crate) fn ns_per_step<T, I, M, const N: usize>(
     mut integrator: I,
     mechanism: &M,
     start: &State<T, N>,
@@ -306,5 +306,6 @@ pub fn run() -> Result<(), String> {
     let path = dir.join("pendulum.svg");
     std::fs::write(&path, doc).map_err(|e| e.to_string())?;
     println!("\nPlot: {}", path.display());
-    Ok(())
+    crate::demo_systems::run()?;
+    crate::demo_constraints::run()
 }

@@ -1,7 +1,9 @@
 //! `cargo xtask`: the project's automation, in Rust so that it runs wherever cargo does.
 //!
 //! - `demo`: the origin's pendulum and a double pendulum with every integrator, a table and an
-//!   SVG plot under `target/lagrange-demo/`.
+//!   SVG plot under `target/lagrange-demo/`; then every standard mechanism (energy error and
+//!   cost per step and per acceleration), the chain's cost against N, and the Kepler orbit;
+//!   then a constrained and a colliding scene with their plots.
 //! - `test`: host tests of every crate, f32 and f64, the long runs (`#[ignore]`d) in release.
 //! - `bench`: run time against error: every integrator on the standard problems, CSV,
 //!   Markdown and SVG work-precision plots under `target/lagrange-bench/` (not part of `ci`).
@@ -13,6 +15,8 @@ mod bench;
 mod cmd;
 mod cross;
 mod demo;
+mod demo_constraints;
+mod demo_systems;
 mod svg;
 
 use std::process::ExitCode;
