@@ -3,43 +3,13 @@
 //! oscillator each method is stable just inside its theoretical limit and blows up (with
 //! `Error::NonFiniteState`) just outside it.
 
-use lagrange_core::nalgebra::SVector;
-use lagrange_core::{Error, EulerLagrange, Lagrangian, Mechanism, Real, Scalar, State};
+use lagrange_core::{Error, Mechanism, Real, State};
 use lagrange_integrators::{ExplicitEuler, Integrator, Rk4, SemiImplicitEuler, VelocityVerlet};
-use lagrange_systems::{DoublePendulum, SimplePendulum};
+use lagrange_systems::{DoublePendulum, ElasticPendulum, Kepler, SimplePendulum, SpringMassDamper};
 use lagrange_tests::{for_f32_and_f64, pick};
 
-/// A unit mass on a spring, `x'' = -w^2 x`, through the automatic path.
-struct Oscillator<T> {
-    w2: T,
-}
-
-impl<T: Real> Lagrangian<T, 1> for Oscillator<T> {
-    fn kinetic<S: Scalar<Real = T>>(&self, _t: S, _q: &SVector<S, 1>, qd: &SVector<S, 1>) -> S {
-        S::from_f64(0.5) * qd[0] * qd[0]
-    }
-    fn potential<S: Scalar<Real = T>>(&self, _t: S, q: &SVector<S, 1>) -> S {
-        S::from_f64(0.5) * S::from_real(self.w2) * q[0] * q[0]
-    }
-}
-
-/// A stiff elastic pendulum (P5 of the bench: m = 1, l0 = 1, k = 1e6), `q = [r, th]`.
-struct Elastic<T> {
-    k: T,
-}
-
-impl<T: Real> Lagrangian<T, 2> for Elastic<T> {
-    fn kinetic<S: Scalar<Real = T>>(&self, _t: S, q: &SVector<S, 2>, qd: &SVector<S, 2>) -> S {
-        S::from_f64(0.5) * (qd[0] * qd[0] + q[0] * q[0] * qd[1] * qd[1])
-    }
-    fn potential<S: Scalar<Real = T>>(&self, _t: S, q: &SVector<S, 2>) -> S {
-        let stretch = q[0] - S::one();
-        S::from_f64(0.5) * S::from_real(self.k) * stretch * stretch
-            - S::from_f64(9.81) * q[0] * q[1].cos()
-    }
-}
-
-/// Frequency of the oscillator, rad/s (stiff, like P5's spring).
+/// Frequency of the oscillator (a unit mass on a `SpringMassDamper`), rad/s: stiff, like P5's
+/// spring.
 const W: f64 = 1000.0;
 
 /// Largest `|E(t) / E(0)|` over `steps` steps of `h = hw / W` from `x = 1` at rest, or the
@@ -49,9 +19,7 @@ fn energy_growth<T: Real, I: Integrator<T, 1>>(
     hw: f64,
     steps: u64,
 ) -> Result<f64, Error> {
-    let m = EulerLagrange::new(Oscillator {
-        w2: T::from_f64(W * W),
-    });
+    let m = SpringMassDamper::new(T::one(), T::from_f64(W * W), T::zero())?;
     let start = State::new(T::zero(), [T::one()], [T::zero()]);
     let e0 = m.energy(&start).to_f64();
     let mut worst: f64 = 1.0;
@@ -125,7 +93,8 @@ fn explicit_euler_grows_exactly<T: Real>() -> Result<(), Error> {
 }
 
 /// The outcome of a run at one step size: a finite state, or one of the errors a blow-up may
-/// give. Anything else fails the test.
+/// give (the state overflowed, or left the coordinates' domain: `r <= 0` for the elastic
+/// pendulum and Kepler). Anything else fails the test.
 fn finite_or_specific<T: Real, const N: usize>(
     result: Result<State<T, N>, Error>,
     what: &str,
@@ -136,7 +105,10 @@ fn finite_or_specific<T: Real, const N: usize>(
     assert!(
         matches!(
             result,
-            Ok(_) | Err(Error::NonFiniteState | Error::SingularMassMatrix { .. })
+            Ok(_)
+                | Err(Error::NonFiniteState
+                    | Error::SingularMassMatrix { .. }
+                    | Error::Singularity { .. })
         ),
         "{what}: unexpected outcome {result:?}"
     );
@@ -177,12 +149,12 @@ fn geometric(lo: f64, hi: f64, n: u32) -> Vec<f64> {
         .collect()
 }
 
-/// The stiff elastic pendulum (radial frequency 1000 rad/s) from `h w = 0.1` to `h w = 100`:
-/// every outcome finite or a specific error, and every method fails somewhere past its limit.
+/// The stiff elastic pendulum of the bench's P5 (radial frequency 1000 rad/s) from `h w = 0.1`
+/// to `h w = 100`: every outcome finite or a specific error, and every method fails somewhere
+/// past its limit.
 fn stiff_elastic_sweep<T: Real>() -> Result<(), Error> {
-    let m = EulerLagrange::new(Elastic {
-        k: T::from_f64(1e6),
-    });
+    let one = T::one();
+    let m = ElasticPendulum::new(one, T::from_f64(1e6), one, T::from_f64(9.81))?;
     let start = State::new(
         T::zero(),
         [T::from_f64(1.0 + 9.81e-6 + 1e-3), T::from_f64(0.3)],
@@ -198,7 +170,9 @@ fn stiff_elastic_sweep<T: Real>() -> Result<(), Error> {
 }
 
 /// The pendulum and the double pendulum (bounded forces) from `dt = 1e-3` to `dt = 10`: the
-/// state may stay finite at any step (the sine bounds the force), but never holds NaN.
+/// state may stay finite at any step (the sine bounds the force), but never holds NaN. The
+/// Kepler orbit of P4 from `dt = 1e-3` to `dt = 10`: a large step throws the body through the
+/// centre, which is `Singularity`, never a NaN.
 fn pendulum_sweeps<T: Real>() -> Result<(), Error> {
     let g = T::from_f64(9.81);
     let one = T::one();
@@ -220,6 +194,14 @@ fn pendulum_sweeps<T: Real>() -> Result<(), Error> {
         1_000,
         "double pendulum",
     );
+    let kepler = Kepler::new(one)?;
+    let periapsis = State::new(
+        T::zero(),
+        [T::from_f64(0.5), T::zero()],
+        [T::zero(), T::from_f64(12f64.sqrt())],
+    );
+    let failures = sweep(&kepler, &periapsis, &dts, 1_000, "Kepler");
+    assert!(failures.iter().all(|&f| f > 0), "{failures:?}");
     Ok(())
 }
 

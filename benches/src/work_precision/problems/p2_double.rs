@@ -1,8 +1,8 @@
 //! P2, the chaotic double pendulum: m = l = 1, both angles pi/2 at rest, 10 s; reference from
 //! the published 1e-27 solve.
 
-use crate::bench::problem::{Problem, Reference};
-use crate::bench::real::BenchReal;
+use crate::problem::{Problem, Reference};
+use crate::real::BenchReal;
 use lagrange_core::{Error, State};
 use lagrange_systems::DoublePendulum;
 

@@ -373,25 +373,30 @@ fn markdown(
         let _ = writeln!(
             s,
             "Mechanism: {}. One RK4 step (4 evaluations), one assembly of `M` and `f`, one \
-             fixed-size Cholesky solve, f64.\n\n| N | ns per RK4 step | ns per assembly | ns per solve |\n|---:|---:|---:|---:|",
+             fixed-size Cholesky solve, f64; and one RK4 step through the automatic \
+             Euler-Lagrange path on the same chain's Lagrangian.\n\n\
+             | N | ns per RK4 step | ns per assembly | ns per solve | ns per RK4 step, automatic path |\n\
+             |---:|---:|---:|---:|---:|",
             chain.mechanism
         );
         for p in &chain.points {
             let _ = writeln!(
                 s,
-                "| {} | {:.0} | {:.0} | {:.0} |",
-                p.n, p.ns_per_step, p.ns_assembly, p.ns_solve
+                "| {} | {:.0} | {:.0} | {:.0} | {:.0} |",
+                p.n, p.ns_per_step, p.ns_assembly, p.ns_solve, p.ns_per_step_automatic
             );
         }
         let _ = writeln!(
             s,
             "\nFitted exponents (least squares of log cost on log N): step **{:.2}** over \
-             N = 2..20, {:.2} over N = 8..20; assembly {:.2}; solve {:.2}. The budget is \
-             O(N^2) plus the fixed-size solve (O(N^3) with a small constant).",
+             N = 2..20, {:.2} over N = 8..20; assembly {:.2}; solve {:.2}; automatic path \
+             {:.2}. The budget is O(N^2) plus the fixed-size solve (O(N^3) with a small \
+             constant).",
             chain.exponent_step,
             chain.exponent_step_large,
             chain.exponent_assembly,
-            chain.exponent_solve
+            chain.exponent_solve,
+            chain.exponent_automatic
         );
     }
 

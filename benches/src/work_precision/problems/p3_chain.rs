@@ -1,10 +1,11 @@
 //! P3, the n-link chain: N unit point masses on N massless unit links, all links at 45 degrees
 //! at rest, T = 5 s, for N = 5 and N = 20; references from the published 1e-28 solves.
 
-use crate::bench::problem::{Problem, Reference};
-use crate::bench::real::BenchReal;
+use crate::problem::{Problem, Reference};
+use crate::real::BenchReal;
 use lagrange_core::nalgebra::SVector;
-use lagrange_core::{Error, EulerLagrange, Lagrangian, Real, Scalar, State};
+use lagrange_core::{Error, Real, State};
+use lagrange_systems::NLinkPendulum;
 
 /// Gravity, m/s^2.
 const G: f64 = 9.81;
@@ -69,56 +70,15 @@ pub const N20: [f64; 40] = [
     0.11289006492739135073,
 ];
 
-/// The chain's Lagrangian, written once in O(N) through the links' cumulative velocities
-/// (unit masses, unit lengths, absolute angles from the downward vertical):
+/// The chain mechanism the bench runs: the hand-derived `NLinkPendulum`.
+pub type ChainMechanism<T, const N: usize> = NLinkPendulum<T, N>;
+
+/// The chain of `N` unit masses on unit links in precision `T`.
 ///
-/// ```text
-/// v_i = sum_{k<=i} (cos th_k, sin th_k) th_k'
-/// T   = sum_i |v_i|^2 / 2
-/// V   = g sum_j mu_j (1 - cos th_j),   mu_j = N - j (masses at and below link j, 0-based)
-/// ```
-///
-/// so that V = 0 at the hanging rest state, the energy convention of the bench. Until a
-/// hand-derived `NLinkPendulum` lands, the chain runs through `EulerLagrange` on this: its
-/// timings are those of the automatic path and are provisional.
-#[derive(Debug, Clone, Copy)]
-pub struct ChainLagrangian<T> {
-    g: T,
-}
-
-impl<T: Real> ChainLagrangian<T> {
-    /// The chain in gravity `g`.
-    pub fn new(g: T) -> Self {
-        Self { g }
-    }
-}
-
-impl<T: Real, const N: usize> Lagrangian<T, N> for ChainLagrangian<T> {
-    fn kinetic<S: Scalar<Real = T>>(&self, _t: S, q: &SVector<S, N>, qd: &SVector<S, N>) -> S {
-        let (mut vx, mut vy, mut twice_t) = (S::zero(), S::zero(), S::zero());
-        for k in 0..N {
-            let (s, c) = q[k].sin_cos();
-            vx += c * qd[k];
-            vy += s * qd[k];
-            twice_t += vx * vx + vy * vy;
-        }
-        S::from_f64(0.5) * twice_t
-    }
-    fn potential<S: Scalar<Real = T>>(&self, _t: S, q: &SVector<S, N>) -> S {
-        let mut v = S::zero();
-        for j in 0..N {
-            v += S::from_f64((N - j) as f64) * (S::one() - q[j].cos());
-        }
-        S::from_real(self.g) * v
-    }
-}
-
-/// The chain mechanism the bench runs.
-pub type ChainMechanism<T> = EulerLagrange<ChainLagrangian<T>>;
-
-/// The chain of `N` links in precision `T`.
-pub fn chain<T: Real>() -> ChainMechanism<T> {
-    EulerLagrange::new(ChainLagrangian::new(T::from_f64(G)))
+/// # Errors
+/// Never, for these parameters.
+pub fn chain<T: Real, const N: usize>() -> Result<ChainMechanism<T, N>, Error> {
+    NLinkPendulum::new([T::one(); N], [T::one(); N], T::from_f64(G))
 }
 
 /// P3 with `N` links (`N2 = 2 N`) and its published final state.
@@ -143,7 +103,7 @@ pub const CHAIN_20: Chain<20, 40> = Chain {
 };
 
 impl<const N: usize, const N2: usize> Problem<N, N2> for Chain<N, N2> {
-    type Mech<T: BenchReal> = ChainMechanism<T>;
+    type Mech<T: BenchReal> = ChainMechanism<T, N>;
 
     fn id(&self) -> &'static str {
         self.id
@@ -152,11 +112,10 @@ impl<const N: usize, const N2: usize> Problem<N, N2> for Chain<N, N2> {
         self.title
     }
     fn mechanism_note(&self) -> &'static str {
-        "EulerLagrange on a bench-local O(N) chain Lagrangian (automatic path; provisional \
-         timings until NLinkPendulum lands)"
+        "NLinkPendulum (hand-derived)"
     }
-    fn mechanism<T: BenchReal>(&self) -> Result<ChainMechanism<T>, Error> {
-        Ok(chain())
+    fn mechanism<T: BenchReal>(&self) -> Result<ChainMechanism<T, N>, Error> {
+        chain()
     }
     fn start(&self) -> State<f64, N> {
         State::at_rest([std::f64::consts::FRAC_PI_4; N])
@@ -165,7 +124,7 @@ impl<const N: usize, const N2: usize> Problem<N, N2> for Chain<N, N2> {
         5.0
     }
     fn energy_datum(&self) -> Option<State<f64, N>> {
-        None
+        Some(State::at_rest([0.0; N]))
     }
     fn reference(&self) -> Result<Reference<N>, String> {
         let p = &self.published;

@@ -1,4 +1,4 @@
-//! `cargo xtask bench`: run time against error.
+//! `cargo xtask bench` (which runs this binary, optimised): run time against error.
 //!
 //! Every method of the methods table ([`method::for_each`]: the library's integrators, a
 //! hand-written RK4 loop, `ode_solvers`' Dopri5 and Dop853) on every problem of the problems
@@ -30,7 +30,8 @@ mod sweep;
 mod timing;
 mod work_precision;
 
-use crate::cmd::project_root;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
 use std::time::Instant;
 use timing::Budget;
 
@@ -101,8 +102,26 @@ fn list(arg: Option<&String>) -> Result<Vec<String>, String> {
 /// Usage of `cargo xtask bench`.
 const USAGE: &str = "usage: cargo xtask bench [--quick] [--only P1,P2,...] [--method NAME,...]";
 
+/// The workspace root (the parent of this crate's manifest directory).
+fn project_root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .map_or_else(|| PathBuf::from("."), Path::to_path_buf)
+}
+
+fn main() -> ExitCode {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    match run(&args) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("bench failed:\n{e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
 /// Runs the bench.
-pub fn run(args: &[String]) -> Result<(), String> {
+fn run(args: &[String]) -> Result<(), String> {
     let opts = Options::parse(args)?;
     let clock = Instant::now();
     let load_before = load_average();

@@ -1,8 +1,8 @@
 //! P1, the origin's pendulum: L = 1 m, g = 9.81 m/s^2, 30 degrees at rest, 10 s; exact
 //! reference from the Jacobi elliptic solution.
 
-use crate::bench::problem::{Problem, Reference};
-use crate::bench::real::BenchReal;
+use crate::problem::{Problem, Reference};
+use crate::real::BenchReal;
 use lagrange_core::{Error, State};
 use lagrange_systems::exact::pendulum_from_rest;
 use lagrange_systems::SimplePendulum;

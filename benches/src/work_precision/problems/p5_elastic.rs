@@ -2,11 +2,11 @@
 //! static stretch, 0.3 rad from the vertical, at rest, T = 2 s; reference from the tightest run
 //! of the library's best method for it, with its estimated error.
 
-use crate::bench::problem::{Problem, Reference};
-use crate::bench::real::BenchReal;
-use lagrange_core::nalgebra::SVector;
-use lagrange_core::{Error, EulerLagrange, Lagrangian, Real, Scalar, State};
+use crate::problem::{Problem, Reference};
+use crate::real::BenchReal;
+use lagrange_core::{Error, State};
 use lagrange_integrators::{Integrator, Rk4};
+use lagrange_systems::ElasticPendulum;
 
 /// Mass, kg.
 const M: f64 = 1.0;
@@ -19,42 +19,11 @@ const G: f64 = 9.81;
 /// Steps of the finer reference run (the coarser takes half as many).
 const REFERENCE_STEPS: u64 = 1 << 19;
 
-/// A mass on a spring in the plane, `q = [r, th]`, `r` the spring length, `th` from the
-/// downward vertical:
-///
-/// ```text
-/// T = m (r'^2 + r^2 th'^2) / 2,   V = -m g r cos th + k (r - l0)^2 / 2
-/// ```
-///
-/// Until a hand-derived `ElasticPendulum` lands, P5 runs through `EulerLagrange` on this
-/// (automatic path: provisional timings).
-#[derive(Debug, Clone, Copy)]
-pub struct ElasticLagrangian<T> {
-    m: T,
-    l0: T,
-    k: T,
-    g: T,
-}
-
-impl<T: Real> Lagrangian<T, 2> for ElasticLagrangian<T> {
-    fn kinetic<S: Scalar<Real = T>>(&self, _t: S, q: &SVector<S, 2>, qd: &SVector<S, 2>) -> S {
-        S::from_real(T::HALF * self.m) * (qd[0] * qd[0] + q[0] * q[0] * qd[1] * qd[1])
-    }
-    fn potential<S: Scalar<Real = T>>(&self, _t: S, q: &SVector<S, 2>) -> S {
-        let stretch = q[0] - S::from_real(self.l0);
-        S::from_real(T::HALF * self.k) * stretch * stretch
-            - S::from_real(self.m * self.g) * q[0] * q[1].cos()
-    }
-}
-
-/// The elastic pendulum the bench runs.
-pub type ElasticMechanism<T> = EulerLagrange<ElasticLagrangian<T>>;
-
 /// P5.
 pub struct StiffElastic;
 
 impl Problem<2, 4> for StiffElastic {
-    type Mech<T: BenchReal> = ElasticMechanism<T>;
+    type Mech<T: BenchReal> = ElasticPendulum<T>;
 
     fn id(&self) -> &'static str {
         "P5"
@@ -64,16 +33,10 @@ impl Problem<2, 4> for StiffElastic {
          th0 = 0.3 at rest, T = 2 s"
     }
     fn mechanism_note(&self) -> &'static str {
-        "EulerLagrange on a bench-local elastic-pendulum Lagrangian (automatic path; \
-         provisional timings until ElasticPendulum lands)"
+        "ElasticPendulum (hand-derived)"
     }
-    fn mechanism<T: BenchReal>(&self) -> Result<ElasticMechanism<T>, Error> {
-        Ok(EulerLagrange::new(ElasticLagrangian {
-            m: T::real(M),
-            l0: T::real(L0),
-            k: T::real(K),
-            g: T::real(G),
-        }))
+    fn mechanism<T: BenchReal>(&self) -> Result<ElasticPendulum<T>, Error> {
+        ElasticPendulum::new(T::real(M), T::real(K), T::real(L0), T::real(G))
     }
     fn start(&self) -> State<f64, 2> {
         State::at_rest([L0 + M * G / K + 1e-3, 0.3])
@@ -94,7 +57,7 @@ impl Problem<2, 4> for StiffElastic {
         };
         let coarse = run(REFERENCE_STEPS / 2)?;
         let fine = run(REFERENCE_STEPS)?;
-        let estimate = crate::bench::problem::state_error(&coarse, &fine) / 15.0;
+        let estimate = crate::problem::state_error(&coarse, &fine) / 15.0;
         Ok(Reference {
             state: fine,
             source: format!(
