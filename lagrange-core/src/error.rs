@@ -52,6 +52,15 @@ pub enum Error {
         /// Index of the first violated constraint row.
         row: usize,
     },
+    /// An adaptive integrator took its maximum number of steps without reaching the end time.
+    TooManySteps {
+        /// How many steps were taken.
+        steps: u64,
+    },
+    /// The Newton matrix of an implicit step is singular: a pivot of its LU factorisation
+    /// was zero (the step is too large for the mechanism's Jacobian, or the Jacobian is
+    /// degenerate).
+    SingularJacobian,
 }
 
 impl fmt::Display for Error {
@@ -76,6 +85,12 @@ impl fmt::Display for Error {
             ),
             Self::ConstraintViolated { row } => {
                 write!(f, "state violates constraint {row} beyond the tolerance")
+            }
+            Self::TooManySteps { steps } => {
+                write!(f, "end time not reached within the limit of {steps} steps")
+            }
+            Self::SingularJacobian => {
+                f.write_str("the Newton matrix of an implicit step is singular")
             }
         }
     }

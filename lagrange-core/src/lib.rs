@@ -12,6 +12,8 @@
 //! - [`GeneralizedForce`], [`ViscousDamping`], [`Input`], [`Forced`]: forces added by wrapping.
 //! - [`constraints`]: holonomic and Pfaffian constraints with Lagrange multipliers
 //!   ([`Constrained`]), Baumgarte [`Stabilization`] and [`Projection`] against drift.
+//! - [`Jacobian`]: `d/dq` and `d/dq'` of the equations of motion, exact from dual numbers for
+//!   [`EulerLagrange`], by [`central_difference_jacobian`] otherwise (for implicit integrators).
 //! - [`Error`]: one small `Copy` error type for every crate.
 //!
 //! ```
@@ -46,6 +48,7 @@ pub mod constraints;
 mod dual;
 mod error;
 mod forces;
+mod jacobian;
 mod lagrangian;
 mod mechanism;
 mod scalar;
@@ -60,6 +63,7 @@ pub use constraints::{
 pub use dual::Dual;
 pub use error::Error;
 pub use forces::{Forced, GeneralizedForce, Input, ViscousDamping};
+pub use jacobian::{acceleration_jacobian_by_differences, central_difference_jacobian, Jacobian};
 pub use lagrangian::{EulerLagrange, Lagrangian};
 pub use mechanism::Mechanism;
 pub use nalgebra;

@@ -5,7 +5,10 @@ use lagrange_core::constraints::{
     Stabilization,
 };
 use lagrange_core::nalgebra::{Matrix1x2, Matrix2, SMatrix, SVector, Vector1, Vector2};
-use lagrange_core::{validate, Error, Lagrangian, Mechanism, Real, Scalar, State};
+use lagrange_core::{
+    acceleration_jacobian_by_differences, validate, Error, Jacobian, Lagrangian, Mechanism, Real,
+    Scalar, State,
+};
 
 /// A point mass `m` at `(x, y)` from a fixed pivot, in gravity `g`, held at distance `l` by a
 /// massless rod: the same pendulum as [`SimplePendulum`](crate::SimplePendulum), written in two
@@ -140,6 +143,12 @@ impl<T: Real> Mechanism<T, 2> for CartesianPendulum<T> {
     }
     fn acceleration_with(&self, s: &State<T, 2>, extra: &Vector2<T>) -> Result<Vector2<T>, Error> {
         Ok(self.solve_with(s, extra)?.acceleration)
+    }
+    fn acceleration_jacobian(
+        &self,
+        s: &State<T, 2>,
+    ) -> Result<(Vector2<T>, Jacobian<T, 2>), Error> {
+        acceleration_jacobian_by_differences(self, s)
     }
 }
 

@@ -5,7 +5,10 @@ use lagrange_core::constraints::{
     solve_kkt, ConstrainedAcceleration, Constraints, HolonomicConstraints, Schur, Stabilization,
 };
 use lagrange_core::nalgebra::{Matrix2x3, SMatrix, SVector, Vector2, Vector3};
-use lagrange_core::{validate, Error, Lagrangian, Mechanism, Real, Scalar, State};
+use lagrange_core::{
+    acceleration_jacobian_by_differences, validate, Error, Jacobian, Lagrangian, Mechanism, Real,
+    Scalar, State,
+};
 
 /// Which of the two ways to close the loop at a given crank angle: the coupler-rocker joint
 /// `C` on the left or on the right of the directed line from the crank tip `B` to the rocker
@@ -327,6 +330,12 @@ impl<T: Real> Mechanism<T, 3> for FourBarLinkage<T> {
     }
     fn acceleration_with(&self, s: &State<T, 3>, extra: &Vector3<T>) -> Result<Vector3<T>, Error> {
         Ok(self.solve_with(s, extra)?.acceleration)
+    }
+    fn acceleration_jacobian(
+        &self,
+        s: &State<T, 3>,
+    ) -> Result<(Vector3<T>, Jacobian<T, 3>), Error> {
+        acceleration_jacobian_by_differences(self, s)
     }
 }
 

@@ -6,7 +6,10 @@ use lagrange_core::constraints::{
     Stabilization,
 };
 use lagrange_core::nalgebra::{Matrix2x4, SMatrix, SVector, Vector2, Vector4};
-use lagrange_core::{validate, Error, Lagrangian, Mechanism, Real, Scalar, State};
+use lagrange_core::{
+    acceleration_jacobian_by_differences, validate, Error, Jacobian, Lagrangian, Mechanism, Real,
+    Scalar, State,
+};
 
 /// A uniform thin disk of mass `m` and radius `R` held upright (no tilt) and rolling without
 /// slipping on a horizontal plane: free to turn about the vertical and to roll, but its
@@ -153,6 +156,12 @@ impl<T: Real> Mechanism<T, 4> for RollingDisk<T> {
     }
     fn acceleration_with(&self, s: &State<T, 4>, extra: &Vector4<T>) -> Result<Vector4<T>, Error> {
         Ok(self.solve_with(s, extra)?.acceleration)
+    }
+    fn acceleration_jacobian(
+        &self,
+        s: &State<T, 4>,
+    ) -> Result<(Vector4<T>, Jacobian<T, 4>), Error> {
+        acceleration_jacobian_by_differences(self, s)
     }
 }
 

@@ -8,7 +8,6 @@ use lagrange_integrators::{ExplicitEuler, Integrator, Rk4, SemiImplicitEuler, Ve
 use lagrange_systems::exact::pendulum_from_rest;
 use lagrange_systems::{DoublePendulum, SimplePendulum};
 use std::hint::black_box;
-use std::time::Instant;
 
 /// The origin's pendulum: L = 1 m, g = 9.81 m/s^2, released at rest from 30 degrees.
 const G: f64 = 9.81;
@@ -44,16 +43,9 @@ where
     I: Integrator<T, N>,
     M: Mechanism<T, N>,
 {
-    let mut times: Vec<f64> = (0..TIMING_RUNS)
-        .map(|_| {
-            let clock = Instant::now();
-            let _ =
-                black_box(integrator.integrate(black_box(mechanism), black_box(start), dt, steps));
-            clock.elapsed().as_secs_f64() * 1e9 / steps as f64
-        })
-        .collect();
-    times.sort_by(f64::total_cmp);
-    times[TIMING_RUNS / 2]
+    crate::demo_integrators::median_ns(steps, || {
+        integrator.integrate(black_box(mechanism), black_box(start), dt, steps)
+    })
 }
 
 /// RK4's cost per step on the pendulum and the double pendulum in `T`.
@@ -307,5 +299,6 @@ pub fn run() -> Result<(), String> {
     std::fs::write(&path, doc).map_err(|e| e.to_string())?;
     println!("\nPlot: {}", path.display());
     crate::demo_systems::run()?;
+    crate::demo_integrators::run()?;
     crate::demo_constraints::run()
 }

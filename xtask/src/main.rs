@@ -16,6 +16,7 @@ mod cmd;
 mod cross;
 mod demo;
 mod demo_constraints;
+mod demo_integrators;
 mod demo_systems;
 mod svg;
 

@@ -2,7 +2,9 @@
 //! mechanism wrapper, and [`Stabilization`] (Baumgarte) against drift.
 
 use super::{Constraints, Schur};
-use crate::{validate, Error, Mechanism, Real, State};
+use crate::{
+    acceleration_jacobian_by_differences, validate, Error, Jacobian, Mechanism, Real, State,
+};
 use nalgebra::{SMatrix, SVector};
 
 /// Drift control folded into the acceleration-level constraint equation.
@@ -364,6 +366,12 @@ where
         extra: &SVector<T, N>,
     ) -> Result<SVector<T, N>, Error> {
         Ok(self.solve_with(state, extra)?.acceleration)
+    }
+    fn acceleration_jacobian(
+        &self,
+        state: &State<T, N>,
+    ) -> Result<(SVector<T, N>, Jacobian<T, N>), Error> {
+        acceleration_jacobian_by_differences(self, state)
     }
 }
 
