@@ -156,7 +156,11 @@ fn implicit_method_on_a_constrained_mechanism() -> Result<(), Error> {
     let simple = SimplePendulum::new(1.0, 1.0, G, 0.0)?;
     let cartesian = CartesianPendulum::new(1.0, 1.0, G)?;
     let mut angle_form = GaussLegendre2::<f64>::default();
-    let mut stepper = Projected::new(GaussLegendre2::<f64>::default(), cartesian, projection::<f64>()?);
+    let mut stepper = Projected::new(
+        GaussLegendre2::<f64>::default(),
+        cartesian,
+        projection::<f64>()?,
+    );
     let mut s = State::at_rest([TH0]);
     let mut c = cartesian.state_from_angle(0.0, TH0, 0.0);
     let (mut worst, mut iterations, mut angle_iterations): (f64, u32, u32) = (0.0, 0, 0);

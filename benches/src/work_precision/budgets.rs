@@ -1,13 +1,12 @@
 //! The first budget of issue 5: the library's RK4 against the hand-written loop on the same
 //! problem, step and precision, timed in interleaved pairs.
 
-use super::method::{HandRk4, Library, Method, Param};
+use super::method::{HandRk4, Library, Method, Param, Rk4Family};
 use super::problem::{state_error, Problem, ProblemVisitor};
 use super::real::{narrow, widen, BenchReal};
 use super::timing::interleaved;
 use super::Options;
 use lagrange_core::State;
-use lagrange_integrators::Rk4;
 use std::hint::black_box;
 
 /// The budget: the library's RK4 step within this factor of the hand-written loop's.
@@ -98,7 +97,7 @@ impl Compare<'_> {
         let t_end = T::real(p.t_end());
         let mech = p.mechanism::<T>().ok()?;
         let library = || {
-            Library(Rk4)
+            Library(Rk4Family)
                 .solve(p, &mech, black_box(&start), t_end, param, None)
                 .map(|r| r.map(|o| o.end))
         };

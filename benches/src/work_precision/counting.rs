@@ -2,13 +2,17 @@
 //! untimed run of each point so that the timed runs pay nothing for it.
 
 use lagrange_core::nalgebra::{SMatrix, SVector};
-use lagrange_core::{Error, Mechanism, Real, State};
+use lagrange_core::{Error, Jacobian, Mechanism, Real, State};
 use std::cell::Cell;
 
-/// `inner`, counting calls to [`Mechanism::acceleration`].
+/// `inner`, counting acceleration evaluations (calls to [`Mechanism::acceleration`] and
+/// [`Mechanism::acceleration_with`], and the one inside each
+/// [`Mechanism::acceleration_jacobian`]) and Jacobian evaluations. Every method is forwarded,
+/// so that the inner mechanism's own fast paths and exact Jacobians are kept.
 pub struct Counting<'a, M> {
     inner: &'a M,
     calls: Cell<u64>,
+    jacobians: Cell<u64>,
 }
 
 impl<'a, M> Counting<'a, M> {
@@ -17,11 +21,16 @@ impl<'a, M> Counting<'a, M> {
         Self {
             inner,
             calls: Cell::new(0),
+            jacobians: Cell::new(0),
         }
     }
     /// Acceleration evaluations so far.
     pub fn calls(&self) -> u64 {
         self.calls.get()
+    }
+    /// Jacobian evaluations so far (implicit methods).
+    pub fn jacobians(&self) -> u64 {
+        self.jacobians.get()
     }
 }
 
@@ -50,5 +59,25 @@ impl<T: Real, const N: usize, M: Mechanism<T, N>> Mechanism<T, N> for Counting<'
     fn acceleration(&self, s: &State<T, N>) -> Result<SVector<T, N>, Error> {
         self.calls.set(self.calls.get() + 1);
         self.inner.acceleration(s)
+    }
+    fn acceleration_with(
+        &self,
+        s: &State<T, N>,
+        extra: &SVector<T, N>,
+    ) -> Result<SVector<T, N>, Error> {
+        self.calls.set(self.calls.get() + 1);
+        self.inner.acceleration_with(s, extra)
+    }
+    fn equation_jacobian(&self, s: &State<T, N>, qdd: &SVector<T, N>) -> Jacobian<T, N> {
+        self.jacobians.set(self.jacobians.get() + 1);
+        self.inner.equation_jacobian(s, qdd)
+    }
+    fn acceleration_jacobian(
+        &self,
+        s: &State<T, N>,
+    ) -> Result<(SVector<T, N>, Jacobian<T, N>), Error> {
+        self.calls.set(self.calls.get() + 1);
+        self.jacobians.set(self.jacobians.get() + 1);
+        self.inner.acceleration_jacobian(s)
     }
 }

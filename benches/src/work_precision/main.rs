@@ -59,7 +59,7 @@ impl Options {
             only: Vec::new(),
             methods: Vec::new(),
             budget: sweep::DEFAULT_BUDGET,
-            max_solve: 0.25,
+            max_solve: 0.2,
             max_steps: 20_000_000,
         };
         let mut it = args.iter();

@@ -4,8 +4,13 @@
 use super::ode_peer::{OdeSolvers, Peer};
 use super::problem::Problem;
 use super::real::BenchReal;
-use lagrange_core::{Error, Mechanism, Real, State};
-use lagrange_integrators::{ExplicitEuler, Integrator, Rk4, SemiImplicitEuler, VelocityVerlet};
+use lagrange_core::{Error, EulerLagrange, Mechanism, Real, State};
+use lagrange_integrators::{
+    AdaptiveSettings, BackwardEuler, Dop853Pair, Dopri5Pair, EmbeddedPair, EmbeddedRungeKutta,
+    ExplicitEuler, GaussLegendre2, ImplicitMidpoint, Integrator, RadauIIA2, Rk4, SemiImplicitEuler,
+    StormerVerlet, VariationalMidpoint, VelocityVerlet, Yoshida4,
+};
+use std::marker::PhantomData;
 
 /// Whose code a method is.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -90,6 +95,11 @@ pub trait Method {
     fn linear_stability_limit(&self) -> Option<f64> {
         None
     }
+    /// True for a fixed-step method whose step is explicit (for the mechanisms of the
+    /// stability scan), so that it has a stability limit to find.
+    fn explicit(&self) -> bool {
+        false
+    }
     /// Solves `problem` (whose mechanism in `T` is `mechanism`, possibly wrapped) from `start`
     /// to `t_end` at `param`, calling `observe` with every new state when given.
     ///
@@ -119,61 +129,53 @@ pub trait MethodVisitor {
 }
 
 /// The methods table: one line per method. A new fixed-step integrator of the library is one
-/// line here and its type in [`fixed_step!`]'s list below.
+/// line in [`fixed_step!`]'s list below and one line here; an adaptive one, one line here.
 pub fn for_each(v: &mut impl MethodVisitor) {
-    v.visit(&Library(ExplicitEuler));
-    v.visit(&Library(SemiImplicitEuler));
-    v.visit(&Library(VelocityVerlet));
-    v.visit(&Library(Rk4));
+    v.visit(&Library(ExplicitEulerFamily));
+    v.visit(&Library(SemiImplicitEulerFamily));
+    v.visit(&Library(VelocityVerletFamily));
+    v.visit(&Library(StormerVerletFamily));
+    v.visit(&Library(Rk4Family));
+    v.visit(&Library(Yoshida4Family));
+    v.visit(&Library(ImplicitMidpointFamily));
+    v.visit(&Library(GaussLegendre2Family));
+    v.visit(&Library(BackwardEulerFamily));
+    v.visit(&Library(RadauIIA2Family));
+    v.visit(&Variational);
+    v.visit(&Adaptive::<7, 1, Dopri5Pair>(PhantomData));
+    v.visit(&Adaptive::<16, 4, Dop853Pair>(PhantomData));
     v.visit(&HandRk4);
     v.visit(&OdeSolvers(Peer::Dopri5));
     v.visit(&OdeSolvers(Peer::Dop853));
 }
 
 /// A fixed-step integrator of the library, for every scalar and dimension at once (which a
-/// bound `Integrator<T, N>` cannot say for all `T` and `N`).
-pub trait FixedStep: Copy {
-    /// The integrator's name.
-    const NAME: &'static str;
+/// bound `Integrator<T, N>` cannot say for all `T` and `N`): a family of integrator types.
+pub trait FixedStep {
+    /// The integrator in precision `T` for `N` degrees of freedom.
+    type Of<T: Real, const N: usize>: Integrator<T, N>;
     /// The largest stable `h w` on an undamped linear oscillator (the imaginary-axis extent
-    /// of the stability region), when the method is explicit.
+    /// of the stability region), for the explicit methods whose value is classical.
     const LINEAR_STABILITY_LIMIT: Option<f64>;
-    /// Runs `steps` steps of `dt`, observing each new state when asked.
-    ///
-    /// # Errors
-    /// The integrator's.
-    fn run<T: Real, const N: usize, M: Mechanism<T, N>>(
-        self,
-        mechanism: &M,
-        start: &State<T, N>,
-        dt: T,
-        steps: u64,
-        observe: Observer<'_, T, N>,
-    ) -> Result<State<T, N>, Error>;
+    /// Explicit (no Newton iteration where `q''` does not depend on `q'`).
+    const EXPLICIT: bool;
+    /// A new integrator (default settings).
+    fn make<T: Real, const N: usize>() -> Self::Of<T, N>;
 }
 
-/// Implements [`FixedStep`] for integrators that implement `Integrator<T, N>` for every `T`
-/// and `N`, each with its linear stability limit (`None` for implicit methods).
+/// Declares a [`FixedStep`] family per line: its marker type, the integrator type (in terms of
+/// `T` and `N`), how to make one, whether it is explicit, and its linear stability limit.
 macro_rules! fixed_step {
-    ($($ty:ident: $limit:expr),* $(,)?) => {
+    ($($family:ident: $ty:ty = $make:expr, $explicit:expr, $limit:expr;)*) => {
         $(
-            impl FixedStep for $ty {
-                const NAME: &'static str = <$ty as Integrator<f64, 1>>::NAME;
+            #[doc = concat!("The family of `", stringify!($ty), "`.")]
+            pub struct $family;
+            impl FixedStep for $family {
+                type Of<T: Real, const N: usize> = $ty;
                 const LINEAR_STABILITY_LIMIT: Option<f64> = $limit;
-                fn run<T: Real, const N: usize, M: Mechanism<T, N>>(
-                    mut self,
-                    mechanism: &M,
-                    start: &State<T, N>,
-                    dt: T,
-                    steps: u64,
-                    observe: Observer<'_, T, N>,
-                ) -> Result<State<T, N>, Error> {
-                    match observe {
-                        Some(o) => Integrator::<T, N>::integrate_with(
-                            &mut self, mechanism, start, dt, steps, o,
-                        ),
-                        None => Integrator::<T, N>::integrate(&mut self, mechanism, start, dt, steps),
-                    }
+                const EXPLICIT: bool = $explicit;
+                fn make<T: Real, const N: usize>() -> Self::Of<T, N> {
+                    $make
                 }
             }
         )*
@@ -181,20 +183,32 @@ macro_rules! fixed_step {
 }
 
 // Stability on y' = i w y: explicit Euler |1 + i h w| > 1 for every h; semi-implicit Euler and
-// Stormer-Verlet are stable for h w < 2; RK4 for h w < 2 sqrt 2.
-fixed_step!(
-    ExplicitEuler: Some(0.0),
-    SemiImplicitEuler: Some(2.0),
-    VelocityVerlet: Some(2.0),
-    Rk4: Some(2.0 * std::f64::consts::SQRT_2),
-);
+// Stormer-Verlet are stable for h w < 2; RK4 for h w < 2 sqrt 2. Yoshida's and the implicit
+// methods' limits are left to the bench to measure.
+fixed_step! {
+    ExplicitEulerFamily: ExplicitEuler = ExplicitEuler, true, Some(0.0);
+    SemiImplicitEulerFamily: SemiImplicitEuler = SemiImplicitEuler, true, Some(2.0);
+    VelocityVerletFamily: VelocityVerlet = VelocityVerlet, true, Some(2.0);
+    StormerVerletFamily: StormerVerlet<T, N> = StormerVerlet::default(), true, Some(2.0);
+    Rk4Family: Rk4 = Rk4, true, Some(2.0 * std::f64::consts::SQRT_2);
+    Yoshida4Family: Yoshida4<StormerVerlet<T, N>> = Yoshida4::new(StormerVerlet::default()), true, None;
+    ImplicitMidpointFamily: ImplicitMidpoint<T> = ImplicitMidpoint::default(), false, None;
+    GaussLegendre2Family: GaussLegendre2<T> = GaussLegendre2::default(), false, None;
+    BackwardEulerFamily: BackwardEuler<T> = BackwardEuler::default(), false, None;
+    RadauIIA2Family: RadauIIA2<T> = RadauIIA2::default(), false, None;
+}
+
+/// The name of a family's integrator.
+fn family_name<F: FixedStep>() -> &'static str {
+    <F::Of<f64, 1> as Integrator<f64, 1>>::NAME
+}
 
 /// A fixed-step integrator of the library.
-pub struct Library<I>(pub I);
+pub struct Library<F>(pub F);
 
-impl<I: FixedStep> Method for Library<I> {
+impl<F: FixedStep> Method for Library<F> {
     fn name(&self) -> &'static str {
-        I::NAME
+        family_name::<F>()
     }
     fn origin(&self) -> Origin {
         Origin::Library
@@ -203,7 +217,10 @@ impl<I: FixedStep> Method for Library<I> {
         Kind::FixedStep
     }
     fn linear_stability_limit(&self) -> Option<f64> {
-        I::LINEAR_STABILITY_LIMIT
+        F::LINEAR_STABILITY_LIMIT
+    }
+    fn explicit(&self) -> bool {
+        F::EXPLICIT
     }
     fn solve<T, P, M, const N: usize, const N2: usize>(
         &self,
@@ -222,16 +239,135 @@ impl<I: FixedStep> Method for Library<I> {
         let Param::Step { dt, steps } = param else {
             return None;
         };
+        let mut integrator = F::make::<T, N>();
+        let dt = T::real(dt);
+        let end = match observe {
+            Some(o) => integrator.integrate_with(mechanism, start, dt, steps, o),
+            None => integrator.integrate(mechanism, start, dt, steps),
+        };
         Some(
-            self.0
-                .run(mechanism, start, T::real(dt), steps, observe)
-                .map(|end| Outcome {
-                    end,
-                    steps,
-                    evals: None,
-                })
-                .map_err(|e| e.to_string()),
+            end.map(|end| Outcome {
+                end,
+                steps,
+                evals: None,
+            })
+            .map_err(|e| e.to_string()),
         )
+    }
+}
+
+/// The variational midpoint integrator, on the problem's mechanism as a Lagrangian system
+/// (`EulerLagrange` over it: the discrete Euler-Lagrange equations need `L`, not `q''`).
+/// It evaluates the Lagrangian in dual numbers, never `acceleration`: its evaluation count is
+/// reported as 0.
+pub struct Variational;
+
+impl Method for Variational {
+    fn name(&self) -> &'static str {
+        "variational midpoint"
+    }
+    fn origin(&self) -> Origin {
+        Origin::Library
+    }
+    fn kind(&self) -> Kind {
+        Kind::FixedStep
+    }
+    fn solve<T, P, M, const N: usize, const N2: usize>(
+        &self,
+        problem: &P,
+        _mechanism: &M,
+        start: &State<T, N>,
+        _t_end: T,
+        param: Param,
+        observe: Observer<'_, T, N>,
+    ) -> Option<Result<Outcome<T, N>, String>>
+    where
+        T: BenchReal,
+        P: Problem<N, N2>,
+        M: Mechanism<T, N>,
+    {
+        let Param::Step { dt, steps } = param else {
+            return None;
+        };
+        let system = match problem.mechanism::<T>() {
+            Ok(m) => EulerLagrange::new(m),
+            Err(e) => return Some(Err(e.to_string())),
+        };
+        let mut integrator = VariationalMidpoint::<T, N>::default();
+        let dt = T::real(dt);
+        let end = match observe {
+            Some(o) => integrator.integrate_with(&system, start, dt, steps, |s, _| o(s)),
+            None => integrator.integrate(&system, start, dt, steps),
+        };
+        Some(
+            end.map(|end| Outcome {
+                end,
+                steps,
+                evals: None,
+            })
+            .map_err(|e| e.to_string()),
+        )
+    }
+}
+
+/// An adaptive embedded Runge-Kutta pair of the library (`S` stages, `R` dense-output rows).
+pub struct Adaptive<const S: usize, const R: usize, P>(pub PhantomData<P>);
+
+/// Most steps one adaptive solve may take.
+const MAX_ADAPTIVE_STEPS: u64 = 10_000_000;
+
+impl<const S: usize, const R: usize, Pair: EmbeddedPair<S, R>> Method for Adaptive<S, R, Pair> {
+    fn name(&self) -> &'static str {
+        Pair::NAME
+    }
+    fn origin(&self) -> Origin {
+        Origin::Library
+    }
+    fn kind(&self) -> Kind {
+        Kind::Adaptive
+    }
+    fn solve<T, P, M, const N: usize, const N2: usize>(
+        &self,
+        _problem: &P,
+        mechanism: &M,
+        start: &State<T, N>,
+        t_end: T,
+        param: Param,
+        observe: Observer<'_, T, N>,
+    ) -> Option<Result<Outcome<T, N>, String>>
+    where
+        T: BenchReal,
+        P: Problem<N, N2>,
+        M: Mechanism<T, N>,
+    {
+        let Param::Tolerance(tol) = param else {
+            return None;
+        };
+        let solve = || -> Result<Outcome<T, N>, Error> {
+            let tol = T::real(tol);
+            let settings = AdaptiveSettings::new(tol, tol)?.with_max_steps(MAX_ADAPTIVE_STEPS)?;
+            let mut rk = EmbeddedRungeKutta::<T, N, S, R, Pair>::new(settings, mechanism, start)?;
+            let end = match observe {
+                None => rk.integrate_to(mechanism, t_end)?,
+                Some(o) => {
+                    // Accepted steps one by one while they end before t_end, then the last
+                    // one (or few), shortened to land on it.
+                    while rk.state().t + rk.step_size() < t_end {
+                        o(&rk.step(mechanism)?);
+                    }
+                    let end = rk.integrate_to(mechanism, t_end)?;
+                    o(&end);
+                    end
+                }
+            };
+            let stats = rk.statistics();
+            Ok(Outcome {
+                end,
+                steps: stats.accepted + stats.rejected,
+                evals: None,
+            })
+        };
+        Some(solve().map_err(|e| e.to_string()))
     }
 }
 

@@ -61,13 +61,13 @@ pub fn write(
 /// Every point as CSV.
 fn csv(rows: &[Row]) -> String {
     let mut s = String::from(
-        "problem,precision,method,origin,kind,param,t_end,steps,evals,final_error,\
+        "problem,precision,method,origin,kind,param,t_end,steps,evals,jacobians,final_error,\
          energy_error,seconds,seconds_per_simulated_second,ns_per_step,runs,failure\n",
     );
     for r in rows {
         let _ = writeln!(
             s,
-            "{},{},{},{},{:?},{:e},{},{},{},{:e},{:e},{:e},{:e},{:.2},{},{}",
+            "{},{},{},{},{:?},{:e},{},{},{},{},{:e},{:e},{:e},{:e},{:.2},{},{}",
             r.problem,
             r.precision,
             r.method,
@@ -77,6 +77,7 @@ fn csv(rows: &[Row]) -> String {
             r.t_end,
             r.steps,
             r.evals,
+            r.jacobians,
             r.final_error,
             r.energy_error,
             r.seconds,
@@ -445,18 +446,19 @@ fn markdown(
     for id in problem_ids(rows) {
         let _ = writeln!(
             s,
-            "\n### {id}\n\n| method | precision | dt or tol | steps | evals | final error | energy error | time / sim s | ns/step | runs | failure |\n\
-             |---|---|---:|---:|---:|---:|---:|---:|---:|---:|---|"
+            "\n### {id}\n\n| method | precision | dt or tol | steps | evals | Jacobians | final error | energy error | time / sim s | ns/step | runs | failure |\n\
+             |---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|"
         );
         for r in rows.iter().filter(|r| r.problem == id) {
             let _ = writeln!(
                 s,
-                "| {} | {} | {:.3e} | {} | {} | {:.2e} | {:.2e} | {} | {:.1} | {} | {} |",
+                "| {} | {} | {:.3e} | {} | {} | {} | {:.2e} | {:.2e} | {} | {:.1} | {} | {} |",
                 r.method,
                 r.precision,
                 r.param,
                 r.steps,
                 r.evals,
+                r.jacobians,
                 r.final_error,
                 r.energy_error,
                 time(r.per_simulated_second()),

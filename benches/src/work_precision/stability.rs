@@ -84,6 +84,7 @@ impl<P: Problem<N, N2>, const N: usize, const N2: usize> MethodVisitor
     fn visit<X: Method>(&mut self, m: &X) {
         if m.kind() != Kind::FixedStep
             || m.origin() != Origin::Library
+            || !m.explicit()
             || !self.opts.method_selected(m.name())
         {
             return;

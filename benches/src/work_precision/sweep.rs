@@ -31,6 +31,8 @@ pub struct Row {
     pub steps: u64,
     /// Acceleration evaluations.
     pub evals: u64,
+    /// Jacobian evaluations (implicit methods).
+    pub jacobians: u64,
     /// `max_i |y_i(T) - y_ref,i(T)|`.
     pub final_error: f64,
     /// `max_t |E(t) - E(0)| / |E(0)|` over every step.
@@ -294,6 +296,7 @@ impl<P: Problem<N, N2>, const N: usize, const N2: usize> SweepMethods<'_, P, N, 
                 t_end: p.t_end(),
                 steps: 0,
                 evals: counter.calls(),
+                jacobians: counter.jacobians(),
                 final_error: f64::NAN,
                 energy_error: max_de,
                 seconds: f64::NAN,
@@ -348,7 +351,7 @@ pub const QUICK_BUDGET: Budget = Budget {
 
 /// The default budget per point.
 pub const DEFAULT_BUDGET: Budget = Budget {
-    seconds: 0.15,
+    seconds: 0.1,
     min_runs: 3,
     max_runs: 11,
 };
