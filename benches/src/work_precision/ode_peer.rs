@@ -190,10 +190,11 @@ where
             finish(s.integrate(), s.x_out(), s.y_out())
         }
     };
-    if let Some(e) = failure.get() {
-        return Err(e.to_string());
-    }
-    let (stats, t, y) = solved?;
+    // A failed evaluation only rejected a trial step, unless the solve failed too.
+    let (stats, t, y) = solved.map_err(|e| match failure.get() {
+        Some(first) => format!("{e} (first failed evaluation: {first})"),
+        None => e,
+    })?;
     let end = state(t, &y);
     if end.is_finite() {
         Ok(Outcome {

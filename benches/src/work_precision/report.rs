@@ -64,13 +64,21 @@ fn csv(rows: &[Row]) -> String {
         "problem,precision,method,origin,kind,param,t_end,steps,evals,jacobians,final_error,\
          energy_error,seconds,seconds_per_simulated_second,ns_per_step,runs,failure\n",
     );
+    // RFC 4180: a field holding a comma or a quote is quoted, its quotes doubled.
+    let field = |text: &str| {
+        if text.contains([',', '"']) {
+            format!("\"{}\"", text.replace('"', "\"\""))
+        } else {
+            text.to_string()
+        }
+    };
     for r in rows {
         let _ = writeln!(
             s,
             "{},{},{},{},{:?},{:e},{},{},{},{},{:e},{:e},{:e},{:e},{:.2},{},{}",
             r.problem,
             r.precision,
-            r.method,
+            field(r.method),
             r.origin.label(),
             r.kind,
             r.param,
@@ -84,7 +92,7 @@ fn csv(rows: &[Row]) -> String {
             r.per_simulated_second(),
             r.ns_per_step(),
             r.runs,
-            r.failure.as_deref().unwrap_or("").replace(',', ";")
+            field(r.failure.as_deref().unwrap_or(""))
         );
     }
     s

@@ -309,8 +309,10 @@ impl<P: Problem<N, N2>, const N: usize, const N2: usize> SweepMethods<'_, P, N, 
                     self.rows.push(row);
                     failures += 1;
                     // A coarse fixed step past the stability limit fails and a finer one may
-                    // not; an adaptive method that fails at one tolerance will at tighter ones.
-                    if m.kind() == Kind::Adaptive || failures >= 12 {
+                    // not; a loose tolerance may let a trial step leave the coordinates' domain
+                    // where a tighter one does not. Three adaptive failures in a row end it.
+                    let limit = if m.kind() == Kind::Adaptive { 3 } else { 12 };
+                    if failures >= limit {
                         return;
                     }
                 }

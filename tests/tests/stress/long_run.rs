@@ -1,9 +1,10 @@
 //! Long runs: 10^7 steps of the origin's pendulum (1 m, g = 9.81, 30 degrees at rest) with a
-//! symplectic method, f32 and f64: the relative energy error stays within a stated bound and
-//! does not drift. A 10^5-step version runs in the quick debug pass.
+//! symplectic method (velocity Verlet at 1 ms, Yoshida 4 at 10 ms), f32 and f64: the relative
+//! energy error stays within a stated bound and does not drift. A 10^5-step version runs in
+//! the quick debug pass.
 
 use lagrange_core::{Error, Mechanism, Real, State};
-use lagrange_integrators::{Integrator, VelocityVerlet};
+use lagrange_integrators::{Integrator, StormerVerlet, VelocityVerlet, Yoshida4};
 use lagrange_systems::SimplePendulum;
 use lagrange_tests::pick;
 
@@ -27,6 +28,7 @@ struct Windows {
 /// `V = 0` at the hanging rest state.
 fn energy_windows<T: Real, I: Integrator<T, 1>>(
     mut integrator: I,
+    dt: f64,
     steps: u64,
 ) -> Result<Windows, Error> {
     let p = SimplePendulum::new(T::one(), T::one(), T::from_f64(G), T::zero())?;
@@ -42,7 +44,7 @@ fn energy_windows<T: Real, I: Integrator<T, 1>>(
     let mut s = start;
     for _ in 0..WINDOWS {
         let (mut max, mut sum) = (0.0f64, 0.0);
-        s = integrator.integrate_with(&p, &s, T::from_f64(DT), steps / WINDOWS, |x| {
+        s = integrator.integrate_with(&p, &s, T::from_f64(dt), steps / WINDOWS, |x| {
             let e = (p64.energy(&widen(x)) - rest - e0) / e0;
             max = max.max(e.abs());
             sum += e;
@@ -69,7 +71,7 @@ fn energy_windows<T: Real, I: Integrator<T, 1>>(
 /// the swing over the run fails. In f32 the window means wander with the rounding walk
 /// (measured within 1.1e-4 of each other): bound 5e-4.
 fn verlet_energy_bounded_without_drift<T: Real>(steps: u64) -> Result<(), Error> {
-    let w = energy_windows::<T, _>(VelocityVerlet, steps)?;
+    let w = energy_windows::<T, _>(VelocityVerlet, DT, steps)?;
     let bound = pick::<T>(5e-4, (DT * DT * G) / 4.0);
     let drift_bound = pick::<T>(5e-4, 1e-7);
     let worst = w.max.iter().copied().fold(0.0, f64::max);
@@ -114,4 +116,54 @@ fn verlet_1e7_steps_f32() -> Result<(), Error> {
 #[ignore = "long run: cargo xtask ci runs it in release"]
 fn verlet_1e7_steps_f64() -> Result<(), Error> {
     verlet_energy_bounded_without_drift::<f64>(10_000_000)
+}
+
+/// Yoshida's fourth-order composition of Stormer-Verlet (symplectic here) at a 10 ms game
+/// step, `h w = 0.031`. Its energy error is fourth order: measured 7.603e-8 in f64, the same
+/// in every window of 10^5 and of 10^7 steps (window maxima within 4e-13 of each other, window
+/// means within 1e-12): bound 1e-7, and the maxima of the first and last windows within 1e-10
+/// of each other. In f32 rounding dominates: measured max 1.88e-5, window means within
+/// 1.4e-5 of each other: bound 1e-4 on both.
+fn yoshida_energy_bounded_without_drift<T: Real>(steps: u64) -> Result<(), Error> {
+    let w = energy_windows::<T, _>(Yoshida4::new(StormerVerlet::<T, 1>::default()), 1e-2, steps)?;
+    let worst = w.max.iter().copied().fold(0.0, f64::max);
+    let bound = pick::<T>(1e-4, 1e-7);
+    assert!(
+        worst <= bound,
+        "max relative energy error {worst:e}: {:?}",
+        w.max
+    );
+    let (first, last) = (w.mean[0], w.mean[w.mean.len() - 1]);
+    assert!(
+        (last - first).abs() <= pick::<T>(1e-4, 1e-10),
+        "energy drifts: window means {:?}",
+        w.mean
+    );
+    if T::EPSILON.to_f64() < 1e-10 {
+        let (a, b) = (w.max[0], w.max[w.max.len() - 1]);
+        assert!((a - b).abs() <= 1e-10, "window maxima {:?}", w.max);
+    }
+    Ok(())
+}
+
+#[test]
+fn yoshida_1e5_steps_f32() -> Result<(), Error> {
+    yoshida_energy_bounded_without_drift::<f32>(100_000)
+}
+
+#[test]
+fn yoshida_1e5_steps_f64() -> Result<(), Error> {
+    yoshida_energy_bounded_without_drift::<f64>(100_000)
+}
+
+#[test]
+#[ignore = "long run: cargo xtask ci runs it in release"]
+fn yoshida_1e7_steps_f32() -> Result<(), Error> {
+    yoshida_energy_bounded_without_drift::<f32>(10_000_000)
+}
+
+#[test]
+#[ignore = "long run: cargo xtask ci runs it in release"]
+fn yoshida_1e7_steps_f64() -> Result<(), Error> {
+    yoshida_energy_bounded_without_drift::<f64>(10_000_000)
 }
