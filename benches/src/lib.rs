@@ -3,7 +3,10 @@
 //! every term of its equations is non-zero.
 
 use lagrange_core::{Error, EulerLagrange, Real, State};
-use lagrange_systems::{BeadOnRotatingHoop, DoublePendulum, FallingParticle, SimplePendulum};
+use lagrange_systems::{
+    Acrobot, BeadOnRotatingHoop, CartPole, DoublePendulum, ElasticPendulum, FallingParticle,
+    Kepler, NLinkPendulum, SimplePendulum, SphericalPendulum, SpringMassDamper, SwingingAtwood,
+};
 
 /// A system and a state to evaluate it at.
 pub struct Fixture<M, T: Real, const N: usize> {
@@ -93,5 +96,106 @@ pub fn double_pendulum_automatic<T: Real>(
         name: "double pendulum (automatic)",
         mechanism: EulerLagrange::new(f.mechanism),
         state: f.state,
+    })
+}
+
+/// A state of `N` coordinates and rates from two arrays.
+fn state<T: Real, const N: usize>(q: [f64; N], qd: [f64; N]) -> State<T, N> {
+    State::new(T::zero(), q.map(T::from_f64), qd.map(T::from_f64))
+}
+
+/// The chain of P3 with `N` unit links, moving.
+///
+/// # Errors
+/// Never, for these parameters.
+pub fn chain<T: Real, const N: usize>() -> Result<Fixture<NLinkPendulum<T, N>, T, N>, Error> {
+    Ok(Fixture {
+        name: if N == 5 { "chain N=5" } else { "chain N=20" },
+        mechanism: NLinkPendulum::new([T::one(); N], [T::one(); N], T::from_f64(G))?,
+        state: state([core::f64::consts::FRAC_PI_4; N], [0.3; N]),
+    })
+}
+
+/// A unit mass on a spring of stiffness 100, lightly damped.
+///
+/// # Errors
+/// Never, for these parameters.
+pub fn spring<T: Real>() -> Result<Fixture<SpringMassDamper<T>, T, 1>, Error> {
+    Ok(Fixture {
+        name: "spring-mass-damper",
+        mechanism: SpringMassDamper::new(T::one(), T::from_f64(100.0), T::from_f64(0.1))?,
+        state: state([0.1], [0.5]),
+    })
+}
+
+/// The elastic pendulum of P5.
+///
+/// # Errors
+/// Never, for these parameters.
+pub fn elastic<T: Real>() -> Result<Fixture<ElasticPendulum<T>, T, 2>, Error> {
+    Ok(Fixture {
+        name: "elastic pendulum",
+        mechanism: ElasticPendulum::new(T::one(), T::from_f64(1e6), T::one(), T::from_f64(G))?,
+        state: state([1.001, 0.3], [0.01, 0.2]),
+    })
+}
+
+/// A spherical pendulum away from its axis.
+///
+/// # Errors
+/// Never, for these parameters.
+pub fn spherical<T: Real>() -> Result<Fixture<SphericalPendulum<T>, T, 2>, Error> {
+    Ok(Fixture {
+        name: "spherical pendulum",
+        mechanism: SphericalPendulum::new(T::one(), T::one(), T::from_f64(G))?,
+        state: state([1.0, 0.2], [0.3, 1.5]),
+    })
+}
+
+/// The classic cart-pole, pole tilted.
+///
+/// # Errors
+/// Never, for these parameters.
+pub fn cart_pole<T: Real>() -> Result<Fixture<CartPole<T>, T, 2>, Error> {
+    Ok(Fixture {
+        name: "cart-pole",
+        mechanism: CartPole::new(T::one(), T::from_f64(0.1), T::from_f64(0.5), T::from_f64(G))?,
+        state: state([0.1, 0.2], [0.3, -0.4]),
+    })
+}
+
+/// Spong's acrobot.
+///
+/// # Errors
+/// Never.
+pub fn acrobot<T: Real>() -> Result<Fixture<Acrobot<T>, T, 2>, Error> {
+    Ok(Fixture {
+        name: "acrobot",
+        mechanism: Acrobot::spong(),
+        state: state([0.5, 0.7], [0.3, -0.4]),
+    })
+}
+
+/// A swinging Atwood machine with mass ratio 3.
+///
+/// # Errors
+/// Never, for these parameters.
+pub fn atwood<T: Real>() -> Result<Fixture<SwingingAtwood<T>, T, 2>, Error> {
+    Ok(Fixture {
+        name: "swinging Atwood",
+        mechanism: SwingingAtwood::new(T::from_f64(3.0), T::one(), T::from_f64(G))?,
+        state: state([1.0, 0.5], [0.1, 0.3]),
+    })
+}
+
+/// The Kepler orbit of P4 at periapsis.
+///
+/// # Errors
+/// Never, for these parameters.
+pub fn kepler<T: Real>() -> Result<Fixture<Kepler<T>, T, 2>, Error> {
+    Ok(Fixture {
+        name: "Kepler",
+        mechanism: Kepler::new(T::one())?,
+        state: state([0.5, 0.0], [0.0, 12f64.sqrt()]),
     })
 }
