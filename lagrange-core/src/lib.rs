@@ -42,10 +42,12 @@
 mod cholesky;
 mod dual;
 mod error;
+pub mod fast_trig;
 mod forces;
 mod lagrangian;
 mod mechanism;
 mod scalar;
+mod scalar_trig;
 mod state;
 pub mod validate;
 

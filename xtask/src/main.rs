@@ -5,12 +5,15 @@
 //! - `test`: host tests of every crate, f32 and f64, the long runs (`#[ignore]`d) in release.
 //! - `cross`: thumbv7em-none-eabihf builds of the library crates, with and without `defmt`,
 //!   and a linked no_std binary with no allocator, with its size.
+//! - `trig-fit`: derives the polynomials and constants of `lagrange_core::fast_trig` and
+//!   checks the library's against them.
 //! - `ci`: format check, clippy with `-D warnings`, test, cross.
 
 mod cmd;
 mod cross;
 mod demo;
 mod svg;
+mod trig_fit;
 
 use std::process::ExitCode;
 
@@ -21,8 +24,9 @@ fn main() -> ExitCode {
         "test" => cmd::run_all(&TEST).and(cmd::run_all(&LONG_TEST)),
         "cross" => cross::run(),
         "ci" => ci(),
+        "trig-fit" => trig_fit::run(),
         _ => {
-            eprintln!("usage: cargo xtask <demo | test | cross | ci>");
+            eprintln!("usage: cargo xtask <demo | test | cross | qemu | trig-fit | ci>");
             return ExitCode::from(2);
         }
     };
@@ -57,7 +61,14 @@ const DOC_TEST: [&[&str]; 1] = [&["test", "--workspace", "--doc", "--quiet"]];
 
 /// Long runs (10^6 steps and more) are `#[ignore]`d in the quick debug test run and run here,
 /// optimised.
-const LONG_TEST: [&[&str]; 1] = [&["test", "--workspace", "--release", "--quiet", "--", "--ignored"]];
+const LONG_TEST: [&[&str]; 1] = [&[
+    "test",
+    "--workspace",
+    "--release",
+    "--quiet",
+    "--",
+    "--ignored",
+]];
 
 /// Everything CI checks; every step runs and every failure is reported at the end.
 fn ci() -> Result<(), String> {

@@ -1,0 +1,59 @@
+//! # lagrange-cases
+//!
+//! The lockstep cases: one `const` table, [`CASES`], of mechanism x integrator x scalar runs
+//! from fixed initial states. The firmware (`embedded/firmware`, on a Cortex-M4F under QEMU)
+//! and the host (`cargo xtask qemu`) both call [`Case::run`] on the same table, and the final
+//! states must agree bit for bit: the same code, the same IEEE-754 operations, the same `libm`
+//! and [`fast_trig`](lagrange_core::fast_trig), no fused multiply-add.
+//!
+//! Adding a case is one line in [`CASES`]; a new mechanism needs a [`Setup`] (parameters and
+//! initial state) first, as [`DoublePendulumSetup`] shows.
+//!
+//! ```
+//! use lagrange_cases::CASES;
+//! let case = &CASES[0];
+//! let a = case.run(100)?;
+//! let b = case.run(100)?;
+//! assert_eq!(a.words(), b.words());
+//! # Ok::<(), lagrange_core::Error>(())
+//! ```
+
+#![no_std]
+#![forbid(unsafe_code)]
+
+mod case;
+mod libm_trig_pendulum;
+mod setups;
+
+pub use case::{Case, Outcome, Precision, MAX_WORDS};
+pub use libm_trig_pendulum::LibmTrigPendulum;
+pub use setups::{DoublePendulumSetup, LibmTrigPendulumSetup, PendulumSetup, Setup};
+
+use lagrange_integrators::{Rk4, SemiImplicitEuler, VelocityVerlet};
+
+/// Steps of every case in the lockstep comparison (1 s of simulated time at the setups' 1 ms).
+pub const STEPS: u32 = 1000;
+
+/// Every case the firmware runs and the host checks, in order (the index is the case's id in
+/// the firmware's log).
+///
+/// The pendulum is the origin's (30 degrees, undamped), the double pendulum starts both links
+/// horizontal, chaotic, so any difference of one bit grows to a visible one within the run.
+/// Velocity Verlet and semi-implicit Euler are the symplectic methods (for the pendulum;
+/// velocity Verlet is not symplectic for the double pendulum, whose mass matrix depends on
+/// `q`). The libm-trig pendulum is the same pendulum with `libm::sinf`: the cost it is
+/// compared against.
+pub const CASES: [Case; 12] = [
+    Case::new::<f32, 1, PendulumSetup, Rk4>(),
+    Case::new::<f64, 1, PendulumSetup, Rk4>(),
+    Case::new::<f32, 1, PendulumSetup, VelocityVerlet>(),
+    Case::new::<f64, 1, PendulumSetup, VelocityVerlet>(),
+    Case::new::<f32, 1, PendulumSetup, SemiImplicitEuler>(),
+    Case::new::<f64, 1, PendulumSetup, SemiImplicitEuler>(),
+    Case::new::<f32, 1, LibmTrigPendulumSetup, Rk4>(),
+    Case::new::<f32, 1, LibmTrigPendulumSetup, VelocityVerlet>(),
+    Case::new::<f32, 2, DoublePendulumSetup, Rk4>(),
+    Case::new::<f64, 2, DoublePendulumSetup, Rk4>(),
+    Case::new::<f32, 2, DoublePendulumSetup, VelocityVerlet>(),
+    Case::new::<f64, 2, DoublePendulumSetup, VelocityVerlet>(),
+];
