@@ -19,8 +19,10 @@
 //! then the quadrant k mod 4 selects +-sin r or +-cos r.
 //! ```
 //!
-//! The reduction is exact to about 2^-64 relative for every finite `f32` (no input is closer
-//! to a multiple of pi/2 than about 2^-29 relative), so large arguments lose nothing.
+//! The fraction `f` is kept to 2^-71 absolute (the 2/pi bits past the window contribute less)
+//! and normalised before the multiplication by pi/2, so `r_hi + r_lo` carries about 64
+//! significant bits even where `x` is within a hair of a multiple of pi/2: large arguments lose
+//! nothing.
 //!
 //! # Accuracy
 //!
@@ -36,11 +38,13 @@
 
 /// The error bound, in units in the last place of the result, over every finite `f32` input.
 ///
-/// The polynomials' own relative error (about 2^-27 for sine and cosine, see
-/// [`SIN_POLY`]) plus the rounding of a handful of `f32` operations stay well inside it:
-/// `tests/tests/fast_trig.rs` measures the maximum over a dense sweep of more than 10^6
-/// inputs of the reduced range, random and large arguments, and every multiple of pi/2 an
-/// `f32` comes close to, and asserts this bound.
+/// The polynomials' own relative error (3.8e-9 for the sine, 1.2e-10 for the cosine: 0.06
+/// and 0.002 ulp) plus the rounding of a handful of `f32` operations and of `r` stay inside
+/// it. Measured (`tests/tests/fast_trig.rs`): 1.315 ulp at most over every `f32` from 2^-12
+/// to 2^20 (exhaustive, each CI run), 1.323 ulp over every finite `f32` (one exhaustive run
+/// of 5.5 minutes), and within the bound over sweeps of 2.8 million inputs in every binade,
+/// random arguments, and the `f32`s nearest to multiples of pi/2. `libm::sinf`/`cosf`, for
+/// comparison, are within 0.501 ulp.
 pub const MAX_ULP_ERROR: f32 = 2.0;
 
 /// Coefficients of `S(u)`, `u = r^2`, lowest degree first: `sin r = r + r^3 S(r^2)` on
@@ -228,7 +232,7 @@ pub fn sin(x: f32) -> f32 {
         return if abs < TINY_BITS { x } else { sin_kernel(x) };
     }
     if abs >= 0x7f80_0000 {
-        return x - x; // NaN for infinities and NaN
+        return f32::NAN; // for infinities and NaN
     }
     let r = reduce(abs);
     let s = match r.quadrant & 3 {
@@ -252,7 +256,7 @@ pub fn cos(x: f32) -> f32 {
         return cos_kernel(x);
     }
     if abs >= 0x7f80_0000 {
-        return x - x;
+        return f32::NAN;
     }
     let r = reduce(abs);
     match r.quadrant & 3 {
@@ -273,7 +277,7 @@ pub fn sin_cos(x: f32) -> (f32, f32) {
         return (s, cos_kernel(x));
     }
     if abs >= 0x7f80_0000 {
-        return (x - x, x - x);
+        return (f32::NAN, f32::NAN);
     }
     let (s, c) = by_quadrant(reduce(abs));
     if bits & SIGN == 0 {

@@ -5,13 +5,17 @@
 //! - `test`: host tests of every crate, f32 and f64, the long runs (`#[ignore]`d) in release.
 //! - `cross`: thumbv7em-none-eabihf builds of the library crates, with and without `defmt`,
 //!   and a linked no_std binary with no allocator, with its size.
+//! - `qemu`: the firmware on an emulated Cortex-M4F (QEMU `mps2-an386`), its defmt log compared
+//!   bit for bit with the host, instructions per step, stack and `.text` sizes, the panic-free
+//!   image; installs QEMU and `defmt-print` when missing.
 //! - `trig-fit`: derives the polynomials and constants of `lagrange_core::fast_trig` and
 //!   checks the library's against them.
-//! - `ci`: format check, clippy with `-D warnings`, test, cross.
+//! - `ci`: format check, clippy with `-D warnings`, test, cross, qemu.
 
 mod cmd;
 mod cross;
 mod demo;
+mod qemu;
 mod svg;
 mod trig_fit;
 
@@ -23,6 +27,7 @@ fn main() -> ExitCode {
         "demo" => demo::run(),
         "test" => cmd::run_all(&TEST).and(cmd::run_all(&LONG_TEST)),
         "cross" => cross::run(),
+        "qemu" => qemu::run(),
         "ci" => ci(),
         "trig-fit" => trig_fit::run(),
         _ => {
@@ -78,6 +83,7 @@ fn ci() -> Result<(), String> {
         cmd::run_all(&DOC_TEST),
         cmd::run_all(&LONG_TEST),
         cross::run(),
+        qemu::run(),
     ]
     .into_iter()
     .filter_map(Result::err)
