@@ -22,7 +22,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, ExitStatus, Stdio};
 use std::time::{Duration, Instant};
 
-use lagrange_cases::{CASES, STEPS};
+use lagrange_cases::{CASES, KERNELS, KERNEL_CALLS, STEPS};
 
 use crate::cmd;
 use crate::cross::{self, TARGET};
@@ -303,6 +303,8 @@ struct Log {
     costs: BTreeMap<usize, Option<(u64, u64)>>,
     /// Stack high-water mark by case id, bytes.
     stacks: BTreeMap<usize, u64>,
+    /// `(digest, ticks)` by kernel id.
+    kernels: BTreeMap<usize, (u64, u64)>,
     /// `(instructions, ticks)` of the calibration loop.
     calibration: Option<(u64, u64)>,
     /// The last line arrived.
@@ -362,6 +364,11 @@ fn parse_log(text: &str) -> Result<Log, String> {
             "stack" => {
                 let id = usize::try_from(number(words.next())?).map_err(|_| bad())?;
                 log.stacks.insert(id, number(words.next())?);
+            }
+            "kernel" => {
+                let id = usize::try_from(number(words.next())?).map_err(|_| bad())?;
+                let digest = number(words.next())?;
+                log.kernels.insert(id, (digest, number(words.next())?));
             }
             "calibrate" => {
                 log.calibration = Some((number(words.next())?, number(words.next())?));
@@ -485,7 +492,52 @@ fn lockstep(elf: &Path, decoder: &Path) -> Result<Vec<String>, String> {
         }
         _ => failures.push("no f32 RK4 pendulum cost to check against its budget".into()),
     }
+    failures.extend(kernels(&log, per_tick));
     Ok(failures)
+}
+
+/// Compares the kernels' digests with the host's and prints instructions per call (the
+/// kernel's ticks less those of the identity loop above it); the list of failed checks.
+fn kernels(log: &Log, per_tick: u64) -> Vec<String> {
+    let mut failures = Vec::new();
+    println!("\nmath kernels on the M4F, {KERNEL_CALLS} calls each (results compared as digests):");
+    println!(
+        "{:>3}  {:<26} {:<14} {:<12} {:>13}",
+        "id", "function", "inputs", "host = M4F", "instr/call"
+    );
+    let mut identity = None;
+    for (id, kernel) in KERNELS.iter().enumerate() {
+        let Some(&(digest, ticks)) = log.kernels.get(&id) else {
+            failures.push(format!("kernel {id} ({}): missing", kernel.name));
+            continue;
+        };
+        let verdict = if digest == kernel.run(KERNEL_CALLS) {
+            "identical"
+        } else {
+            failures.push(format!(
+                "kernel {id} ({} on {}): results differ from the host's",
+                kernel.name, kernel.inputs
+            ));
+            "DIFFERENT"
+        };
+        let cost = if kernel.name.starts_with("identity") {
+            identity = Some(ticks);
+            "(loop)".to_string()
+        } else {
+            identity.map_or_else(
+                || "-".into(),
+                |base| {
+                    let instructions = ticks.saturating_sub(base) * per_tick;
+                    format!("{:.1}", instructions as f64 / f64::from(KERNEL_CALLS))
+                },
+            )
+        };
+        println!(
+            "{id:>3}  {:<26} {:<14} {verdict:<12} {cost:>13}",
+            kernel.name, kernel.inputs
+        );
+    }
+    failures
 }
 
 /// The `.text` size of an ELF, bytes.

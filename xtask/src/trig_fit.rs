@@ -308,6 +308,27 @@ pub fn frac_pi_2_fixed() -> u64 {
     kept + ((frac >> 2) & 1)
 }
 
+/// `pi/2` split as `P1 + P2 + P3 + P4`: three consecutive 17-bit slices of its binary
+/// expansion (`P1` holds the integer bit and 16 fractional ones), then the rest rounded to
+/// `f32`.
+pub fn frac_pi_2_parts() -> [f32; 4] {
+    let pi = pi_fixed();
+    // pi/2 * 2^126 in a u128: pi * 2^125, from the integer limb and 125 fractional bits.
+    let frac = (u128::from(pi[1]) << 96)
+        | (u128::from(pi[2]) << 64)
+        | (u128::from(pi[3]) << 32)
+        | u128::from(pi[4]);
+    let v = (u128::from(pi[0]) << 125) | (frac >> 3);
+    let slice = |end: u32| ((v >> (126 - end)) & 0x1_ffff) as f32 * 2f32.powi(-(end as i32));
+    let rest = v & ((1u128 << (126 - 50)) - 1);
+    [
+        slice(16),
+        slice(33),
+        slice(50),
+        rest as f32 * 2f32.powi(-126),
+    ]
+}
+
 /// Prints the derived constants as Rust source and compares them with the library's.
 pub fn run() -> Result<(), String> {
     let (s, se) = sin_coefficients(fast_trig::SIN_POLY.len())?;
@@ -327,7 +348,12 @@ pub fn run() -> Result<(), String> {
         "pub const FRAC_PI_2_FIXED: u64 = 0x{:016x};",
         frac_pi_2_fixed()
     );
+    println!(
+        "pub const FRAC_PI_2_PARTS: [f32; 4] = {:?};",
+        frac_pi_2_parts()
+    );
     let same = s == fast_trig::SIN_POLY
+        && frac_pi_2_parts() == fast_trig::FRAC_PI_2_PARTS
         && c == fast_trig::COS_POLY
         && bits == fast_trig::FRAC_2_PI_BITS
         && frac_pi_2_fixed() == fast_trig::FRAC_PI_2_FIXED;
@@ -355,6 +381,7 @@ mod tests {
             fast_trig::FRAC_2_PI_BITS
         );
         assert_eq!(frac_pi_2_fixed(), fast_trig::FRAC_PI_2_FIXED);
+        assert_eq!(frac_pi_2_parts(), fast_trig::FRAC_PI_2_PARTS);
         Ok(())
     }
 
@@ -371,6 +398,17 @@ mod tests {
         assert!((f - std::f64::consts::FRAC_2_PI).abs() <= 2f64.powi(-53));
         let pio2 = frac_pi_2_fixed() as f64 / 2f64.powi(62);
         assert_eq!(pio2, std::f64::consts::FRAC_PI_2);
+        let parts = frac_pi_2_parts();
+        let sum: f64 = parts.iter().map(|&p| f64::from(p)).sum();
+        assert!((sum - std::f64::consts::FRAC_PI_2).abs() <= 2f64.powi(-52));
+        // The first three have at most 17 significant bits: k P is exact for k < 2^7.
+        for p in &parts[..3] {
+            assert_eq!(
+                p.to_bits() & 0x7f,
+                0,
+                "{p:e} has more than 17 significant bits"
+            );
+        }
     }
 
     /// The fits level the error: the Remez error is far below an `f32` ulp (2^-24 ~ 6e-8).

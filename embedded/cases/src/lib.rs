@@ -6,6 +6,9 @@
 //! states must agree bit for bit: the same code, the same IEEE-754 operations, the same `libm`
 //! and [`fast_trig`](lagrange_core::fast_trig), no fused multiply-add.
 //!
+//! [`KERNELS`] does the same for the math functions a step spends its time in (sine, cosine,
+//! square root), over fixed input sets, compared as digests of every result's bits.
+//!
 //! Adding a case is one line in [`CASES`]; a new mechanism needs a [`Setup`] (parameters and
 //! initial state) first, as [`DoublePendulumSetup`] shows.
 //!
@@ -22,10 +25,12 @@
 #![forbid(unsafe_code)]
 
 mod case;
+mod kernels;
 mod libm_trig_pendulum;
 mod setups;
 
 pub use case::{Case, Outcome, Precision, MAX_WORDS};
+pub use kernels::{Kernel, KERNELS, KERNEL_CALLS};
 pub use libm_trig_pendulum::LibmTrigPendulum;
 pub use setups::{DoublePendulumSetup, LibmTrigPendulumSetup, PendulumSetup, Setup};
 

@@ -1,6 +1,7 @@
 //! The lockstep firmware: runs every case of `lagrange_cases::CASES` on the Cortex-M4F and
 //! logs, with defmt over semihosting, each final state as exact bit patterns, the SysTick
-//! ticks of a run of 0 and of `STEPS` steps, and the stack high-water mark; then a calibration
+//! ticks of a run of 0 and of `STEPS` steps, and the stack high-water mark; then every math
+//! kernel of `lagrange_cases::KERNELS` (digest and ticks); then a calibration
 //! of ticks against instructions. `cargo xtask qemu` decodes the log with `defmt-print` and
 //! compares every state bit for bit with the same cases run on the host.
 //!
@@ -11,6 +12,7 @@
 //! case <id> <words as [a, b, ...]>       or   case <id> error
 //! cost <id> <ticks for 0 steps> <ticks for STEPS steps>
 //! stack <id> <bytes>
+//! kernel <id> <digest of the results' bits> <ticks for KERNEL_CALLS calls>
 //! calibrate <instructions> <ticks>
 //! done
 //! ```
@@ -22,7 +24,7 @@
 
 use cortex_m_rt::{entry, exception, ExceptionFrame};
 use defmt_semihosting as _;
-use lagrange_cases::{CASES, STEPS};
+use lagrange_cases::{CASES, KERNELS, KERNEL_CALLS, STEPS};
 use lagrange_firmware::{exit, stack_high_water, Counter};
 
 /// The calibration loop's argument: `cortex_m::asm::delay(n)` (cortex-m 0.7.10) runs `n + 1`
@@ -56,6 +58,14 @@ fn main() -> ! {
             }
         }
         defmt::println!("stack {=usize} {=u32}", id, stack);
+    }
+    for (id, kernel) in KERNELS.iter().enumerate() {
+        match counter.measure(|| kernel.run(KERNEL_CALLS)) {
+            (digest, Some(ticks)) => {
+                defmt::println!("kernel {=usize} {=u64} {=u32}", id, digest, ticks)
+            }
+            (_, None) => ok = false,
+        }
     }
     let (_, empty) = counter.measure(|| cortex_m::asm::delay(0));
     let (_, full) = counter.measure(|| cortex_m::asm::delay(CALIBRATION_CYCLES));
