@@ -54,39 +54,33 @@ fn origin_pendulum_no_worse_than_with_libm() -> Result<(), Error> {
     Ok(())
 }
 
-/// Over 60 release angles from 3 to 177 degrees (arguments up to pi, so the reduction runs),
-/// RK4 and velocity Verlet at 1 ms for 10 s: the root-mean-square error with the pure-`f32`
-/// sine is within 10% of that with `libm::sinf`. In `f32` the error at 1 ms is mostly
-/// rounding, a random walk that any one-ulp difference in a sine re-draws, so single runs
-/// differ both ways by tens of percent; the mean over many does not.
+/// Over 60 release angles from 3 to 177 degrees (arguments up to pi, so the medium-range
+/// reduction runs), RK4 and velocity Verlet at 1 ms for 10 s: the geometric mean over the runs
+/// of (error with the pure-`f32` sine) / (error with `libm::sinf`) is at most 1.1. In `f32` the
+/// error at 1 ms is mostly rounding, a random walk that any one-ulp difference in a sine
+/// re-draws, so single runs differ both ways by factors up to 7 (near the separatrix); the
+/// geometric mean weighs every run alike. Measured: 0.976 for RK4, 0.921 for velocity Verlet.
 #[test]
 fn fast_trig_keeps_the_pendulums_accuracy() -> Result<(), Error> {
     let p = SimplePendulum::new(1.0_f32, 1.0, G as f32, 0.0)?;
     let libm = LibmTrigPendulum(p);
-    let (mut fast, mut slow) = ([0.0; 2], [0.0; 2]);
+    let mut log_ratio = [0.0; 2];
     let angles = 60;
     for i in 0..angles {
         let th0 = f64::to_radians(3.0 + 174.0 * f64::from(i) / f64::from(angles - 1));
-        let e = [
-            error(&p, Rk4, th0, 1e-3, 10_000)?,
-            error(&p, VelocityVerlet, th0, 1e-3, 10_000)?,
-        ];
-        let l = [
-            error(&libm, Rk4, th0, 1e-3, 10_000)?,
-            error(&libm, VelocityVerlet, th0, 1e-3, 10_000)?,
-        ];
-        for k in 0..2 {
-            fast[k] += e[k] * e[k];
-            slow[k] += l[k] * l[k];
-        }
+        log_ratio[0] +=
+            (error(&p, Rk4, th0, 1e-3, 10_000)? / error(&libm, Rk4, th0, 1e-3, 10_000)?).ln();
+        log_ratio[1] += (error(&p, VelocityVerlet, th0, 1e-3, 10_000)?
+            / error(&libm, VelocityVerlet, th0, 1e-3, 10_000)?)
+        .ln();
     }
     for (k, name) in ["RK4", "velocity Verlet"].iter().enumerate() {
-        let (f, l) = (fast[k].sqrt(), slow[k].sqrt());
-        println!(
-            "{name}: rms error fast_trig {f:.3e}, libm {l:.3e}, ratio {:.3}",
-            f / l
+        let ratio = (log_ratio[k] / f64::from(angles)).exp();
+        println!("{name}: geometric mean of error(fast_trig) / error(libm) = {ratio:.3}");
+        assert!(
+            ratio <= 1.1,
+            "{name}: fast_trig is {ratio:.3} times as far off"
         );
-        assert!(f <= 1.1 * l, "{name}: fast_trig {f:e}, libm {l:e}");
     }
     Ok(())
 }
