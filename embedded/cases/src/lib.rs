@@ -62,3 +62,26 @@ pub const CASES: [Case; 12] = [
     Case::new::<f32, 2, DoublePendulumSetup, VelocityVerlet>(),
     Case::new::<f64, 2, DoublePendulumSetup, VelocityVerlet>(),
 ];
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every case runs on the host and its outcome holds `t`, `q` and `q'`; no two cases are
+    /// the same run (the firmware's log names them by index only).
+    #[test]
+    fn every_case_runs_and_is_distinct() -> Result<(), lagrange_core::Error> {
+        for (i, case) in CASES.iter().enumerate() {
+            let outcome = case.run(STEPS)?;
+            assert_eq!(outcome.words().len(), 1 + 2 * case.dof, "case {i}");
+            for other in &CASES[..i] {
+                assert!(
+                    (other.system, other.method, other.precision)
+                        != (case.system, case.method, case.precision),
+                    "case {i} repeats an earlier one"
+                );
+            }
+        }
+        Ok(())
+    }
+}
