@@ -10,11 +10,11 @@
 //!
 //! ```text
 //! |x| <= pi/4         r = x, quadrant 0
-//! pi/4 < |x| < 128    k = round(x 2/pi) (at most 82), r = x - k pi/2 with pi/2 split in
-//!                     four f32s P1..P4, the first three of 17 bits so that k Pi is exact:
+//! pi/4 < |x| < 512    k = round(x 2/pi) (at most 326), r = x - k pi/2 with pi/2 split in
+//!                     four f32s P1..P4, the first three of 15 bits so that k Pi is exact:
 //!                     x - k P1 is exact, and error-free sums (TwoSum) carry the rest as
-//!                     r_hi + r_lo, to about 2^-66 absolute
-//! 128 <= |x| < inf    x 2/pi = k + f, k an integer, |f| <= 1/2, in fixed point:
+//!                     r_hi + r_lo, to about 2^-62 absolute
+//! 512 <= |x| < inf    x 2/pi = k + f, k an integer, |f| <= 1/2, in fixed point:
 //!                     x = m 2^e (m a 24-bit integer) times a 96-bit window of the bits of
 //!                     2/pi (Payne-Hanek: only the bits that can change k mod 4 and f); then
 //!                     r = f pi/2 as r_hi + r_lo, two f32s carrying 64 bits
@@ -86,14 +86,14 @@ pub const FRAC_2_PI_BITS: [u32; 8] = [
 /// `pi/2` in unsigned fixed point with 62 fractional bits, rounded to nearest.
 pub const FRAC_PI_2_FIXED: u64 = 0x6487_ed51_10b4_611a;
 
-/// `pi/2 = P1 + P2 + P3 + P4` (to 2^-76): `P1`, `P2`, `P3` are consecutive 17-bit slices of
-/// its binary expansion (so `k Pi` is exact for `k < 2^7`), `P4` the rest rounded to `f32`.
+/// `pi/2 = P1 + P2 + P3 + P4` (to 2^-71): `P1`, `P2`, `P3` are consecutive 15-bit slices of
+/// its binary expansion (so `k Pi` is exact for `k < 2^9`), `P4` the rest rounded to `f32`.
 /// Derived by `cargo xtask trig-fit`.
-pub const FRAC_PI_2_PARTS: [f32; 4] = [1.570_785_5, 1.080_427_3e-5, 6.077_094_4e-11, 6.123_234e-17];
+pub const FRAC_PI_2_PARTS: [f32; 4] = [1.570_739_7, 5.657_971e-5, 9.920_882e-10, 5.390_303e-15];
 
-/// The bits of `128.0`: inputs below it (and above pi/4) are reduced with
+/// The bits of `512.0`: inputs below it (and above pi/4) are reduced with
 /// [`FRAC_PI_2_PARTS`], larger ones with [`FRAC_2_PI_BITS`].
-const MEDIUM_BITS: u32 = 0x4300_0000;
+const MEDIUM_BITS: u32 = 0x4400_0000;
 
 /// The bits of the largest `f32` not above `pi/4`: inputs up to it need no reduction.
 const FRAC_PI_4_BITS: u32 = 0x3f49_0fda;
@@ -144,15 +144,15 @@ fn two_sum(a: f32, b: f32) -> (f32, f32) {
     (s, e)
 }
 
-/// Reduces `pi/4 < ax < 128` modulo `pi/2` with [`FRAC_PI_2_PARTS`].
+/// Reduces `pi/4 < ax < 512` modulo `pi/2` with [`FRAC_PI_2_PARTS`].
 #[inline]
 fn reduce_medium(ax: f32) -> Reduced {
     let [p1, p2, p3, p4] = FRAC_PI_2_PARTS;
-    // k = round(ax 2/pi) <= 82; a k off by one near a half-integer only moves r a hair past
+    // k = round(ax 2/pi) <= 326; a k off by one near a half-integer only moves r a hair past
     // pi/4, where the polynomials are still accurate.
-    #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)] // 1..=82
+    #[allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)] // 1..=326
     let k = (ax * core::f32::consts::FRAC_2_PI + 0.5) as u32;
-    #[allow(clippy::cast_precision_loss)] // below 2^7: exact
+    #[allow(clippy::cast_precision_loss)] // below 2^9: exact
     let kf = k as f32;
     // Exact: k P1 has 24 bits, and ax - k P1 is a multiple of ulp(ax) below 1.
     let t1 = ax - kf * p1;
@@ -176,19 +176,19 @@ fn reduce(abs_bits: u32) -> Reduced {
     }
 }
 
-/// Reduces a finite `|x| >= 128` (given as its bits without the sign) modulo `pi/2`.
+/// Reduces a finite `|x| >= 512` (given as its bits without the sign) modulo `pi/2`.
 #[inline(never)]
 fn reduce_large(abs_bits: u32) -> Reduced {
-    // |x| = m 2^e with m a 24-bit integer (finite and at least 128, so normal; e >= -16).
+    // |x| = m 2^e with m a 24-bit integer (finite and at least 512, so normal; e >= -14).
     let m = (abs_bits & 0x007f_ffff) | 0x0080_0000;
     #[allow(clippy::cast_possible_wrap)] // an 8-bit field
     let e = (abs_bits >> 23) as i32 - 150;
     // Bits of 2/pi from position i0 on; earlier bits only add multiples of 4 to x 2/pi.
     let i0 = (e - 1).max(1);
-    // x 2/pi mod 4 = (m W) 2^-s, W the 96-bit window from bit i0; s is in 94..=112.
+    // x 2/pi mod 4 = (m W) 2^-s, W the 96-bit window from bit i0; s is in 94..=110.
     #[allow(clippy::cast_sign_loss)] // i0 >= 1
     let w = window((i0 - 1) as u32);
-    #[allow(clippy::cast_sign_loss)] // 94..=112 for finite inputs from 128
+    #[allow(clippy::cast_sign_loss)] // 94..=110 for finite inputs from 512
     let s = (i0 + 95 - e) as u32;
     let p = u128::from(m) * w;
     // Quadrant bits at the top: shifting out the higher bits is the reduction mod 4.

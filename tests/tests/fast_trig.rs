@@ -191,15 +191,15 @@ fn worst_over(from: u32, to: u32) -> (f64, f32) {
 #[ignore = "exhaustive: about 15 s in release"]
 fn exhaustive_from_2_pow_minus_12_to_2_pow_20() {
     const BLOCK: u32 = 1 << 18;
-    // The three paths: no reduction, the medium one (to 128), the large one (to 2^20).
+    // The three paths: no reduction, the medium one (to 512), the large one (to 2^20).
     let regions = [
         (
             "2^-12 <= x <= pi/4",
             0x3980_0000,
             FRAC_PI_4_F32.to_bits() + 1,
         ),
-        ("pi/4 < x < 128", FRAC_PI_4_F32.to_bits() + 1, 0x4300_0000),
-        ("128 <= x < 2^20", 0x4300_0000, 0x4980_0000),
+        ("pi/4 < x < 512", FRAC_PI_4_F32.to_bits() + 1, 0x4400_0000),
+        ("512 <= x < 2^20", 0x4400_0000, 0x4980_0000),
     ];
     for (name, from, to) in regions {
         // Interleaved blocks, so that both threads get as many cheap and dear inputs.

@@ -308,8 +308,8 @@ pub fn frac_pi_2_fixed() -> u64 {
     kept + ((frac >> 2) & 1)
 }
 
-/// `pi/2` split as `P1 + P2 + P3 + P4`: three consecutive 17-bit slices of its binary
-/// expansion (`P1` holds the integer bit and 16 fractional ones), then the rest rounded to
+/// `pi/2` split as `P1 + P2 + P3 + P4`: three consecutive 15-bit slices of its binary
+/// expansion (`P1` holds the integer bit and 14 fractional ones), then the rest rounded to
 /// `f32`.
 pub fn frac_pi_2_parts() -> [f32; 4] {
     let pi = pi_fixed();
@@ -319,12 +319,12 @@ pub fn frac_pi_2_parts() -> [f32; 4] {
         | (u128::from(pi[3]) << 32)
         | u128::from(pi[4]);
     let v = (u128::from(pi[0]) << 125) | (frac >> 3);
-    let slice = |end: u32| ((v >> (126 - end)) & 0x1_ffff) as f32 * 2f32.powi(-(end as i32));
-    let rest = v & ((1u128 << (126 - 50)) - 1);
+    let slice = |end: u32| ((v >> (126 - end)) & 0x7fff) as f32 * 2f32.powi(-(end as i32));
+    let rest = v & ((1u128 << (126 - 44)) - 1);
     [
-        slice(16),
-        slice(33),
-        slice(50),
+        slice(14),
+        slice(29),
+        slice(44),
         rest as f32 * 2f32.powi(-126),
     ]
 }

@@ -63,12 +63,14 @@ fn sweep64(calls: u32, lo: f64, hi: f64, f: impl Fn(f64) -> f64) -> u64 {
 const QUARTER: (f32, f32) = (-0.785, 0.785);
 /// `|x| <= 8`: both paths, as a mechanism's angles.
 const WIDE: (f32, f32) = (-8.0, 8.0);
+/// Up to `500`: mostly the medium reduction, with quadrant counts up to 318.
+const HUNDREDS: (f32, f32) = (-500.0, 500.0);
 /// Up to `1e30`: the reduction with bits of 2/pi far from the point.
 const HUGE: (f32, f32) = (-1e30, 1e30);
 
 /// The kernels measured, in order (the index is the kernel's id in the firmware's log). Each
 /// "identity" entry is the cost of the loop itself, subtracted from the kernels of its type.
-pub const KERNELS: [Kernel; 12] = [
+pub const KERNELS: [Kernel; 13] = [
     Kernel {
         name: "identity f32",
         inputs: "-",
@@ -83,6 +85,11 @@ pub const KERNELS: [Kernel; 12] = [
         name: "fast_trig::sin",
         inputs: "|x| <= 8",
         runner: |n| sweep32(n, WIDE.0, WIDE.1, fast_trig::sin),
+    },
+    Kernel {
+        name: "fast_trig::sin",
+        inputs: "|x| <= 500",
+        runner: |n| sweep32(n, HUNDREDS.0, HUNDREDS.1, fast_trig::sin),
     },
     Kernel {
         name: "fast_trig::sin",
