@@ -37,6 +37,30 @@ pub enum Error {
     },
     /// An adaptive integrator needed a step smaller than its minimum.
     StepSizeUnderflow,
+    /// Constraint row `row` is, to within `sqrt(EPSILON)` of its own size, a combination of the
+    /// rows before it (in the mass-weighted sense of `J M^-1 J^T`): the constraints are
+    /// redundant, or the configuration is one where they are singular (their Jacobian loses
+    /// rank, or a row's gradient vanishes).
+    RedundantConstraints {
+        /// Index of the first dependent constraint row.
+        row: usize,
+    },
+    /// A state violates constraint `row` beyond the tolerance it was checked against: its
+    /// position residual `phi`, its velocity residual `J q'`, or (for a contact) its
+    /// penetration. Typically an inconsistent initial state.
+    ConstraintViolated {
+        /// Index of the first violated constraint row.
+        row: usize,
+    },
+    /// An adaptive integrator took its maximum number of steps without reaching the end time.
+    TooManySteps {
+        /// How many steps were taken.
+        steps: u64,
+    },
+    /// The Newton matrix of an implicit step is singular: a pivot of its LU factorisation
+    /// was zero (the step is too large for the mechanism's Jacobian, or the Jacobian is
+    /// degenerate).
+    SingularJacobian,
 }
 
 impl fmt::Display for Error {
@@ -55,6 +79,19 @@ impl fmt::Display for Error {
                 write!(f, "no convergence after {iterations} iterations")
             }
             Self::StepSizeUnderflow => f.write_str("step size fell below its minimum"),
+            Self::RedundantConstraints { row } => write!(
+                f,
+                "constraint {row} depends on the ones before it (redundant or singular constraints)"
+            ),
+            Self::ConstraintViolated { row } => {
+                write!(f, "state violates constraint {row} beyond the tolerance")
+            }
+            Self::TooManySteps { steps } => {
+                write!(f, "end time not reached within the limit of {steps} steps")
+            }
+            Self::SingularJacobian => {
+                f.write_str("the Newton matrix of an implicit step is singular")
+            }
         }
     }
 }

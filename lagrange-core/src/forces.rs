@@ -1,7 +1,7 @@
 //! Composable generalized forces: damping, inputs and user forces added by wrapping a
 //! mechanism, never by editing it.
 
-use crate::{validate, Error, Mechanism, Real, State};
+use crate::{central_difference_jacobian, validate, Error, Jacobian, Mechanism, Real, State};
 use nalgebra::{SMatrix, SVector};
 
 /// A generalized force `Q(t, q, q')` that can be added to any mechanism with
@@ -11,6 +11,13 @@ use nalgebra::{SMatrix, SVector};
 pub trait GeneralizedForce<T: Real, const N: usize> {
     /// The force at `state`.
     fn force(&self, state: &State<T, N>) -> SVector<T, N>;
+
+    /// `(dQ/dq, dQ/dq')` at `state`, for the Newton matrices of implicit integrators. The
+    /// default takes central differences ([`central_difference_jacobian`], `4 N` evaluations
+    /// of [`GeneralizedForce::force`]); [`ViscousDamping`] and [`Input`] give theirs exactly.
+    fn jacobian(&self, state: &State<T, N>) -> Jacobian<T, N> {
+        central_difference_jacobian(state, |s| self.force(s))
+    }
 }
 
 impl<T: Real, const N: usize, F: Fn(&State<T, N>) -> SVector<T, N>> GeneralizedForce<T, N> for F {
@@ -61,6 +68,12 @@ impl<T: Real, const N: usize> GeneralizedForce<T, N> for ViscousDamping<T, N> {
     fn force(&self, state: &State<T, N>) -> SVector<T, N> {
         -self.coefficients.component_mul(&state.qd)
     }
+    fn jacobian(&self, _state: &State<T, N>) -> Jacobian<T, N> {
+        Jacobian {
+            wrt_q: SMatrix::zeros(),
+            wrt_qd: SMatrix::from_diagonal(&-self.coefficients),
+        }
+    }
 }
 
 /// A drive or control input: a generalized force held constant over a step, which the caller
@@ -84,6 +97,9 @@ impl<T: Real, const N: usize> Input<T, N> {
 impl<T: Real, const N: usize> GeneralizedForce<T, N> for Input<T, N> {
     fn force(&self, _state: &State<T, N>) -> SVector<T, N> {
         self.value
+    }
+    fn jacobian(&self, _state: &State<T, N>) -> Jacobian<T, N> {
+        Jacobian::zeros()
     }
 }
 
@@ -142,6 +158,23 @@ where
     }
     fn solve_mass(&self, state: &State<T, N>, b: &SVector<T, N>) -> Result<SVector<T, N>, Error> {
         self.mechanism.solve_mass(state, b)
+    }
+    /// The inner mechanism's acceleration law with this force added, so that a constrained
+    /// mechanism keeps its constraint forces when wrapped.
+    fn acceleration(&self, state: &State<T, N>) -> Result<SVector<T, N>, Error> {
+        self.mechanism
+            .acceleration_with(state, &self.force.force(state))
+    }
+    fn acceleration_with(
+        &self,
+        state: &State<T, N>,
+        extra: &SVector<T, N>,
+    ) -> Result<SVector<T, N>, Error> {
+        self.mechanism
+            .acceleration_with(state, &(self.force.force(state) + extra))
+    }
+    fn equation_jacobian(&self, state: &State<T, N>, qdd: &SVector<T, N>) -> Jacobian<T, N> {
+        self.mechanism.equation_jacobian(state, qdd) - self.force.jacobian(state)
     }
 }
 

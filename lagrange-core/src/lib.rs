@@ -10,6 +10,10 @@
 //! - [`Lagrangian`] and [`EulerLagrange`]: write `T` and `V` once and get the equations of
 //!   motion by automatic differentiation.
 //! - [`GeneralizedForce`], [`ViscousDamping`], [`Input`], [`Forced`]: forces added by wrapping.
+//! - [`constraints`]: holonomic and Pfaffian constraints with Lagrange multipliers
+//!   ([`Constrained`]), Baumgarte [`Stabilization`] and [`Projection`] against drift.
+//! - [`Jacobian`]: `d/dq` and `d/dq'` of the equations of motion, exact from dual numbers for
+//!   [`EulerLagrange`], by [`central_difference_jacobian`] otherwise (for implicit integrators).
 //! - [`Error`]: one small `Copy` error type for every crate.
 //!
 //! ```
@@ -40,10 +44,12 @@
 #![forbid(unsafe_code)]
 
 mod cholesky;
+pub mod constraints;
 mod dual;
 mod error;
 pub mod fast_trig;
 mod forces;
+mod jacobian;
 mod lagrangian;
 mod mechanism;
 mod scalar;
@@ -52,9 +58,14 @@ mod state;
 pub mod validate;
 
 pub use cholesky::solve_spd;
+pub use constraints::{
+    Constrained, Constraints, Holonomic, HolonomicConstraints, Pfaffian, PfaffianConstraints,
+    Projection, Stabilization,
+};
 pub use dual::Dual;
 pub use error::Error;
 pub use forces::{Forced, GeneralizedForce, Input, ViscousDamping};
+pub use jacobian::{acceleration_jacobian_by_differences, central_difference_jacobian, Jacobian};
 pub use lagrangian::{EulerLagrange, Lagrangian};
 pub use mechanism::Mechanism;
 pub use nalgebra;

@@ -1,7 +1,7 @@
 //! The [`Mechanism`] contract: what an integrator needs to know about a system.
 
 use crate::forces::Forced;
-use crate::{solve_spd, Error, Real, State};
+use crate::{central_difference_jacobian, solve_spd, Error, Jacobian, Real, State};
 use nalgebra::{SMatrix, SVector};
 
 /// A mechanical system with `N` generalized coordinates, in the form
@@ -60,6 +60,78 @@ pub trait Mechanism<T: Real, const N: usize> {
     /// As [`Mechanism::solve_mass`].
     fn acceleration(&self, state: &State<T, N>) -> Result<SVector<T, N>, Error> {
         self.solve_mass(state, &(self.rhs(state) + self.generalized_force(state)))
+    }
+
+    /// The generalized accelerations with the extra generalized force `extra` acting besides
+    /// `Q`: `M^-1 (f + Q + extra)` by default.
+    ///
+    /// [`Forced`] calls this, so that a mechanism whose acceleration law is more than
+    /// `M^-1 (f + Q)` keeps that law when a force is added by wrapping: a constrained mechanism
+    /// (see [`constraints`](crate::constraints)) overrides both this method and
+    /// [`Mechanism::acceleration`] to add its constraint forces.
+    ///
+    /// # Errors
+    /// As [`Mechanism::solve_mass`].
+    fn acceleration_with(
+        &self,
+        state: &State<T, N>,
+        extra: &SVector<T, N>,
+    ) -> Result<SVector<T, N>, Error> {
+        self.solve_mass(
+            state,
+            &(self.rhs(state) + self.generalized_force(state) + extra),
+        )
+    }
+
+    /// The Jacobian of the equations of motion written as a residual,
+    ///
+    /// ```text
+    /// r(t, q, q') = M(t, q, q') a - f(t, q, q') - Q(t, q, q')
+    /// ```
+    ///
+    /// with the acceleration `a` held fixed: `(dr/dq, dr/dq')`. It composes: a wrapper that
+    /// adds a force subtracts that force's Jacobian. At `a = q''` it gives the Jacobian of the
+    /// acceleration ([`Mechanism::acceleration_jacobian`]), which Newton's method in the
+    /// implicit integrators needs.
+    ///
+    /// The default takes central differences of `r` ([`central_difference_jacobian`]):
+    /// `4 N` evaluations of `M`, `f` and `Q`, relative accuracy about `EPSILON^(2/3)`.
+    /// [`EulerLagrange`](crate::EulerLagrange) overrides it with exact derivatives from dual
+    /// numbers; a hand-derived system may override it with its own.
+    fn equation_jacobian(&self, state: &State<T, N>, qdd: &SVector<T, N>) -> Jacobian<T, N> {
+        central_difference_jacobian(state, |s| {
+            self.mass_matrix(s) * qdd - self.rhs(s) - self.generalized_force(s)
+        })
+    }
+
+    /// The accelerations `q''` and their Jacobian `(dq''/dq, dq''/dq')`.
+    ///
+    /// Differentiating `M q'' = f + Q` gives `M dq''/dx = -dr/dx` with `r` from
+    /// [`Mechanism::equation_jacobian`] at `a = q''`: one acceleration, one equation Jacobian
+    /// and `2 N` solves with `M` ([`Mechanism::solve_mass`], so a closed-form inverse is used
+    /// where a system has one). Exact where `equation_jacobian` is.
+    ///
+    /// # Errors
+    /// As [`Mechanism::acceleration`]; [`Error::NonFiniteState`] when the Jacobian is not
+    /// finite.
+    fn acceleration_jacobian(
+        &self,
+        state: &State<T, N>,
+    ) -> Result<(SVector<T, N>, Jacobian<T, N>), Error> {
+        let qdd = self.acceleration(state)?;
+        let r = self.equation_jacobian(state, &qdd);
+        let mut j = Jacobian::<T, N>::zeros();
+        for k in 0..N {
+            let dq = self.solve_mass(state, &-r.wrt_q.column(k).into_owned())?;
+            let dqd = self.solve_mass(state, &-r.wrt_qd.column(k).into_owned())?;
+            j.wrt_q.set_column(k, &dq);
+            j.wrt_qd.set_column(k, &dqd);
+        }
+        if j.is_finite() {
+            Ok((qdd, j))
+        } else {
+            Err(Error::NonFiniteState)
+        }
     }
 
     /// This mechanism with `force` added to its generalized forces.

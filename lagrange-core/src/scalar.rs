@@ -84,6 +84,11 @@ pub trait Real:
     const EPSILON: Self;
     /// Positive infinity.
     const INFINITY: Self;
+    /// The smallest positive normal number (below it, precision is lost to subnormals).
+    const MIN_POSITIVE: Self;
+    /// `EPSILON^(1/3)`: the relative step of central differences that balances truncation
+    /// against rounding (a constant, so that a Jacobian costs no `powf`).
+    const CBRT_EPSILON: Self;
     /// Neither NaN nor infinite.
     fn is_finite(self) -> bool;
     /// Widen to `f64` (for reports and logs).
@@ -126,7 +131,7 @@ pub(crate) fn powi_by_squaring<S: Scalar>(x: S, n: i32) -> S {
 macro_rules! impl_real {
     ($t:ident, $sin:ident, $cos:ident, $sin_cos:ident, $tan:ident, $sqrt:ident, $exp:ident,
      $ln:ident, $fabs:ident, $atan2:ident, $floor:ident, $round:ident, $asin:ident,
-     $acos:ident, $atan:ident, $pow:ident) => {
+     $acos:ident, $atan:ident, $pow:ident, $cbrt_eps:expr) => {
         impl Scalar for $t {
             type Real = $t;
             #[inline]
@@ -194,6 +199,9 @@ macro_rules! impl_real {
             const PI: $t = core::$t::consts::PI;
             const EPSILON: $t = $t::EPSILON;
             const INFINITY: $t = $t::INFINITY;
+            const MIN_POSITIVE: $t = $t::MIN_POSITIVE;
+            #[allow(clippy::excessive_precision)]
+            const CBRT_EPSILON: $t = $cbrt_eps;
             #[inline]
             fn is_finite(self) -> bool {
                 $t::is_finite(self)
@@ -239,9 +247,40 @@ macro_rules! impl_real {
 }
 
 impl_real!(
-    f64, sin, cos, sin_cos, tan, sqrt, exp, log, fabs, atan2, floor, round, asin, acos, atan, pow
+    f64,
+    sin,
+    cos,
+    sin_cos,
+    tan,
+    sqrt,
+    exp,
+    log,
+    fabs,
+    atan2,
+    floor,
+    round,
+    asin,
+    acos,
+    atan,
+    pow,
+    6.055_454_452_393_343e-6 // 2^(-52/3)
 );
 impl_real!(
-    f32, sinf, cosf, sin_cosf, tanf, sqrtf, expf, logf, fabsf, atan2f, floorf, roundf, asinf,
-    acosf, atanf, powf
+    f32,
+    sinf,
+    cosf,
+    sin_cosf,
+    tanf,
+    sqrtf,
+    expf,
+    logf,
+    fabsf,
+    atan2f,
+    floorf,
+    roundf,
+    asinf,
+    acosf,
+    atanf,
+    powf,
+    4.921_566_4e-3 // 2^(-23/3)
 );

@@ -11,7 +11,8 @@ pub trait Integrator<T: Real, const N: usize> {
     const NAME: &'static str;
     /// Order of the global error: halving `dt` divides the error by `2^ORDER`.
     const ORDER: u32;
-    /// Acceleration evaluations per step.
+    /// Acceleration evaluations per step (for an implicit method: per Newton iteration, and
+    /// each step also evaluates one acceleration Jacobian).
     const EVALS_PER_STEP: u32;
 
     /// Advances `state` by `dt` (which may be negative, to integrate backwards).
@@ -64,13 +65,20 @@ pub trait Integrator<T: Real, const N: usize> {
 
 /// `dt` when it is finite and not zero and the state it is to step from is finite.
 pub(crate) fn check_step<T: Real, const N: usize>(s: &State<T, N>, dt: T) -> Result<T, Error> {
-    if !(dt.is_finite() && dt != T::zero()) {
-        return Err(Error::InvalidParameter {
+    let dt = check_dt(dt)?;
+    s.check_finite().map(|()| dt)
+}
+
+/// `dt` when it is finite and not zero.
+pub(crate) fn check_dt<T: Real>(dt: T) -> Result<T, Error> {
+    if dt.is_finite() && dt != T::zero() {
+        Ok(dt)
+    } else {
+        Err(Error::InvalidParameter {
             name: "dt",
             reason: "must be finite and not zero",
-        });
+        })
     }
-    s.check_finite().map(|()| dt)
 }
 
 /// The state a step produced, or [`Error::NonFiniteState`] when it blew up.

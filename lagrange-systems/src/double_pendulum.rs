@@ -1,5 +1,6 @@
 //! [`DoublePendulum`]: two point masses on two massless rods, a planar chain.
 
+use crate::small_solve::solve_sym2;
 use lagrange_core::nalgebra::{Matrix2, SVector, Vector2};
 use lagrange_core::{validate, Error, Lagrangian, Mechanism, Real, Scalar, State};
 
@@ -90,21 +91,6 @@ impl<T: Real> DoublePendulum<T> {
     }
 }
 
-/// Solves the symmetric 2x2 system `m x = b` by its closed-form inverse.
-fn solve_2x2<T: Real>(m: &Matrix2<T>, b: &Vector2<T>) -> Result<Vector2<T>, Error> {
-    let det = m[(0, 0)] * m[(1, 1)] - m[(0, 1)] * m[(1, 0)];
-    if !det.is_finite() {
-        return Err(Error::NonFiniteState);
-    }
-    if det <= T::zero() {
-        return Err(Error::SingularMassMatrix { pivot: 1 });
-    }
-    Ok(Vector2::new(
-        m[(1, 1)] * b[0] - m[(0, 1)] * b[1],
-        m[(0, 0)] * b[1] - m[(1, 0)] * b[0],
-    ) / det)
-}
-
 impl<T: Real> Mechanism<T, 2> for DoublePendulum<T> {
     fn mass_matrix(&self, s: &State<T, 2>) -> Matrix2<T> {
         self.terms(s).0
@@ -123,11 +109,11 @@ impl<T: Real> Mechanism<T, 2> for DoublePendulum<T> {
         -self.gravity * (mu * self.l1 * s.q[0].cos() + self.m2 * self.l2 * s.q[1].cos())
     }
     fn solve_mass(&self, s: &State<T, 2>, b: &Vector2<T>) -> Result<Vector2<T>, Error> {
-        solve_2x2(&self.mass_matrix(s), b)
+        solve_sym2(&self.mass_matrix(s), b)
     }
     fn acceleration(&self, s: &State<T, 2>) -> Result<Vector2<T>, Error> {
         let (m, f) = self.terms(s);
-        solve_2x2(&m, &f)
+        solve_sym2(&m, &f)
     }
 }
 

@@ -1,5 +1,6 @@
 //! Exact solutions used as references: the large-amplitude pendulum through Jacobi elliptic
-//! functions, computed by the arithmetic-geometric mean.
+//! functions, computed by the arithmetic-geometric mean; the damped oscillator
+//! ([`damped_oscillator`]); Kepler orbits through Kepler's equation ([`kepler_orbit`]).
 
 use lagrange_core::{validate, Error, Real};
 
@@ -108,3 +109,9 @@ pub fn pendulum_period<T: Real>(theta0: T, omega: T) -> Result<T, Error> {
     let k = (T::HALF * validate::finite("theta0", theta0)?).sin().abs();
     Ok(T::from_f64(4.0) * elliptic_k(k)? / omega)
 }
+
+mod damped_oscillator;
+mod kepler;
+
+pub use damped_oscillator::damped_oscillator;
+pub use kepler::{eccentric_anomaly, kepler_orbit};

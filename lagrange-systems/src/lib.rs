@@ -12,8 +12,28 @@
 //! | [`SimplePendulum`] | `[th]` | mass, length, gravity, damping |
 //! | [`BeadOnRotatingHoop`] | `[th]` | mass, radius, omega, gravity |
 //! | [`DoublePendulum`] | `[th1, th2]` | m1, m2, l1, l2, gravity |
+//! | [`NLinkPendulum`] | `[th1..thN]` | `masses: [T; N]`, `lengths: [T; N]`, gravity |
+//! | [`SpringMassDamper`] | `[x]` | mass, stiffness, damping |
+//! | [`ElasticPendulum`] | `[r, th]` | mass, stiffness, rest_length, gravity |
+//! | [`SphericalPendulum`] | `[th, phi]` | mass, length, gravity |
+//! | [`CartPole`] | `[x, th]`, th from the upward vertical | cart_mass, pole_mass, pole_half_length, gravity; input force |
+//! | [`Acrobot`] | `[th1, th2]`, th2 relative to link 1 | m1, m2, l1, l2, lc1, lc2, i1, i2, gravity; input torque |
+//! | [`SwingingAtwood`] | `[r, th]` | big_mass, small_mass, gravity |
+//! | [`Kepler`] | `[r, phi]` | mu |
 //!
-//! [`exact`] holds closed-form solutions used as references.
+//! Constrained mechanisms (Lagrange multipliers, see
+//! [`lagrange_core::constraints`]): each also implements
+//! [`Constraints`](lagrange_core::Constraints), hand-derived, and the generic form the dual
+//! numbers check it against; its `acceleration` includes the constraint forces.
+//!
+//! | type | q | constraints | parameters |
+//! |---|---|---|---|
+//! | [`CartesianPendulum`] | `[x, y]` | 1 holonomic: `x^2 + y^2 = l^2` | mass, length, gravity |
+//! | [`FourBarLinkage`] | `[th1, th2, th3]` | 2 holonomic: loop closure | 4 lengths, 3 masses, gravity |
+//! | [`RollingDisk`] | `[x, y, psi, phi]` | 2 Pfaffian: rolling without slipping | mass, radius |
+//!
+//! [`exact`] holds closed-form solutions used as references: the large-amplitude pendulum, the
+//! damped oscillator and Kepler orbits.
 //!
 //! ```
 //! use lagrange_core::{Mechanism, State};
@@ -27,13 +47,37 @@
 #![no_std]
 #![forbid(unsafe_code)]
 
+mod acrobot;
 mod bead_on_rotating_hoop;
+mod cart_pole;
+mod cartesian_pendulum;
 mod double_pendulum;
+mod elastic_pendulum;
 pub mod exact;
 mod falling_particle;
+mod four_bar_linkage;
+mod kepler;
+mod n_link_pendulum;
+mod rolling_disk;
 mod simple_pendulum;
+mod small_solve;
+mod spherical_pendulum;
+mod spring_mass_damper;
+mod swinging_atwood;
 
 pub use bead_on_rotating_hoop::BeadOnRotatingHoop;
+pub use cartesian_pendulum::CartesianPendulum;
 pub use double_pendulum::DoublePendulum;
 pub use falling_particle::FallingParticle;
+pub use four_bar_linkage::{Branch, FourBarLinkage};
+pub use rolling_disk::RollingDisk;
 pub use simple_pendulum::SimplePendulum;
+
+pub use acrobot::Acrobot;
+pub use cart_pole::CartPole;
+pub use elastic_pendulum::ElasticPendulum;
+pub use kepler::Kepler;
+pub use n_link_pendulum::NLinkPendulum;
+pub use spherical_pendulum::SphericalPendulum;
+pub use spring_mass_damper::SpringMassDamper;
+pub use swinging_atwood::SwingingAtwood;

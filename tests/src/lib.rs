@@ -3,6 +3,10 @@
 
 use lagrange_core::{Real, State};
 
+mod agreement;
+
+pub use agreement::{agrees_with_automatic, random_state, relative, Agreement, Scales};
+
 /// A small, seeded, reproducible generator (SplitMix64), so that random-state tests are the
 /// same on every run and every machine.
 pub struct Rng(u64);
@@ -87,3 +91,14 @@ macro_rules! for_f32_and_f64 {
 #[cfg(doctest)]
 #[doc = include_str!("../../README.md")]
 pub struct ReadmeDoctests;
+
+/// Problem P4's start: `mu = 1`, `e = 0.5`, `a = 1` (period `2 pi`, energy -1/2), at
+/// periapsis: `r = 0.5`, `phi = 0`, `r' = 0`, `phi' = 2 sqrt(3)`.
+#[must_use]
+pub fn kepler_periapsis<T: Real>() -> State<T, 2> {
+    State::new(
+        T::zero(),
+        [T::HALF, T::zero()],
+        [T::zero(), T::from_f64(2.0 * 3.0f64.sqrt())],
+    )
+}

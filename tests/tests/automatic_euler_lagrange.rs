@@ -1,9 +1,9 @@
 //! Every hand-derived system agrees with the automatic Euler-Lagrange path (dual numbers) at
 //! 1,000 random states and random valid parameters.
 
-use lagrange_core::{Error, EulerLagrange, Lagrangian, Mechanism, Real, State};
+use lagrange_core::{Error, Lagrangian, Mechanism, Real};
 use lagrange_systems::{BeadOnRotatingHoop, DoublePendulum, FallingParticle, SimplePendulum};
-use lagrange_tests::{for_f32_and_f64, pick, Rng};
+use lagrange_tests::{agrees_with_automatic, for_f32_and_f64, pick, random_state, Rng, Scales};
 
 const STATES: usize = 1000;
 
@@ -15,50 +15,22 @@ fn tolerance<T: Real>() -> f64 {
     pick::<T>(5e-6, 1e-12)
 }
 
-/// `|a - b|_inf / (|a|_inf + scale)`: relative, with `scale` the system's natural size of the
-/// quantity so that a state where it happens to vanish is not judged on rounding alone.
-fn relative<T: Real>(
-    a: impl IntoIterator<Item = T>,
-    b: impl IntoIterator<Item = T>,
-    scale: f64,
-) -> f64 {
-    let (mut diff, mut size) = (0.0f64, 0.0f64);
-    for (x, y) in a.into_iter().zip(b) {
-        diff = diff.max((x - y).abs().to_f64());
-        size = size.max(x.abs().to_f64());
-    }
-    diff / (size + scale)
-}
-
-/// Compares `hand` with `EulerLagrange::new(hand)` at `STATES` random states from `state`;
-/// `scale` is a natural acceleration of the system (e.g. g / l).
+/// Compares `hand` with `EulerLagrange::new(hand)` at `STATES` random states (angles in
+/// (-3.2, 3.2), rates in (-5, 5)); `scale` is a natural acceleration of the system (e.g. g / l),
+/// also used as the energy scale.
 fn agree<T, S, const N: usize>(hand: &S, scale: f64, rng: &mut Rng) -> Result<(), Error>
 where
     T: Real,
     S: Mechanism<T, N> + Lagrangian<T, N> + Clone,
 {
-    let auto = EulerLagrange::new(hand.clone());
-    let tol = tolerance::<T>();
-    for _ in 0..STATES {
-        let q: [T; N] = core::array::from_fn(|_| rng.uniform(-3.2, 3.2));
-        let qd: [T; N] = core::array::from_fn(|_| rng.uniform(-5.0, 5.0));
-        let s = State::new(rng.uniform(0.0, 10.0), q, qd);
-        let (a, b) = (hand.acceleration(&s)?, auto.acceleration(&s)?);
-        let e = relative(a.iter().copied(), b.iter().copied(), scale);
-        assert!(
-            e < tol,
-            "acceleration at {s:?}: hand {a:?} auto {b:?} ({e:e})"
-        );
-        let (ma, mb) = (hand.mass_matrix(&s), auto.mass_matrix(&s));
-        let e = relative(ma.iter().copied(), mb.iter().copied(), 0.0);
-        assert!(
-            e < tol,
-            "mass matrix at {s:?}: hand {ma:?} auto {mb:?} ({e:e})"
-        );
-        let e = relative([hand.energy(&s)], [auto.energy(&s)], scale);
-        assert!(e < tol, "energy at {s:?} ({e:e})");
-    }
-    Ok(())
+    let scale = Scales {
+        acceleration: scale,
+        energy: scale,
+    };
+    agrees_with_automatic(hand, scale, tolerance::<T>(), STATES, rng, |r| {
+        random_state(r, (-3.2, 3.2), (-5.0, 5.0))
+    })
+    .map(|_| ())
 }
 
 fn double_pendulum<T: Real>() -> Result<(), Error> {

@@ -4,7 +4,10 @@ use lagrange_core::nalgebra::SVector;
 use lagrange_core::{
     Error, EulerLagrange, Lagrangian, Mechanism, Real, Scalar, State, ViscousDamping,
 };
-use lagrange_integrators::{ExplicitEuler, Integrator, Rk4, SemiImplicitEuler, VelocityVerlet};
+use lagrange_integrators::{
+    BackwardEuler, ExplicitEuler, GaussLegendre2, ImplicitMidpoint, Integrator, RadauIIA2, Rk4,
+    SemiImplicitEuler, StormerVerlet, VariationalMidpoint, VelocityVerlet, Yoshida4,
+};
 use lagrange_systems::exact::{jacobi_sn_cn, pendulum_from_rest};
 use lagrange_systems::{BeadOnRotatingHoop, DoublePendulum, FallingParticle, SimplePendulum};
 use lagrange_tests::for_f32_and_f64;
@@ -94,7 +97,43 @@ fn integrators_refuse_bad_states_and_steps<T: Real>() -> Result<(), Error> {
     check_integrator::<T, _>(ExplicitEuler)?;
     check_integrator::<T, _>(SemiImplicitEuler)?;
     check_integrator::<T, _>(VelocityVerlet)?;
-    check_integrator::<T, _>(Rk4)
+    check_integrator::<T, _>(Rk4)?;
+    check_integrator::<T, _>(StormerVerlet::default())?;
+    check_integrator::<T, _>(Yoshida4::<StormerVerlet<T, 2>>::default())?;
+    check_integrator::<T, _>(ImplicitMidpoint::default())?;
+    check_integrator::<T, _>(GaussLegendre2::default())?;
+    check_integrator::<T, _>(BackwardEuler::default())?;
+    check_integrator::<T, _>(RadauIIA2::default())?;
+    check_variational::<T>()
+}
+
+/// The variational integrator, which steps a Lagrangian rather than any mechanism, refuses
+/// the same states and steps.
+fn check_variational<T: Real>() -> Result<(), Error> {
+    let one = T::one();
+    let dp = EulerLagrange::new(DoublePendulum::new(one, one, one, one, T::from_f64(9.81))?);
+    let nan = T::from_f64(f64::NAN);
+    let mut vi = VariationalMidpoint::default();
+    let good = State::new(T::zero(), [T::HALF, T::zero()], [T::zero(); 2]);
+    for bad in [
+        State::new(T::zero(), [nan, T::zero()], [T::zero(); 2]),
+        State::new(T::zero(), [T::zero(); 2], [T::INFINITY, T::zero()]),
+        State::new(nan, [T::zero(); 2], [T::zero(); 2]),
+    ] {
+        assert_eq!(
+            vi.step(&dp, &bad, T::from_f64(1e-3)),
+            Err(Error::NonFiniteState)
+        );
+        assert_eq!(
+            vi.integrate(&dp, &bad, T::from_f64(1e-3), 3),
+            Err(Error::NonFiniteState)
+        );
+    }
+    for dt in [T::zero(), nan, T::INFINITY] {
+        refuses(vi.step(&dp, &good, dt), "dt");
+    }
+    vi.step(&dp, &good, -T::from_f64(1e-3))?;
+    Ok(())
 }
 
 /// A unit mass on a spring of stiffness `k`, through the automatic path.

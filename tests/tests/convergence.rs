@@ -1,8 +1,11 @@
 //! Measured order of convergence of every fixed-step integrator: the slope of log(error)
 //! against log(dt) must be within 0.2 of the stated order (f64).
 
-use lagrange_core::{Error, Mechanism, State};
-use lagrange_integrators::{ExplicitEuler, Integrator, Rk4, SemiImplicitEuler, VelocityVerlet};
+use lagrange_core::{Error, EulerLagrange, Lagrangian, Mechanism, State};
+use lagrange_integrators::{
+    BackwardEuler, ExplicitEuler, GaussLegendre2, ImplicitMidpoint, Integrator, RadauIIA2, Rk4,
+    SemiImplicitEuler, StormerVerlet, VariationalMidpoint, VelocityVerlet, Yoshida4,
+};
 use lagrange_systems::exact::pendulum_from_rest;
 use lagrange_systems::{DoublePendulum, SimplePendulum};
 use lagrange_tests::{fitted_order, state_error};
@@ -19,24 +22,70 @@ fn measured_order<I: Integrator<f64, N> + Default, M: Mechanism<f64, N>, const N
     reference: &[f64],
     dts: &[f64],
 ) -> Result<f64, Error> {
+    order_of(I::NAME, I::ORDER, reference, dts, |dt, steps| {
+        I::default().integrate(m, start, dt, steps)
+    })
+}
+
+/// The fitted order of `run(dt, steps)` (the state at `T_END`) against `reference`, asserted
+/// within [`ORDER_TOLERANCE`] of `stated`.
+fn order_of<const N: usize>(
+    name: &str,
+    stated: u32,
+    reference: &[f64],
+    dts: &[f64],
+    mut run: impl FnMut(f64, u64) -> Result<State<f64, N>, Error>,
+) -> Result<f64, Error> {
     let mut errs = Vec::new();
     for &dt in dts {
-        let end = I::default().integrate(m, start, dt, (T_END / dt).round() as u64)?;
+        let end = run(dt, (T_END / dt).round() as u64)?;
         errs.push(state_error(&end, reference));
     }
     let order = fitted_order(dts, &errs);
     println!(
-        "{:<20} errors {errs:?} -> order {order:.3} (stated {})",
-        I::NAME,
-        I::ORDER
+        "{name:<20} errors {:?} -> order {order:.3} (stated {stated})",
+        errs.iter().map(|e| format!("{e:.3e}")).collect::<Vec<_>>()
     );
     assert!(
-        (order - f64::from(I::ORDER)).abs() < ORDER_TOLERANCE,
-        "{}: measured order {order}, stated {}",
-        I::NAME,
-        I::ORDER
+        (order - f64::from(stated)).abs() < ORDER_TOLERANCE,
+        "{name}: measured order {order}, stated {stated}"
     );
     Ok(order)
+}
+
+/// The variational integrator's order: it needs the Lagrangian, so it runs on the automatic
+/// path of the same mechanism.
+fn variational_order<L: Lagrangian<f64, N>, const N: usize>(
+    l: L,
+    start: &State<f64, N>,
+    reference: &[f64],
+    dts: &[f64],
+) -> Result<f64, Error> {
+    let m = EulerLagrange::new(l);
+    order_of("variational midpoint", 2, reference, dts, |dt, steps| {
+        VariationalMidpoint::default().integrate(&m, start, dt, steps)
+    })
+}
+
+/// The orders of the symmetric, implicit and variational methods.
+fn structure_preserving_orders<L, const N: usize>(
+    l: L,
+    start: &State<f64, N>,
+    r: &[f64],
+    dt2: f64,
+    dt4: f64,
+) -> Result<(), Error>
+where
+    L: Lagrangian<f64, N> + Mechanism<f64, N> + Copy,
+{
+    measured_order::<StormerVerlet<f64, N>, _, N>(&l, start, r, &halvings(dt2))?;
+    measured_order::<Yoshida4<StormerVerlet<f64, N>>, _, N>(&l, start, r, &halvings(dt4))?;
+    measured_order::<ImplicitMidpoint<f64>, _, N>(&l, start, r, &halvings(dt2))?;
+    measured_order::<GaussLegendre2<f64>, _, N>(&l, start, r, &halvings(dt4))?;
+    measured_order::<BackwardEuler<f64>, _, N>(&l, start, r, &halvings(1e-3))?;
+    measured_order::<RadauIIA2<f64>, _, N>(&l, start, r, &halvings(dt4))?;
+    variational_order(l, start, r, &halvings(dt2))?;
+    Ok(())
 }
 
 /// Step sizes halving from `dt0`, four of them: coarse enough to stay above rounding, fine
@@ -58,7 +107,7 @@ fn orders_on_the_pendulum() -> Result<(), Error> {
     measured_order::<SemiImplicitEuler, _, 1>(&p, &start, &r, &halvings(1e-3))?;
     measured_order::<VelocityVerlet, _, 1>(&p, &start, &r, &halvings(1e-2))?;
     measured_order::<Rk4, _, 1>(&p, &start, &r, &halvings(5e-2))?;
-    Ok(())
+    structure_preserving_orders(p, &start, &r, 1e-2, 5e-2)
 }
 
 /// A regular (non-chaotic) double pendulum start, where the accelerations depend on the
@@ -74,5 +123,5 @@ fn orders_on_the_double_pendulum() -> Result<(), Error> {
     measured_order::<SemiImplicitEuler, _, 2>(&dp, &start, &r, &halvings(1e-3))?;
     measured_order::<VelocityVerlet, _, 2>(&dp, &start, &r, &halvings(1e-2))?;
     measured_order::<Rk4, _, 2>(&dp, &start, &r, &halvings(4e-2))?;
-    Ok(())
+    structure_preserving_orders(dp, &start, &r, 1e-2, 4e-2)
 }

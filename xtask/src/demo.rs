@@ -8,7 +8,6 @@ use lagrange_integrators::{ExplicitEuler, Integrator, Rk4, SemiImplicitEuler, Ve
 use lagrange_systems::exact::pendulum_from_rest;
 use lagrange_systems::{DoublePendulum, SimplePendulum};
 use std::hint::black_box;
-use std::time::Instant;
 
 /// The origin's pendulum: L = 1 m, g = 9.81 m/s^2, released at rest from 30 degrees.
 const G: f64 = 9.81;
@@ -19,7 +18,7 @@ const TABLE_TIMES: [f64; 4] = [2.5, 5.0, 7.5, 10.0];
 /// Points kept per run for the plot.
 const PLOT_POINTS: u64 = 1000;
 /// Timing: the median of this many whole runs.
-const TIMING_RUNS: usize = 5;
+pub(crate) const TIMING_RUNS: usize = 5;
 
 /// Problem P2 of shared/BENCH_PROBLEMS.md: both angles pi/2 at rest, T = 10 s; its state at
 /// T from a 1e-27 reference solve (th1, th2, th1', th2').
@@ -32,7 +31,7 @@ const P2_REFERENCE: [f64; 4] = [
 ];
 
 /// Median wall time per step of `steps` steps, over `TIMING_RUNS` whole runs.
-fn ns_per_step<T, I, M, const N: usize>(
+pub(crate) fn ns_per_step<T, I, M, const N: usize>(
     mut integrator: I,
     mechanism: &M,
     start: &State<T, N>,
@@ -44,16 +43,9 @@ where
     I: Integrator<T, N>,
     M: Mechanism<T, N>,
 {
-    let mut times: Vec<f64> = (0..TIMING_RUNS)
-        .map(|_| {
-            let clock = Instant::now();
-            let _ =
-                black_box(integrator.integrate(black_box(mechanism), black_box(start), dt, steps));
-            clock.elapsed().as_secs_f64() * 1e9 / steps as f64
-        })
-        .collect();
-    times.sort_by(f64::total_cmp);
-    times[TIMING_RUNS / 2]
+    crate::demo_integrators::median_ns(steps, || {
+        integrator.integrate(black_box(mechanism), black_box(start), dt, steps)
+    })
 }
 
 /// RK4's cost per step on the pendulum and the double pendulum in `T`.
@@ -306,5 +298,7 @@ pub fn run() -> Result<(), String> {
     let path = dir.join("pendulum.svg");
     std::fs::write(&path, doc).map_err(|e| e.to_string())?;
     println!("\nPlot: {}", path.display());
-    Ok(())
+    crate::demo_systems::run()?;
+    crate::demo_integrators::run()?;
+    crate::demo_constraints::run()
 }

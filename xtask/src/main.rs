@@ -1,7 +1,9 @@
 //! `cargo xtask`: the project's automation, in Rust so that it runs wherever cargo does.
 //!
 //! - `demo`: the origin's pendulum and a double pendulum with every integrator, a table and an
-//!   SVG plot under `target/lagrange-demo/`.
+//!   SVG plot under `target/lagrange-demo/`; then every standard mechanism (energy error and
+//!   cost per step and per acceleration), the chain's cost against N, and the Kepler orbit;
+//!   then a constrained and a colliding scene with their plots.
 //! - `test`: host tests of every crate, f32 and f64, the long runs (`#[ignore]`d) in release.
 //! - `cross`: thumbv7em-none-eabihf builds of the library crates, with and without `defmt`,
 //!   and a linked no_std binary with no allocator, with its size.
@@ -15,6 +17,9 @@
 mod cmd;
 mod cross;
 mod demo;
+mod demo_constraints;
+mod demo_integrators;
+mod demo_systems;
 mod qemu;
 mod svg;
 mod trig_fit;

@@ -1,0 +1,131 @@
+//! [`Projection`]: a state moved back onto `phi = 0` and `J q' = 0`, mass-weighted.
+
+use super::{max_abs, Constraints, Schur};
+use crate::{validate, Error, Mechanism, Real, State};
+use nalgebra::SVector;
+
+/// Projection of a state onto its constraints after a step: positions by bounded Newton
+/// iterations, then velocities exactly, both in the metric of the mass matrix:
+///
+/// ```text
+/// repeat while max |phi_i(q)| > tolerance (at most max_iterations times):
+///     q  <- q  - M^-1 J^T (J M^-1 J^T)^-1 phi(q)        J, M at the current q
+/// then
+///     q' <- q' - M^-1 J^T (J M^-1 J^T)^-1 J q'          J, M at the final q
+/// ```
+///
+/// Each correction is the smallest in kinetic-energy norm that removes the residual to first
+/// order, so projection changes the motion as little as possible; the velocity step is an
+/// `M`-orthogonal projection, so it never adds kinetic energy. Newton converges
+/// quadratically: after one integrator step the residual is the step's truncation error and
+/// one iteration (often none) brings it below the tolerance. Pfaffian rows (zero `phi`) take
+/// part in the velocity step and keep their linearised `A dq = 0` in the position step.
+///
+/// `tolerance` is in the units of `phi`; choose it above the rounding level of `phi` (about
+/// `EPSILON` times its largest term), or Newton cannot reach it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Projection<T> {
+    tolerance: T,
+    max_iterations: u32,
+}
+
+impl<T: Real> Projection<T> {
+    /// Newton on positions until `max_i |phi_i| <= tolerance` (> 0), in at most
+    /// `max_iterations` (>= 1) iterations.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] `tolerance` when not positive and finite,
+    /// `max_iterations` when zero.
+    pub fn new(tolerance: T, max_iterations: u32) -> Result<Self, Error> {
+        if max_iterations == 0 {
+            return Err(Error::InvalidParameter {
+                name: "max_iterations",
+                reason: "must be at least 1",
+            });
+        }
+        Ok(Self {
+            tolerance: validate::positive("tolerance", tolerance)?,
+            max_iterations,
+        })
+    }
+
+    /// The position tolerance.
+    #[must_use]
+    pub fn tolerance(&self) -> T {
+        self.tolerance
+    }
+
+    /// The most Newton iterations per projection.
+    #[must_use]
+    pub fn max_iterations(&self) -> u32 {
+        self.max_iterations
+    }
+
+    /// `state` projected onto every row of `constraints`, mass-weighted by `mechanism`.
+    ///
+    /// # Errors
+    /// As [`Projection::project_rows`].
+    pub fn project<M, K, const N: usize, const C: usize>(
+        &self,
+        mechanism: &M,
+        constraints: &K,
+        state: &State<T, N>,
+    ) -> Result<State<T, N>, Error>
+    where
+        M: Mechanism<T, N>,
+        K: Constraints<T, N, C>,
+    {
+        self.project_rows(mechanism, constraints, state, &[true; C])
+    }
+
+    /// `state` projected onto the rows of `constraints` marked `active` (the others are left
+    /// free), mass-weighted by `mechanism`.
+    ///
+    /// # Errors
+    /// [`Error::NoConvergence`] when the position residual is still above the tolerance after
+    /// `max_iterations`; [`Error::RedundantConstraints`] at dependent or singular rows;
+    /// [`Error::NonFiniteState`]; whatever [`Mechanism::solve_mass`] returns.
+    pub fn project_rows<M, K, const N: usize, const C: usize>(
+        &self,
+        mechanism: &M,
+        constraints: &K,
+        state: &State<T, N>,
+        active: &[bool; C],
+    ) -> Result<State<T, N>, Error>
+    where
+        M: Mechanism<T, N>,
+        K: Constraints<T, N, C>,
+    {
+        let mut s = *state;
+        let mut iterations = 0;
+        loop {
+            let phi = masked(constraints.position_residual(&s.q), active);
+            let worst = max_abs(&phi);
+            if !worst.is_finite() {
+                return Err(Error::NonFiniteState);
+            }
+            let schur = Schur::new(mechanism, constraints, &s, active)?;
+            if worst <= self.tolerance {
+                let w = schur.jacobian() * s.qd;
+                s.qd -= schur.correction(&w);
+                return s.check_finite().map(|()| s);
+            }
+            if iterations == self.max_iterations {
+                return Err(Error::NoConvergence { iterations });
+            }
+            s.q -= schur.correction(&phi);
+            iterations += 1;
+        }
+    }
+}
+
+/// `v` with the entries of inactive rows set to zero.
+fn masked<T: Real, const C: usize>(mut v: SVector<T, C>, active: &[bool; C]) -> SVector<T, C> {
+    for (x, &on) in v.iter_mut().zip(active) {
+        if !on {
+            *x = T::zero();
+        }
+    }
+    v
+}

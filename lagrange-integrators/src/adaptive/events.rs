@@ -1,0 +1,253 @@
+//! Dense output of the adaptive integrators (the continuous extension between the last two
+//! accepted points) and event location by root finding on it.
+
+use super::embedded::{combine, real, EmbeddedPair, EmbeddedRungeKutta};
+use lagrange_core::nalgebra::SVector;
+use lagrange_core::{Error, Mechanism, Real, State};
+
+/// Why [`EmbeddedRungeKutta::integrate_until_event`] stopped.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Stop<T: Real, const N: usize> {
+    /// The guard changed sign: the state at the located time.
+    Event(State<T, N>),
+    /// The end time was reached without an event: the state there.
+    End(State<T, N>),
+}
+
+impl<T: Real, const N: usize> Stop<T, N> {
+    /// The state where the integration stopped, whatever the reason.
+    #[must_use]
+    pub fn state(&self) -> &State<T, N> {
+        match self {
+            Self::Event(s) | Self::End(s) => s,
+        }
+    }
+}
+
+#[cfg(feature = "defmt")]
+impl<T: Real, const N: usize> defmt::Format for Stop<T, N> {
+    fn format(&self, f: defmt::Formatter<'_>) {
+        match self {
+            Self::Event(s) => defmt::write!(f, "Event({})", s),
+            Self::End(s) => defmt::write!(f, "End({})", s),
+        }
+    }
+}
+
+/// Root-finding iterations allowed per event (the Illinois method needs ~10 to rounding).
+const MAX_ROOT_ITERATIONS: u32 = 200;
+
+/// `g` when it is not NaN.
+fn checked_guard<T: Real>(g: T) -> Result<T, Error> {
+    if g.partial_cmp(&T::zero()).is_none() {
+        Err(Error::InvalidParameter {
+            name: "guard",
+            reason: "returned NaN",
+        })
+    } else {
+        Ok(g)
+    }
+}
+
+/// True when `g` went from `g0` (not zero) to `g1` through zero.
+fn crossed<T: Real>(g0: T, g1: T) -> bool {
+    g0 != T::zero() && (g1 == T::zero() || (g0 < T::zero()) != (g1 < T::zero()))
+}
+
+impl<T, const N: usize, const S: usize, const R: usize, P> EmbeddedRungeKutta<T, N, S, R, P>
+where
+    T: Real,
+    P: EmbeddedPair<S, R>,
+{
+    /// Computes the dense coefficients of the last step, evaluating its extra stages.
+    fn prepare_dense<M: Mechanism<T, N>>(&mut self, m: &M) -> Result<(), Error> {
+        if self.hermite.is_some() {
+            return Ok(());
+        }
+        let (y0, h) = (self.previous, self.h_last);
+        for i in P::FSAL + 1..S {
+            let s = self.stage_state(&y0, h, i);
+            self.kq[i] = s.qd;
+            self.kv[i] = self.eval(m, &s)?;
+        }
+        // The step's end, recomputed from the stages (a state cut by an event is not it).
+        let y1 = self.stage_state(&y0, h, P::FSAL);
+        let hermite = |dy: SVector<T, N>, k0: SVector<T, N>, k1: SVector<T, N>| {
+            let c3 = k0 * h - dy;
+            [dy, c3, dy - k1 * h - c3]
+        };
+        let f = P::FSAL;
+        self.hermite = Some((
+            hermite(y1.q - y0.q, self.kq[0], self.kq[f]),
+            hermite(y1.qd - y0.qd, self.kv[0], self.kv[f]),
+        ));
+        for (r, row) in P::DENSE.iter().enumerate() {
+            self.rows_q[r] = combine(row, &self.kq) * h;
+            self.rows_v[r] = combine(row, &self.kv) * h;
+        }
+        Ok(())
+    }
+
+    /// The continuous extension at `t` (inside the last step), from prepared coefficients:
+    ///
+    /// ```text
+    /// y(t0 + s h) = y0 + s (d1 + (1-s) (d2 + s (d3 + (1-s) (d4 + s (d5 + ...)))))
+    /// ```
+    fn evaluate_dense(&self, t: T) -> State<T, N> {
+        let (y0, h) = (self.previous, self.h_last);
+        let s = (t - y0.t) / h;
+        let s1 = T::one() - s;
+        let weight = |i: usize| if i % 2 == 0 { s } else { s1 };
+        let fold = |hermite: &[SVector<T, N>; 3], rows: &[SVector<T, N>; R]| {
+            let mut acc = SVector::<T, N>::zeros();
+            for (r, row) in rows.iter().enumerate().rev() {
+                acc = (row + acc) * weight(r + 3);
+            }
+            for (i, c) in hermite.iter().enumerate().rev() {
+                acc = (c + acc) * weight(i);
+            }
+            acc
+        };
+        match &self.hermite {
+            Some((hq, hv)) => State {
+                t,
+                q: y0.q + fold(hq, &self.rows_q),
+                qd: y0.qd + fold(hv, &self.rows_v),
+            },
+            None => self.state,
+        }
+    }
+
+    /// The interval `[t0, t1]` that [`EmbeddedRungeKutta::dense_output`] can sample: the
+    /// last accepted step (up to an event that cut it short), `None` before any step.
+    #[must_use]
+    pub fn dense_interval(&self) -> Option<(T, T)> {
+        (self.h_last > T::zero()).then_some((self.previous.t, self.dense_end))
+    }
+
+    /// The state at time `t` between the last two accepted points (from the start of the
+    /// last step to the current time), by the method's continuous extension (order 4 for
+    /// Dormand-Prince 5(4), 7 for DOP853, which evaluates 3 more stages once per step for it).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] `t` when outside that interval or before any step;
+    /// whatever [`Mechanism::acceleration`] returns.
+    pub fn dense_output<M: Mechanism<T, N>>(
+        &mut self,
+        mechanism: &M,
+        t: T,
+    ) -> Result<State<T, N>, Error> {
+        if !(self.h_last > T::zero() && t >= self.previous.t && t <= self.dense_end) {
+            return Err(Error::InvalidParameter {
+                name: "t",
+                reason: "must lie within the last accepted step",
+            });
+        }
+        if t == self.dense_end {
+            return Ok(self.state);
+        }
+        self.prepare_dense(mechanism)?;
+        Ok(self.evaluate_dense(t))
+    }
+
+    /// Steps towards `t_end` until `guard(state)` changes sign, locates the time of the
+    /// change on the dense output (the Illinois variant of regula falsi, to
+    /// [`AdaptiveSettings::event_tolerance`](super::AdaptiveSettings::event_tolerance) or to
+    /// rounding), and stops there: the integrator's state becomes the one at the event, and
+    /// the next call continues from it.
+    ///
+    /// The guard is a function `g(t, q, q')` of the state. A sign change is a step from a
+    /// non-zero value to zero or to the opposite sign; the located time is the first one known
+    /// to be past the change (`g` there is zero or has the new sign), so continuing does not
+    /// report the same event again. Events in which `g` touches zero or crosses twice within
+    /// one step are not seen: bound the step ([`with_step_bounds`](super::AdaptiveSettings::with_step_bounds)) below
+    /// the shortest interval between sign changes.
+    ///
+    /// # Errors
+    /// As [`EmbeddedRungeKutta::integrate_to`]; [`Error::InvalidParameter`] `guard` when it
+    /// returns NaN.
+    pub fn integrate_until_event<M, G>(
+        &mut self,
+        mechanism: &M,
+        t_end: T,
+        mut guard: G,
+    ) -> Result<Stop<T, N>, Error>
+    where
+        M: Mechanism<T, N>,
+        G: FnMut(&State<T, N>) -> T,
+    {
+        let t_end = self.check_end(t_end)?;
+        let mut g0 = checked_guard(guard(&self.state))?;
+        let mut steps = 0;
+        while self.state.t < t_end {
+            if steps == self.settings.max_steps() {
+                return Err(Error::TooManySteps { steps });
+            }
+            self.advance(mechanism, Some(t_end))?;
+            steps += 1;
+            let g1 = checked_guard(guard(&self.state))?;
+            if crossed(g0, g1) {
+                if g1 != T::zero() {
+                    let t = self.locate(mechanism, &mut guard, g0, g1)?;
+                    self.state = self.evaluate_dense(t);
+                    self.dense_end = t;
+                    self.derivative = None;
+                }
+                return Ok(Stop::Event(self.state));
+            }
+            g0 = g1;
+        }
+        Ok(Stop::End(self.state))
+    }
+
+    /// The time of the sign change of `guard` within the last step, given its values at
+    /// both ends.
+    fn locate<M, G>(&mut self, m: &M, guard: &mut G, g0: T, g1: T) -> Result<T, Error>
+    where
+        M: Mechanism<T, N>,
+        G: FnMut(&State<T, N>) -> T,
+    {
+        self.prepare_dense(m)?;
+        let (mut a, mut ga) = (self.previous.t, g0);
+        let (mut b, mut gb) = (self.state.t, g1);
+        let tolerance = self
+            .settings
+            .event_tolerance()
+            .max(real::<T>(4.0) * T::EPSILON * b.abs());
+        // Which end moved last: the Illinois method halves the other end's value when the
+        // same end moves twice, so both ends converge.
+        let mut moved_b = None;
+        for _ in 0..MAX_ROOT_ITERATIONS {
+            if b - a <= tolerance {
+                break;
+            }
+            let mut c = b - gb * (b - a) / (gb - ga);
+            if !(c > a && c < b) {
+                c = a + (b - a) * T::HALF;
+                if !(c > a && c < b) {
+                    break;
+                }
+            }
+            let gc = checked_guard(guard(&self.evaluate_dense(c)))?;
+            if gc == T::zero() {
+                return Ok(c);
+            }
+            if (gc < T::zero()) == (gb < T::zero()) {
+                b = c;
+                gb = gc;
+                if moved_b == Some(true) {
+                    ga *= T::HALF;
+                }
+                moved_b = Some(true);
+            } else {
+                a = c;
+                ga = gc;
+                if moved_b == Some(false) {
+                    gb *= T::HALF;
+                }
+                moved_b = Some(false);
+            }
+        }
+        Ok(b)
+    }
+}

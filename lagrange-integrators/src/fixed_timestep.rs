@@ -1,0 +1,176 @@
+//! [`FixedTimestep`]: steps a mechanism at a fixed `dt` from variable frame times, with a cap
+//! on the steps per frame and state interpolation for rendering.
+
+use crate::Integrator;
+use lagrange_core::{Error, Mechanism, Real, State};
+
+/// What one frame did.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Frame<T> {
+    /// Fixed steps taken.
+    pub steps: u32,
+    /// Simulated time given up because the frame needed more steps than the cap (zero in a
+    /// frame that kept up): the simulation runs slower than real time instead of spiralling.
+    pub dropped: T,
+}
+
+/// Whole steps of the accumulated time are taken when within this many epsilons of a step,
+/// so that frame times equal to `dt` give one step per frame despite rounding.
+const STEP_SLACK_EPS: f64 = 64.0;
+
+/// The fixed-timestep loop of a game or a real-time controller: frame times of any length
+/// accumulate, the mechanism advances in steps of exactly `dt` (so that its behaviour does not
+/// depend on the frame rate), and the state to draw is interpolated between the last two steps
+/// by the fraction of a step left over.
+///
+/// ```text
+/// accumulator += frame_time
+/// while accumulator >= dt and steps < max_steps_per_frame: step; accumulator -= dt
+/// beyond the cap, whole steps of the accumulator are dropped (reported in Frame::dropped)
+/// drawn state = previous + alpha (current - previous),   alpha = accumulator / dt in [0, 1]
+/// ```
+///
+/// The cap keeps a slow frame from demanding more steps than the next frame can afford (the
+/// spiral of death): the simulation falls behind real time instead.
+///
+/// ```
+/// use lagrange_core::State;
+/// use lagrange_integrators::{FixedTimestep, StormerVerlet};
+/// use lagrange_systems::SimplePendulum;
+/// let p = SimplePendulum::new(1.0_f64, 1.0, 9.81, 0.0)?;
+/// let mut sim = FixedTimestep::new(StormerVerlet::default(), 0.01, 8, State::at_rest([0.5]))?;
+/// let frame = sim.advance(&p, 0.025)?; // two steps, half a step left over
+/// assert_eq!(frame.steps, 2);
+/// assert!((sim.alpha() - 0.5).abs() < 1e-12);
+/// // Drawn half way between the steps at 0.01 s and 0.02 s: one step behind real time.
+/// let drawn = sim.interpolated();
+/// assert!((drawn.t - 0.015).abs() < 1e-12);
+/// # Ok::<(), lagrange_core::Error>(())
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FixedTimestep<T: Real, const N: usize, I> {
+    integrator: I,
+    dt: T,
+    max_steps_per_frame: u32,
+    accumulator: T,
+    previous: State<T, N>,
+    current: State<T, N>,
+}
+
+impl<T: Real, const N: usize, I: Integrator<T, N>> FixedTimestep<T, N, I> {
+    /// Steps of `dt` (positive, finite) by `integrator` from `start`, at most
+    /// `max_steps_per_frame` (at least 1) per frame.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] `dt` or `max_steps_per_frame`; [`Error::NonFiniteState`]
+    /// for a non-finite `start`.
+    pub fn new(
+        integrator: I,
+        dt: T,
+        max_steps_per_frame: u32,
+        start: State<T, N>,
+    ) -> Result<Self, Error> {
+        let dt = lagrange_core::validate::positive("dt", dt)?;
+        if max_steps_per_frame == 0 {
+            return Err(Error::InvalidParameter {
+                name: "max_steps_per_frame",
+                reason: "must be at least 1",
+            });
+        }
+        start.check_finite()?;
+        Ok(Self {
+            integrator,
+            dt,
+            max_steps_per_frame,
+            accumulator: T::zero(),
+            previous: start,
+            current: start,
+        })
+    }
+
+    /// Adds `frame_time` (zero or positive, finite) to the accumulated time and takes the
+    /// fixed steps it pays for, up to the cap.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] `frame_time`; the first error of a step, after which the
+    /// current state is the last good one and the failed step's time stays accumulated.
+    pub fn advance<M: Mechanism<T, N>>(
+        &mut self,
+        mechanism: &M,
+        frame_time: T,
+    ) -> Result<Frame<T>, Error> {
+        lagrange_core::validate::non_negative("frame_time", frame_time)?;
+        self.accumulator += frame_time;
+        let threshold = self.dt * (T::one() - T::from_f64(STEP_SLACK_EPS) * T::EPSILON);
+        let mut steps = 0;
+        while self.accumulator >= threshold && steps < self.max_steps_per_frame {
+            let next = self.integrator.step(mechanism, &self.current, self.dt)?;
+            self.previous = self.current;
+            self.current = next;
+            self.accumulator -= self.dt;
+            steps += 1;
+        }
+        let mut dropped = T::zero();
+        if self.accumulator >= threshold {
+            dropped = (self.accumulator / self.dt).floor() * self.dt;
+            self.accumulator -= dropped;
+        }
+        Ok(Frame { steps, dropped })
+    }
+
+    /// The fraction of a step accumulated but not yet taken, in `[0, 1]`.
+    #[must_use]
+    pub fn alpha(&self) -> T {
+        (self.accumulator / self.dt).max(T::zero()).min(T::one())
+    }
+
+    /// The state to draw: linear interpolation between the last two steps by
+    /// [`FixedTimestep::alpha`] (it lags the simulation by up to one step, and never
+    /// extrapolates).
+    #[must_use]
+    pub fn interpolated(&self) -> State<T, N> {
+        let a = self.alpha();
+        let (p, c) = (&self.previous, &self.current);
+        State {
+            t: c.t + (a - T::one()) * (c.t - p.t),
+            q: p.q + (c.q - p.q) * a,
+            qd: p.qd + (c.qd - p.qd) * a,
+        }
+    }
+
+    /// The state after the last step.
+    #[must_use]
+    pub fn current(&self) -> &State<T, N> {
+        &self.current
+    }
+
+    /// The state before the last step.
+    #[must_use]
+    pub fn previous(&self) -> &State<T, N> {
+        &self.previous
+    }
+
+    /// The fixed step.
+    #[must_use]
+    pub fn dt(&self) -> T {
+        self.dt
+    }
+
+    /// The integrator (to read its statistics or change its settings).
+    pub fn integrator_mut(&mut self) -> &mut I {
+        &mut self.integrator
+    }
+
+    /// Starts again from `state` with nothing accumulated.
+    ///
+    /// # Errors
+    /// [`Error::NonFiniteState`] for a non-finite `state`.
+    pub fn reset(&mut self, state: State<T, N>) -> Result<(), Error> {
+        state.check_finite()?;
+        self.previous = state;
+        self.current = state;
+        self.accumulator = T::zero();
+        Ok(())
+    }
+}

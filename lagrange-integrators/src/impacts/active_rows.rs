@@ -1,0 +1,201 @@
+//! [`ActiveRows`]: a mechanism under the rows of a contact set that are in force (bilateral
+//! rows and resting contacts), which is what the integrator steps between events.
+
+use super::Contacts;
+use lagrange_core::constraints::{
+    constrained_acceleration, ConstrainedAcceleration, Schur, Stabilization,
+};
+use lagrange_core::nalgebra::{SMatrix, SVector};
+use lagrange_core::{Error, Mechanism, Real, State};
+
+/// `mechanism` held by the `active` rows of `contacts`.
+///
+/// Inside every solve, a unilateral row whose multiplier comes out negative (its contact
+/// would pull) is dropped and the rest solved again, so a resting contact lets go as soon as
+/// the motion lifts it. With friction, a resting contact slides against a Coulomb force
+/// `-mu lambda_n sat(u / slip_speed)` along its tangent (`u` the sliding speed): the normal
+/// force from the frictionless solve, then one more solve with the friction forces applied
+/// (exact when tangent and normal are decoupled in the mass metric, as for a point on flat
+/// ground; one fixed-point pass otherwise).
+pub(crate) struct ActiveRows<'a, M, K, T, const C: usize> {
+    pub(crate) mechanism: &'a M,
+    pub(crate) contacts: &'a K,
+    pub(crate) active: [bool; C],
+    pub(crate) unilateral: [bool; C],
+    pub(crate) friction: T,
+    pub(crate) slip_speed: T,
+}
+
+impl<T: Real, M, K, const C: usize> ActiveRows<'_, M, K, T, C> {
+    /// Accelerations and multipliers at `state` with `extra` force, and the rows still in
+    /// force after the pulling ones were dropped.
+    pub(crate) fn solve<const N: usize>(
+        &self,
+        state: &State<T, N>,
+        extra: &SVector<T, N>,
+    ) -> Result<(ConstrainedAcceleration<T, N, C>, [bool; C]), Error>
+    where
+        M: Mechanism<T, N>,
+        K: Contacts<T, N, C>,
+    {
+        let mut active = self.active;
+        // Each pass either returns or drops at least one active row, so at most C + 1 passes.
+        loop {
+            let mut solved = match self.solve_rows(state, extra, &active) {
+                Err(Error::RedundantConstraints { row })
+                    if redundant_contact(row, &active, &self.unilateral) =>
+                {
+                    active[row] = false;
+                    continue;
+                }
+                other => other?,
+            };
+            if self.friction > T::zero() {
+                if let Some(tangents) = self.contacts.tangent_jacobian(&state.q) {
+                    let force =
+                        self.sliding_friction(state, &tangents, &solved.multipliers, &active);
+                    solved = self.solve_rows(state, &(extra + force), &active)?;
+                }
+            }
+            let mut dropped = false;
+            for (i, on) in active.iter_mut().enumerate() {
+                if *on && self.unilateral[i] && solved.multipliers[i] < T::zero() {
+                    *on = false;
+                    dropped = true;
+                }
+            }
+            if !dropped {
+                return Ok((solved, active));
+            }
+        }
+    }
+
+    fn solve_rows<const N: usize>(
+        &self,
+        state: &State<T, N>,
+        extra: &SVector<T, N>,
+        active: &[bool; C],
+    ) -> Result<ConstrainedAcceleration<T, N, C>, Error>
+    where
+        M: Mechanism<T, N>,
+        K: Contacts<T, N, C>,
+    {
+        constrained_acceleration(
+            self.mechanism,
+            self.contacts,
+            &Stabilization::None,
+            state,
+            extra,
+            active,
+        )
+    }
+
+    /// The generalized Coulomb force of the active, pushing contacts.
+    fn sliding_friction<const N: usize>(
+        &self,
+        state: &State<T, N>,
+        tangents: &SMatrix<T, C, N>,
+        normal: &SVector<T, C>,
+        active: &[bool; C],
+    ) -> SVector<T, N> {
+        let u = tangents * state.qd;
+        let mut force = SVector::<T, N>::zeros();
+        for i in 0..C {
+            if active[i] && self.unilateral[i] && normal[i] > T::zero() {
+                let sat = (u[i] / self.slip_speed).max(-T::one()).min(T::one());
+                force -= tangents.row(i).transpose() * (self.friction * normal[i] * sat);
+            }
+        }
+        force
+    }
+}
+
+/// True when `row` is an active unilateral row: a contact that depends on the other rows
+/// carries no force of its own (they already hold the motion), so it can be left out, where
+/// a dependent bilateral row is the user's error.
+fn redundant_contact<const C: usize>(
+    row: usize,
+    active: &[bool; C],
+    unilateral: &[bool; C],
+) -> bool {
+    active.get(row).copied().unwrap_or(false) && unilateral.get(row).copied().unwrap_or(false)
+}
+
+/// The Schur complement of the `active` rows with every contact (row not in `bilateral`) that
+/// depends on the rows before it left out of `active`: several contacts holding the same
+/// freedom, or more resting contacts than degrees of freedom.
+///
+/// # Errors
+/// [`Error::RedundantConstraints`] when bilateral rows depend on each other; as
+/// [`Schur::new`] otherwise.
+pub(crate) fn independent<T, M, K, const N: usize, const C: usize>(
+    mechanism: &M,
+    contacts: &K,
+    state: &State<T, N>,
+    active: &mut [bool; C],
+    bilateral: &[bool; C],
+) -> Result<Schur<T, N, C>, Error>
+where
+    T: Real,
+    M: Mechanism<T, N>,
+    K: Contacts<T, N, C>,
+{
+    let unilateral: [bool; C] = core::array::from_fn(|i| !bilateral[i]);
+    // Each failed pass leaves out one more row, so at most C + 1 passes.
+    loop {
+        match Schur::new(mechanism, contacts, state, active) {
+            Err(Error::RedundantConstraints { row })
+                if redundant_contact(row, active, &unilateral) =>
+            {
+                active[row] = false;
+            }
+            other => return other,
+        }
+    }
+}
+
+impl<T, M, K, const N: usize, const C: usize> Mechanism<T, N> for ActiveRows<'_, M, K, T, C>
+where
+    T: Real,
+    M: Mechanism<T, N>,
+    K: Contacts<T, N, C>,
+{
+    fn mass_matrix(&self, state: &State<T, N>) -> SMatrix<T, N, N> {
+        self.mechanism.mass_matrix(state)
+    }
+    fn rhs(&self, state: &State<T, N>) -> SVector<T, N> {
+        self.mechanism.rhs(state)
+    }
+    fn generalized_force(&self, state: &State<T, N>) -> SVector<T, N> {
+        self.mechanism.generalized_force(state)
+    }
+    fn kinetic_energy(&self, state: &State<T, N>) -> T {
+        self.mechanism.kinetic_energy(state)
+    }
+    fn potential_energy(&self, state: &State<T, N>) -> T {
+        self.mechanism.potential_energy(state)
+    }
+    fn solve_mass(&self, state: &State<T, N>, b: &SVector<T, N>) -> Result<SVector<T, N>, Error> {
+        self.mechanism.solve_mass(state, b)
+    }
+    /// In free flight (no row in force) the mechanism's own, possibly closed-form,
+    /// acceleration.
+    fn acceleration(&self, state: &State<T, N>) -> Result<SVector<T, N>, Error> {
+        if self.active.iter().any(|&on| on) {
+            self.acceleration_with(state, &SVector::zeros())
+        } else {
+            self.mechanism.acceleration(state)
+        }
+    }
+    fn acceleration_with(
+        &self,
+        state: &State<T, N>,
+        extra: &SVector<T, N>,
+    ) -> Result<SVector<T, N>, Error> {
+        if self.active.iter().any(|&on| on) {
+            Ok(self.solve(state, extra)?.0.acceleration)
+        } else {
+            self.mechanism.acceleration_with(state, extra)
+        }
+    }
+}

@@ -1,0 +1,354 @@
+//! [`ContactStepper`]: fixed steps with contacts found inside the step, impacts at the contact
+//! time, and resting contacts held as constraints.
+
+use super::active_rows::{independent, ActiveRows};
+use super::impulse::Rows;
+use super::{ContactModel, Contacts, Impact};
+use crate::Integrator;
+use lagrange_core::constraints::Projection;
+use lagrange_core::nalgebra::SVector;
+use lagrange_core::{validate, Error, Mechanism, Real, State};
+
+/// Any integrator, stepping a mechanism with unilateral contacts `g(q) >= 0` (and optional
+/// bilateral rows) at a fixed step:
+///
+/// ```text
+/// 1. trial step over what is left of dt, with the bilateral rows and the resting contacts
+///    held as constraints (multipliers; a resting contact that would pull lets go)
+/// 2. no free contact crossed (g_i < 0 and deeper than at the start)?  accept, go to 5
+/// 3. locate the crossing: bisection on the step length, re-stepping from the start of the
+///    stretch, until the bracket is shorter than time_tolerance; advance to its early end
+///    (the contact is then open by at most |w| time_tolerance: no penetration)
+/// 4. impact there (velocity jump, see ContactModel and Impact), back to 1
+/// 5. project onto the bilateral and resting rows (Projection); release the resting contacts
+///    whose multiplier would pull
+/// ```
+///
+/// Between events the inner integrator's order holds; each event costs about
+/// `log2(dt / time_tolerance)` re-steps. A contact that opens and closes again within one step
+/// without being open at its end is not seen (choose `dt` so that a bounce lasts several
+/// steps). Depth: a free contact never ends a step deeper than it started it or below zero, a
+/// resting one is projected to within the projection's tolerance. At most `4 C + 8` events per
+/// step: beyond that the step fails with [`Error::NoConvergence`] rather than loop, which
+/// with resting contacts (no Zeno) does not happen.
+///
+/// Contacts that depend on the other rows in force (several rows for one contact, more resting
+/// contacts than degrees of freedom) are left out of each solve: the others already hold the
+/// motion, and the force distribution among them is not determined. Dependent bilateral rows
+/// are an error ([`Error::RedundantConstraints`]).
+///
+/// A start state must satisfy the bilateral rows to within the projection's tolerance and
+/// have every gap above `-tolerance`; the first step from any state other than this stepper's
+/// last output checks it (and forgets the resting set).
+///
+/// ```
+/// use lagrange_core::{nalgebra::SVector, Holonomic, HolonomicConstraints, Projection, Scalar, State};
+/// use lagrange_integrators::{ContactModel, ContactStepper, Integrator, Rk4};
+/// use lagrange_systems::FallingParticle;
+///
+/// /// The ground at y = 0.
+/// struct Ground;
+/// impl HolonomicConstraints<f64, 1, 1> for Ground {
+///     fn phi<S: Scalar<Real = f64>>(&self, q: &SVector<S, 1>) -> SVector<S, 1> {
+///         *q
+///     }
+/// }
+///
+/// let ball = FallingParticle::new(1.0, 9.81)?;
+/// let model = ContactModel::new(0.5, 0.05, 1e-10)?;
+/// let mut stepper = ContactStepper::new(Rk4, Holonomic::new(Ground), model, Projection::new(1e-12, 4)?);
+/// let end = stepper.integrate(&ball, &State::at_rest([1.0]), 1e-3, 3000)?;
+/// assert!(stepper.resting()[0] && end.q[0].abs() < 1e-12);
+/// # Ok::<(), lagrange_core::Error>(())
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ContactStepper<I, K, T: Real, const N: usize, const C: usize> {
+    integrator: I,
+    contacts: K,
+    model: ContactModel<T>,
+    projection: Projection<T>,
+    bilateral: [bool; C],
+    resting: [bool; C],
+    impacts: u64,
+    last: Option<State<T, N>>,
+}
+
+impl<I, K, T: Real, const N: usize, const C: usize> ContactStepper<I, K, T, N, C> {
+    /// `integrator` stepping with the unilateral `contacts` under `model`, with `projection`
+    /// for the rows held as constraints.
+    pub fn new(
+        integrator: I,
+        contacts: K,
+        model: ContactModel<T>,
+        projection: Projection<T>,
+    ) -> Self {
+        Self {
+            integrator,
+            contacts,
+            model,
+            projection,
+            bilateral: [false; C],
+            resting: [false; C],
+            impacts: 0,
+            last: None,
+        }
+    }
+
+    /// The same stepper with the rows marked `true` in `rows` bilateral (`phi_i = 0` always,
+    /// e.g. a pendulum's rod) instead of unilateral.
+    #[must_use]
+    pub fn with_bilateral(self, rows: [bool; C]) -> Self {
+        Self {
+            bilateral: rows,
+            last: None,
+            ..self
+        }
+    }
+
+    /// The contacts resting now (held as constraints).
+    #[must_use]
+    pub fn resting(&self) -> &[bool; C] {
+        &self.resting
+    }
+
+    /// Impacts so far.
+    #[must_use]
+    pub fn impacts(&self) -> u64 {
+        self.impacts
+    }
+
+    /// The contact model.
+    #[must_use]
+    pub fn model(&self) -> &ContactModel<T> {
+        &self.model
+    }
+
+    /// The contact set.
+    #[must_use]
+    pub fn contacts(&self) -> &K {
+        &self.contacts
+    }
+
+    /// The rows held as constraints now: bilateral rows and resting contacts.
+    fn held(&self) -> [bool; C] {
+        held(&self.bilateral, &self.resting)
+    }
+}
+
+/// Bilateral rows and resting contacts.
+fn held<const C: usize>(bilateral: &[bool; C], resting: &[bool; C]) -> [bool; C] {
+    core::array::from_fn(|i| bilateral[i] || resting[i])
+}
+
+/// The mechanism the inner integrator steps between events: `mechanism` held by the
+/// bilateral and resting rows of `contacts`, with `model`'s friction.
+fn active<'a, M, K, T: Real, const C: usize>(
+    mechanism: &'a M,
+    contacts: &'a K,
+    model: &ContactModel<T>,
+    bilateral: &[bool; C],
+    resting: &[bool; C],
+) -> ActiveRows<'a, M, K, T, C> {
+    ActiveRows {
+        mechanism,
+        contacts,
+        active: held(bilateral, resting),
+        unilateral: core::array::from_fn(|i| !bilateral[i]),
+        friction: model.friction(),
+        slip_speed: model.rest_speed(),
+    }
+}
+
+impl<I, K, T, const N: usize, const C: usize> ContactStepper<I, K, T, N, C>
+where
+    T: Real,
+    I: Integrator<T, N>,
+    K: Contacts<T, N, C>,
+{
+    /// As [`Integrator::step`], calling `observe` with every impact inside the step.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] `dt` unless positive and finite; [`Error::NonFiniteState`];
+    /// [`Error::ConstraintViolated`] for a start state that violates a bilateral row or
+    /// penetrates a contact beyond the projection's tolerance; [`Error::NoConvergence`] after
+    /// `4 C + 8` events in one step; the inner integrator's and the projection's errors.
+    pub fn step_observed<M, F>(
+        &mut self,
+        mechanism: &M,
+        state: &State<T, N>,
+        dt: T,
+        mut observe: F,
+    ) -> Result<State<T, N>, Error>
+    where
+        M: Mechanism<T, N>,
+        F: FnMut(&Impact<T, N, C>),
+    {
+        let dt = validate::positive("dt", dt)?;
+        state.check_finite()?;
+        if self.last.as_ref() != Some(state) {
+            self.start(state)?;
+        }
+        let max_events = 4 * C + 8;
+        let mut s = *state;
+        let mut remaining = dt;
+        let mut events = 0;
+        loop {
+            let trial = self.integrator.step(
+                &active(
+                    mechanism,
+                    &self.contacts,
+                    &self.model,
+                    &self.bilateral,
+                    &self.resting,
+                ),
+                &s,
+                remaining,
+            )?;
+            let start_gaps = self.contacts.position_residual(&s.q);
+            let crossed = self.crossed(&start_gaps, &trial);
+            if !crossed.iter().any(|&c| c) {
+                s = trial;
+                break;
+            }
+            let (lo, at, struck) = self.locate(mechanism, &s, &start_gaps, remaining, crossed)?;
+            let rows = Rows {
+                contacts: &self.contacts,
+                model: &self.model,
+                bilateral: self.bilateral,
+            };
+            let (after, impact) = rows.impact(mechanism, &at, struck, &mut self.resting)?;
+            // Resting contacts that depend on the others (more of them than degrees of
+            // freedom) are left free: the others hold the motion.
+            let mut held = self.held();
+            independent(
+                mechanism,
+                &self.contacts,
+                &after,
+                &mut held,
+                &self.bilateral,
+            )?;
+            for (r, h) in self.resting.iter_mut().zip(held) {
+                *r = *r && h;
+            }
+            observe(&impact);
+            self.impacts += 1;
+            events += 1;
+            if events > max_events {
+                return Err(Error::NoConvergence {
+                    iterations: u32::try_from(events).unwrap_or(u32::MAX),
+                });
+            }
+            s = after;
+            remaining -= lo;
+        }
+        let held = self.held();
+        if held.iter().any(|&h| h) {
+            s = self
+                .projection
+                .project_rows(mechanism, &self.contacts, &s, &held)?;
+            let rows = active(
+                mechanism,
+                &self.contacts,
+                &self.model,
+                &self.bilateral,
+                &self.resting,
+            );
+            let (_, still) = rows.solve(&s, &SVector::zeros())?;
+            for (r, kept) in self.resting.iter_mut().zip(still) {
+                *r = *r && kept;
+            }
+        }
+        self.last = Some(s);
+        Ok(s)
+    }
+
+    /// Checks a new start state and forgets the resting set.
+    fn start(&mut self, s: &State<T, N>) -> Result<(), Error> {
+        let tol = self.projection.tolerance();
+        let phi = self.contacts.position_residual(&s.q);
+        let w = self.contacts.jacobian(&s.q) * s.qd;
+        for i in 0..C {
+            let ok = if self.bilateral[i] {
+                phi[i].abs() <= tol && w[i].abs() <= tol
+            } else {
+                phi[i] >= -tol
+            };
+            if !ok {
+                return Err(Error::ConstraintViolated { row: i });
+            }
+        }
+        self.resting = [false; C];
+        Ok(())
+    }
+
+    /// The free contacts that are below zero at `end` and deeper than at the start.
+    fn crossed(&self, start_gaps: &SVector<T, C>, end: &State<T, N>) -> [bool; C] {
+        let gaps = self.contacts.position_residual(&end.q);
+        let held = self.held();
+        core::array::from_fn(|i| !held[i] && gaps[i] < T::zero() && gaps[i] < start_gaps[i])
+    }
+
+    /// Bisection on the step length from `s` for the first crossing: the length `lo` at the
+    /// early end of the final bracket, the state there, and the contacts crossed at its late
+    /// end.
+    fn locate<M: Mechanism<T, N>>(
+        &mut self,
+        mechanism: &M,
+        s: &State<T, N>,
+        start_gaps: &SVector<T, C>,
+        remaining: T,
+        crossed: [bool; C],
+    ) -> Result<(T, State<T, N>, [bool; C]), Error> {
+        let (mut lo, mut hi, mut at, mut struck) = (T::zero(), remaining, *s, crossed);
+        while hi - lo > self.model.time_tolerance() {
+            let mid = lo + (hi - lo) * T::HALF;
+            if mid <= lo || mid >= hi {
+                break; // the bracket is at the resolution of T
+            }
+            let trial = self.integrator.step(
+                &active(
+                    mechanism,
+                    &self.contacts,
+                    &self.model,
+                    &self.bilateral,
+                    &self.resting,
+                ),
+                s,
+                mid,
+            )?;
+            let c = self.crossed(start_gaps, &trial);
+            if c.iter().any(|&x| x) {
+                hi = mid;
+                struck = c;
+            } else {
+                lo = mid;
+                at = trial;
+            }
+        }
+        Ok((lo, at, struck))
+    }
+}
+
+impl<I, K, T, const N: usize, const C: usize> Integrator<T, N> for ContactStepper<I, K, T, N, C>
+where
+    T: Real,
+    I: Integrator<T, N>,
+    K: Contacts<T, N, C>,
+{
+    const NAME: &'static str = I::NAME;
+    const ORDER: u32 = I::ORDER;
+    const EVALS_PER_STEP: u32 = I::EVALS_PER_STEP;
+
+    /// One step with contacts; see [`ContactStepper::step_observed`].
+    ///
+    /// # Errors
+    /// As [`ContactStepper::step_observed`].
+    fn step<M: Mechanism<T, N>>(
+        &mut self,
+        mechanism: &M,
+        state: &State<T, N>,
+        dt: T,
+    ) -> Result<State<T, N>, Error> {
+        self.step_observed(mechanism, state, dt, |_| {})
+    }
+}

@@ -1,0 +1,236 @@
+//! [`ImplicitRungeKutta`]: the one stepper behind implicit midpoint, Gauss-Legendre, backward
+//! Euler and Radau IIA, each given by its Butcher tableau ([`ImplicitTableau`]).
+
+use crate::integrator::{check_step, finish};
+use crate::newton::{self, BlockMatrix, Blocks, NewtonProblem, NewtonSettings, Start};
+use crate::Integrator;
+use core::marker::PhantomData;
+use lagrange_core::nalgebra::{SMatrix, SVector};
+use lagrange_core::{Error, Jacobian, Mechanism, Real, State};
+
+/// The Butcher tableau of an `S`-stage implicit Runge-Kutta method, as `f64` constants
+/// rounded to the integrator's scalar when used.
+pub trait ImplicitTableau<const S: usize> {
+    /// Short name for tables and logs.
+    const NAME: &'static str;
+    /// Order of the global error.
+    const ORDER: u32;
+    /// The stage coefficients `a_ij`.
+    const A: [[f64; S]; S];
+    /// The weights `b_j`.
+    const B: [f64; S];
+    /// The nodes `c_i` (row sums of `A`).
+    const C: [f64; S];
+}
+
+/// An implicit Runge-Kutta method applied to `y = (q, q')`, `y' = (q', q'')`:
+///
+/// ```text
+/// V_i = q'0 + h sum_j a_ij K_j        Q_i = q0 + h sum_j a_ij V_j
+/// K_i = q''(t0 + c_i h, Q_i, V_i)     (S N equations in the stage accelerations K)
+/// q'1 = q'0 + h sum_j b_j K_j         q1  = q0 + h sum_j b_j V_j
+/// ```
+///
+/// The stage equations are solved by simplified Newton ([`NewtonSettings`]): the Newton matrix
+/// `I - h A (x) dq''/dq' - h^2 A^2 (x) dq''/dq` is built from the mechanism's
+/// [`Mechanism::acceleration_jacobian`] at the start of the step (exact from dual numbers for
+/// an [`EulerLagrange`](lagrange_core::EulerLagrange) mechanism, central differences otherwise),
+/// factorised once, and rebuilt from the stages' own Jacobians only if convergence slows.
+/// Converged means each component's update of a `K_i` is at most
+/// `tolerance (|K_i| + |q'0| / |h|)`: the new velocity is settled to `tolerance` relative to
+/// the motion.
+///
+/// Cost per step: one acceleration Jacobian, then `S` accelerations per Newton iteration
+/// ([`ImplicitRungeKutta::last_iterations`] tells how many the last step took; measured on a
+/// double pendulum, the last iteration confirming convergence: 4 to 5 at `h = 1e-2`, 3 to 4
+/// at `h = 1e-3`; 2 for a linear mechanism).
+///
+/// Use the aliases: [`ImplicitMidpoint`](crate::ImplicitMidpoint),
+/// [`GaussLegendre2`](crate::GaussLegendre2), [`BackwardEuler`](crate::BackwardEuler),
+/// [`RadauIIA2`](crate::RadauIIA2).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ImplicitRungeKutta<T: Real, const S: usize, M> {
+    newton: NewtonSettings<T>,
+    iterations: u32,
+    method: PhantomData<M>,
+}
+
+impl<T: Real, const S: usize, M> ImplicitRungeKutta<T, S, M> {
+    /// The method, iterating with `newton`.
+    #[must_use]
+    pub fn new(newton: NewtonSettings<T>) -> Self {
+        Self {
+            newton,
+            iterations: 0,
+            method: PhantomData,
+        }
+    }
+
+    /// The Newton settings.
+    #[must_use]
+    pub fn newton(&self) -> &NewtonSettings<T> {
+        &self.newton
+    }
+
+    /// Newton iterations of the last successful step (0 before any).
+    #[must_use]
+    pub fn last_iterations(&self) -> u32 {
+        self.iterations
+    }
+}
+
+impl<T: Real, const S: usize, M> Default for ImplicitRungeKutta<T, S, M> {
+    /// With [`NewtonSettings::default`].
+    fn default() -> Self {
+        Self::new(NewtonSettings::default())
+    }
+}
+
+#[cfg(feature = "defmt")]
+impl<T: Real + defmt::Format, const S: usize, M: ImplicitTableau<S>> defmt::Format
+    for ImplicitRungeKutta<T, S, M>
+{
+    fn format(&self, f: defmt::Formatter<'_>) {
+        defmt::write!(f, "{} {{ newton: {} }}", M::NAME, self.newton);
+    }
+}
+
+/// `x` in the integrator's scalar.
+fn real<T: Real>(x: f64) -> T {
+    T::from_f64(x)
+}
+
+/// The stage equations of one step.
+struct Stages<'a, T: Real, Mech, const N: usize, const S: usize> {
+    mechanism: &'a Mech,
+    start: &'a State<T, N>,
+    h: T,
+    a: [[T; S]; S],
+    a2: [[T; S]; S],
+    c: [T; S],
+    /// The Jacobian at the start, used for the first Newton matrix.
+    start_jacobian: Option<Jacobian<T, N>>,
+    /// `|q'0| / |h|`: the velocities in units of acceleration, added to `|K|` as the scale.
+    velocity_scale: SVector<T, N>,
+}
+
+impl<T: Real, Mech: Mechanism<T, N>, const N: usize, const S: usize> Stages<'_, T, Mech, N, S> {
+    /// The stage velocities `V_i` for stage accelerations `k`.
+    fn velocities(&self, k: &Blocks<T, N, S>) -> Blocks<T, N, S> {
+        core::array::from_fn(|i| {
+            let mut v = self.start.qd;
+            for (a, kj) in self.a[i].iter().zip(k.iter()) {
+                v += kj * (self.h * *a);
+            }
+            v
+        })
+    }
+
+    /// The stage states `(t0 + c_i h, Q_i, V_i)`.
+    fn stage_states(&self, k: &Blocks<T, N, S>) -> [State<T, N>; S] {
+        let v = self.velocities(k);
+        core::array::from_fn(|i| {
+            let mut q = self.start.q;
+            for (a, vj) in self.a[i].iter().zip(v.iter()) {
+                q += vj * (self.h * *a);
+            }
+            State {
+                t: self.start.t + self.c[i] * self.h,
+                q,
+                qd: v[i],
+            }
+        })
+    }
+}
+
+impl<T, Mech, const N: usize, const S: usize> NewtonProblem<T, N, S> for Stages<'_, T, Mech, N, S>
+where
+    T: Real,
+    Mech: Mechanism<T, N>,
+{
+    fn residual(&mut self, k: &Blocks<T, N, S>) -> Result<Blocks<T, N, S>, Error> {
+        let states = self.stage_states(k);
+        let mut r = *k;
+        for (ri, s) in r.iter_mut().zip(states.iter()) {
+            *ri -= self.mechanism.acceleration(s)?;
+        }
+        Ok(r)
+    }
+
+    fn newton_matrix(&mut self, k: &Blocks<T, N, S>) -> Result<BlockMatrix<T, N, S>, Error> {
+        // First the start's Jacobian for every stage; on a refresh each stage's own.
+        let jacobians: [Jacobian<T, N>; S] = match self.start_jacobian.take() {
+            Some(j) => [j; S],
+            None => {
+                let states = self.stage_states(k);
+                let mut js = [Jacobian::zeros(); S];
+                for (j, s) in js.iter_mut().zip(states.iter()) {
+                    *j = self.mechanism.acceleration_jacobian(s)?.1;
+                }
+                js
+            }
+        };
+        let (h, h2) = (self.h, self.h * self.h);
+        Ok(BlockMatrix::from_blocks(|i, j| {
+            let identity = if i == j {
+                SMatrix::identity()
+            } else {
+                SMatrix::zeros()
+            };
+            identity
+                - jacobians[i].wrt_qd * (h * self.a[i][j])
+                - jacobians[i].wrt_q * (h2 * self.a2[i][j])
+        }))
+    }
+
+    fn weights(&self, k: &Blocks<T, N, S>) -> Blocks<T, N, S> {
+        k.map(|ki| ki.map(|x| x.abs()) + self.velocity_scale)
+    }
+}
+
+impl<T, M, const N: usize, const S: usize> Integrator<T, N> for ImplicitRungeKutta<T, S, M>
+where
+    T: Real,
+    M: ImplicitTableau<S>,
+{
+    const NAME: &'static str = M::NAME;
+    const ORDER: u32 = M::ORDER;
+    /// Per Newton iteration; each step also evaluates one acceleration Jacobian.
+    const EVALS_PER_STEP: u32 = S as u32;
+
+    fn step<Mech: Mechanism<T, N>>(
+        &mut self,
+        m: &Mech,
+        s: &State<T, N>,
+        dt: T,
+    ) -> Result<State<T, N>, Error> {
+        let h = check_step(s, dt)?;
+        let a: [[T; S]; S] = M::A.map(|row| row.map(real));
+        let a2 = core::array::from_fn(|i| {
+            core::array::from_fn(|j| (0..S).fold(T::zero(), |acc, l| acc + a[i][l] * a[l][j]))
+        });
+        let (qdd, jacobian) = m.acceleration_jacobian(s)?;
+        let mut problem = Stages {
+            mechanism: m,
+            start: s,
+            h,
+            a,
+            a2,
+            c: M::C.map(real),
+            start_jacobian: Some(jacobian),
+            velocity_scale: s.qd.map(|v| v.abs() / h.abs()),
+        };
+        let mut k = [qdd; S];
+        self.iterations = newton::solve(&mut problem, &mut k, &self.newton, Start::Newton)?;
+
+        let v = problem.velocities(&k);
+        let mut q = s.q;
+        let mut qd = s.qd;
+        for ((b, kj), vj) in M::B.iter().zip(k.iter()).zip(v.iter()) {
+            let hb = h * real::<T>(*b);
+            qd += kj * hb;
+            q += vj * hb;
+        }
+        finish(State { t: s.t + h, q, qd })
+    }
+}

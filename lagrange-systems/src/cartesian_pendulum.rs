@@ -1,0 +1,183 @@
+//! [`CartesianPendulum`]: the simple pendulum in Cartesian coordinates, held by a constraint.
+
+use lagrange_core::constraints::{
+    constrained_acceleration, ConstrainedAcceleration, Constraints, HolonomicConstraints,
+    Stabilization,
+};
+use lagrange_core::nalgebra::{Matrix1x2, Matrix2, SMatrix, SVector, Vector1, Vector2};
+use lagrange_core::{
+    acceleration_jacobian_by_differences, validate, Error, Jacobian, Lagrangian, Mechanism, Real,
+    Scalar, State,
+};
+
+/// A point mass `m` at `(x, y)` from a fixed pivot, in gravity `g`, held at distance `l` by a
+/// massless rod: the same pendulum as [`SimplePendulum`](crate::SimplePendulum), written in two
+/// coordinates and one holonomic constraint instead of one angle.
+///
+/// ```text
+/// q      = [x, y]                 the bob relative to the pivot, m; y up
+/// L      = m (x'^2 + y'^2) / 2 - m g y            (a free particle)
+/// phi    = (x^2 + y^2 - l^2) / (2 l) = 0          ~ r - l near the circle: a length, m
+/// J      = [x, y] / l,   J'q' = (x'^2 + y'^2) / l
+/// m q''  = [0, -m g] + J^T lambda
+/// lambda = m l (g y - |q'|^2) / (x^2 + y^2)       the rod's tension is -lambda (pulls inward)
+/// ```
+///
+/// On the constraint, `x = l sin th`, `y = -l cos th` with `th` the simple pendulum's angle
+/// from the downward vertical ([`CartesianPendulum::state_from_angle`],
+/// [`CartesianPendulum::angle`]). Singular configuration: the bob at the pivot (`x = y = 0`,
+/// where `J = 0`), reported as [`Error::RedundantConstraints`]. [`Mechanism::acceleration`]
+/// includes the rod's force; `mass_matrix`, `rhs` and `solve_mass` are the free particle's.
+/// Energy `T + V` is conserved by the exact motion.
+///
+/// ```
+/// use lagrange_core::{Mechanism, State};
+/// use lagrange_systems::CartesianPendulum;
+/// let p = CartesianPendulum::new(1.0_f64, 1.0, 9.81)?;
+/// // Horizontal at rest: the rod carries nothing, the bob falls freely.
+/// let a = p.acceleration(&State::new(0.0, [1.0, 0.0], [0.0, 0.0]))?;
+/// assert!(a[0].abs() < 1e-15 && (a[1] + 9.81).abs() < 1e-15);
+/// # Ok::<(), lagrange_core::Error>(())
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct CartesianPendulum<T: Real> {
+    mass: T,
+    length: T,
+    gravity: T,
+    stabilization: Stabilization<T>,
+}
+
+impl<T: Real> CartesianPendulum<T> {
+    /// A bob of `mass` (kg, > 0) on a rod of `length` (m, > 0) in `gravity` (m/s^2, >= 0),
+    /// without drift control.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming the first parameter out of range or not finite.
+    pub fn new(mass: T, length: T, gravity: T) -> Result<Self, Error> {
+        Ok(Self {
+            mass: validate::positive("mass", mass)?,
+            length: validate::positive("length", length)?,
+            gravity: validate::non_negative("gravity", gravity)?,
+            stabilization: Stabilization::None,
+        })
+    }
+
+    /// The same pendulum with `stabilization` in its acceleration.
+    #[must_use]
+    pub fn with_stabilization(self, stabilization: Stabilization<T>) -> Self {
+        Self {
+            stabilization,
+            ..self
+        }
+    }
+
+    /// Mass, kg.
+    #[must_use]
+    pub fn mass(&self) -> T {
+        self.mass
+    }
+    /// Rod length, m.
+    #[must_use]
+    pub fn length(&self) -> T {
+        self.length
+    }
+    /// Gravity, m/s^2.
+    #[must_use]
+    pub fn gravity(&self) -> T {
+        self.gravity
+    }
+
+    /// The consistent state at time `t` of angle `th` from the downward vertical and angular
+    /// rate `thd`.
+    #[must_use]
+    pub fn state_from_angle(&self, t: T, th: T, thd: T) -> State<T, 2> {
+        let (s, c) = th.sin_cos();
+        let l = self.length;
+        State::new(t, [l * s, -l * c], [l * c * thd, l * s * thd])
+    }
+
+    /// The angle from the downward vertical and its rate, `(atan2(x, -y), (x y' - y x') / r^2)`.
+    #[must_use]
+    pub fn angle(&self, state: &State<T, 2>) -> (T, T) {
+        let (x, y) = (state.q[0], state.q[1]);
+        let r2 = x * x + y * y;
+        (x.atan2(-y), (x * state.qd[1] - y * state.qd[0]) / r2)
+    }
+
+    /// Accelerations and the multiplier at `state`.
+    ///
+    /// # Errors
+    /// [`Error::RedundantConstraints`] with the bob at the pivot; [`Error::NonFiniteState`].
+    pub fn solve(&self, state: &State<T, 2>) -> Result<ConstrainedAcceleration<T, 2, 1>, Error> {
+        self.solve_with(state, &SVector::zeros())
+    }
+
+    fn solve_with(
+        &self,
+        state: &State<T, 2>,
+        extra: &Vector2<T>,
+    ) -> Result<ConstrainedAcceleration<T, 2, 1>, Error> {
+        constrained_acceleration(self, self, &self.stabilization, state, extra, &[true])
+    }
+}
+
+impl<T: Real> Mechanism<T, 2> for CartesianPendulum<T> {
+    fn mass_matrix(&self, _s: &State<T, 2>) -> Matrix2<T> {
+        Matrix2::identity() * self.mass
+    }
+    fn rhs(&self, _s: &State<T, 2>) -> Vector2<T> {
+        Vector2::new(T::zero(), -self.mass * self.gravity)
+    }
+    fn kinetic_energy(&self, s: &State<T, 2>) -> T {
+        T::HALF * self.mass * (s.qd[0] * s.qd[0] + s.qd[1] * s.qd[1])
+    }
+    fn potential_energy(&self, s: &State<T, 2>) -> T {
+        self.mass * self.gravity * s.q[1]
+    }
+    fn solve_mass(&self, _s: &State<T, 2>, b: &Vector2<T>) -> Result<Vector2<T>, Error> {
+        Ok(b / self.mass)
+    }
+    fn acceleration(&self, s: &State<T, 2>) -> Result<Vector2<T>, Error> {
+        Ok(self.solve(s)?.acceleration)
+    }
+    fn acceleration_with(&self, s: &State<T, 2>, extra: &Vector2<T>) -> Result<Vector2<T>, Error> {
+        Ok(self.solve_with(s, extra)?.acceleration)
+    }
+    fn acceleration_jacobian(
+        &self,
+        s: &State<T, 2>,
+    ) -> Result<(Vector2<T>, Jacobian<T, 2>), Error> {
+        acceleration_jacobian_by_differences(self, s)
+    }
+}
+
+impl<T: Real> Constraints<T, 2, 1> for CartesianPendulum<T> {
+    fn position_residual(&self, q: &Vector2<T>) -> Vector1<T> {
+        let l = self.length;
+        Vector1::new((q[0] * q[0] + q[1] * q[1] - l * l) / (T::TWO * l))
+    }
+    fn jacobian(&self, q: &Vector2<T>) -> SMatrix<T, 1, 2> {
+        Matrix1x2::new(q[0], q[1]) / self.length
+    }
+    fn velocity_product(&self, _q: &Vector2<T>, qd: &Vector2<T>) -> Vector1<T> {
+        Vector1::new((qd[0] * qd[0] + qd[1] * qd[1]) / self.length)
+    }
+}
+
+impl<T: Real> HolonomicConstraints<T, 2, 1> for CartesianPendulum<T> {
+    fn phi<S: Scalar<Real = T>>(&self, q: &SVector<S, 2>) -> SVector<S, 1> {
+        let l = S::from_real(self.length);
+        Vector1::new((q[0] * q[0] + q[1] * q[1] - l * l) / (l + l))
+    }
+}
+
+/// The free particle, for the automatic Euler-Lagrange check.
+impl<T: Real> Lagrangian<T, 2> for CartesianPendulum<T> {
+    fn kinetic<S: Scalar<Real = T>>(&self, _t: S, _q: &SVector<S, 2>, qd: &SVector<S, 2>) -> S {
+        S::from_real(T::HALF * self.mass) * (qd[0] * qd[0] + qd[1] * qd[1])
+    }
+    fn potential<S: Scalar<Real = T>>(&self, _t: S, q: &SVector<S, 2>) -> S {
+        S::from_real(self.mass * self.gravity) * q[1]
+    }
+}

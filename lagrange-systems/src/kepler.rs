@@ -1,0 +1,111 @@
+//! [`Kepler`]: a unit mass orbiting a fixed centre of inverse-square attraction.
+
+use crate::small_solve::{positive_radius, solve_diagonal2};
+use lagrange_core::nalgebra::{Matrix2, SVector, Vector2};
+use lagrange_core::{validate, Error, Lagrangian, Mechanism, Real, Scalar, State};
+
+/// What [`Kepler`] reports at `r <= 0`.
+const AT_CENTRE: &str = "radius r <= 0: orbiting body at the centre of attraction";
+
+/// The Kepler problem: a body of unit mass in the plane, attracted to a fixed centre at the
+/// origin with gravitational parameter `mu`, in polar coordinates.
+///
+/// ```text
+/// q = [r, phi]   r: distance from the centre (> 0); phi: polar angle, rad (unwrapped)
+/// T = (r'^2 + r^2 phi'^2) / 2
+/// V = -mu / r
+///
+/// M = diag(1, r^2)
+/// f = | r phi'^2 - mu / r^2 |
+///     | -2 r r' phi'        |
+/// r''   = r phi'^2 - mu / r^2
+/// phi'' = -2 r' phi' / r
+/// ```
+///
+/// Parameter: `mu = G M`, length^3/time^2 (with unit mass the energy is per unit mass). `phi`
+/// is cyclic, so besides the energy `E = T + V` the angular momentum `h = r^2 phi'`
+/// ([`Kepler::angular_momentum`]) is conserved. A bound orbit (`E < 0`) has semi-major axis
+/// `a = -mu / (2 E)`, period `2 pi sqrt(a^3 / mu)` and eccentricity
+/// `e = sqrt(1 + 2 E h^2 / mu^2)`; [`exact::kepler_orbit`](crate::exact::kepler_orbit) gives
+/// its exact motion through Kepler's equation.
+///
+/// Singular configurations: the centre, `r = 0` (collision: `V` and `M^-1` blow up, `phi` is
+/// undefined), and `r < 0`, outside the coordinates. There [`Mechanism::acceleration`] returns
+/// [`Error::Singularity`], as it does where `r` is so small that `q''` overflows. A close
+/// periapsis passage needs a step much smaller than `r / |v|` there.
+///
+/// ```
+/// use lagrange_core::{Mechanism, State};
+/// use lagrange_systems::Kepler;
+/// let k = Kepler::new(1.0)?;
+/// // A circular orbit of radius 2: phi'^2 = mu / r^3, no radial acceleration.
+/// let s = State::new(0.0, [2.0, 0.0], [0.0, (1.0f64 / 8.0).sqrt()]);
+/// let a = k.acceleration(&s)?;
+/// assert!(a[0].abs() < 1e-16 && a[1] == 0.0);
+/// assert!((k.energy(&s) + 0.25).abs() < 1e-15);
+/// # Ok::<(), lagrange_core::Error>(())
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Kepler<T: Real> {
+    mu: T,
+}
+
+impl<T: Real> Kepler<T> {
+    /// The Kepler problem with gravitational parameter `mu` (> 0).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] `mu` when not positive and finite.
+    pub fn new(mu: T) -> Result<Self, Error> {
+        Ok(Self {
+            mu: validate::positive("mu", mu)?,
+        })
+    }
+    /// The gravitational parameter.
+    #[must_use]
+    pub fn mu(&self) -> T {
+        self.mu
+    }
+    /// The conserved angular momentum per unit mass, `h = r^2 phi'`.
+    #[must_use]
+    pub fn angular_momentum(&self, s: &State<T, 2>) -> T {
+        s.q[0] * s.q[0] * s.qd[1]
+    }
+}
+
+impl<T: Real> Mechanism<T, 2> for Kepler<T> {
+    fn mass_matrix(&self, s: &State<T, 2>) -> Matrix2<T> {
+        let r = s.q[0];
+        Matrix2::new(T::one(), T::zero(), T::zero(), r * r)
+    }
+    fn rhs(&self, s: &State<T, 2>) -> Vector2<T> {
+        let (r, rd, phid) = (s.q[0], s.qd[0], s.qd[1]);
+        Vector2::new(r * phid * phid - self.mu / (r * r), -T::TWO * r * rd * phid)
+    }
+    fn kinetic_energy(&self, s: &State<T, 2>) -> T {
+        let (r, rd, phid) = (s.q[0], s.qd[0], s.qd[1]);
+        T::HALF * (rd * rd + r * r * phid * phid)
+    }
+    fn potential_energy(&self, s: &State<T, 2>) -> T {
+        -self.mu / s.q[0]
+    }
+    fn solve_mass(&self, s: &State<T, 2>, b: &Vector2<T>) -> Result<Vector2<T>, Error> {
+        let r = s.q[0];
+        positive_radius(s, AT_CENTRE)?;
+        solve_diagonal2(s, [T::one(), r * r], b, AT_CENTRE)
+    }
+}
+
+impl<T: Real> Lagrangian<T, 2> for Kepler<T> {
+    /// `|v|^2 / 2` with the Cartesian velocity `d/dt (r cos phi, r sin phi)`.
+    fn kinetic<S: Scalar<Real = T>>(&self, _t: S, q: &SVector<S, 2>, qd: &SVector<S, 2>) -> S {
+        let (r, rd, phid) = (q[0], qd[0], qd[1]);
+        let (sin, cos) = q[1].sin_cos();
+        let vx = rd * cos - r * sin * phid;
+        let vy = rd * sin + r * cos * phid;
+        S::from_f64(0.5) * (vx * vx + vy * vy)
+    }
+    fn potential<S: Scalar<Real = T>>(&self, _t: S, q: &SVector<S, 2>) -> S {
+        -S::from_real(self.mu) / q[0]
+    }
+}

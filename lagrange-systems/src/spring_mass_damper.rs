@@ -1,0 +1,97 @@
+//! [`SpringMassDamper`]: a mass on a linear spring with a linear viscous damper.
+
+use crate::small_solve::finite;
+use lagrange_core::nalgebra::{Matrix1, SMatrix, SVector, Vector1};
+use lagrange_core::{validate, Error, Lagrangian, Mechanism, Real, Scalar, State};
+
+/// A mass `m` on a linear spring of stiffness `k` and a viscous damper `c`, no gravity.
+///
+/// ```text
+/// q = [x]      displacement from the spring's rest position, m
+/// L = m x'^2 / 2 - k x^2 / 2
+/// Q = -c x'
+/// m x'' = -k x - c x'
+/// ```
+///
+/// Under-damped for `c^2 < 4 k m`, critically damped at equality, over-damped above;
+/// [`exact::damped_oscillator`](crate::exact::damped_oscillator) gives the exact motion in every
+/// case. No singular configurations; a non-finite state gives [`Error::NonFiniteState`]. Energy
+/// `T + V` is conserved when `c = 0` and never increases otherwise.
+///
+/// ```
+/// use lagrange_core::{Mechanism, State};
+/// use lagrange_systems::SpringMassDamper;
+/// let smd = SpringMassDamper::<f64>::new(2.0, 8.0, 0.5)?;
+/// let a = smd.acceleration(&State::new(0.0, [0.1], [1.0]))?;
+/// assert!((a[0] - (-8.0 * 0.1 - 0.5 * 1.0) / 2.0).abs() < 1e-15);
+/// # Ok::<(), lagrange_core::Error>(())
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct SpringMassDamper<T: Real> {
+    mass: T,
+    stiffness: T,
+    damping: T,
+}
+
+impl<T: Real> SpringMassDamper<T> {
+    /// A `mass` (kg, > 0) on a spring of `stiffness` (N/m, >= 0) with `damping` (N s/m, >= 0).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming the first parameter out of range or not finite.
+    pub fn new(mass: T, stiffness: T, damping: T) -> Result<Self, Error> {
+        Ok(Self {
+            mass: validate::positive("mass", mass)?,
+            stiffness: validate::non_negative("stiffness", stiffness)?,
+            damping: validate::non_negative("damping", damping)?,
+        })
+    }
+    /// Mass, kg.
+    #[must_use]
+    pub fn mass(&self) -> T {
+        self.mass
+    }
+    /// Stiffness, N/m.
+    #[must_use]
+    pub fn stiffness(&self) -> T {
+        self.stiffness
+    }
+    /// Damping, N s/m.
+    #[must_use]
+    pub fn damping(&self) -> T {
+        self.damping
+    }
+}
+
+impl<T: Real> Mechanism<T, 1> for SpringMassDamper<T> {
+    fn mass_matrix(&self, _s: &State<T, 1>) -> SMatrix<T, 1, 1> {
+        Matrix1::new(self.mass)
+    }
+    fn rhs(&self, s: &State<T, 1>) -> SVector<T, 1> {
+        Vector1::new(-self.stiffness * s.q[0])
+    }
+    fn generalized_force(&self, s: &State<T, 1>) -> SVector<T, 1> {
+        Vector1::new(-self.damping * s.qd[0])
+    }
+    fn kinetic_energy(&self, s: &State<T, 1>) -> T {
+        T::HALF * self.mass * s.qd[0] * s.qd[0]
+    }
+    fn potential_energy(&self, s: &State<T, 1>) -> T {
+        T::HALF * self.stiffness * s.q[0] * s.q[0]
+    }
+    fn solve_mass(&self, _s: &State<T, 1>, b: &SVector<T, 1>) -> Result<SVector<T, 1>, Error> {
+        finite(b / self.mass, Error::NonFiniteState)
+    }
+}
+
+impl<T: Real> Lagrangian<T, 1> for SpringMassDamper<T> {
+    fn kinetic<S: Scalar<Real = T>>(&self, _t: S, _q: &SVector<S, 1>, qd: &SVector<S, 1>) -> S {
+        S::from_real(T::HALF * self.mass) * qd[0] * qd[0]
+    }
+    fn potential<S: Scalar<Real = T>>(&self, _t: S, q: &SVector<S, 1>) -> S {
+        S::from_real(T::HALF * self.stiffness) * q[0] * q[0]
+    }
+    fn non_conservative_force(&self, s: &State<T, 1>) -> SVector<T, 1> {
+        Mechanism::generalized_force(self, s)
+    }
+}

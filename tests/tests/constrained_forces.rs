@@ -1,0 +1,64 @@
+//! Forces added by wrapping act through the constraints: `with_force` on a constrained
+//! mechanism keeps its multipliers.
+
+use lagrange_core::{Error, Input, Mechanism, Projection, Real, State, ViscousDamping};
+use lagrange_integrators::{Integrator, Projected, Rk4};
+use lagrange_systems::{CartesianPendulum, RollingDisk, SimplePendulum};
+use lagrange_tests::{for_f32_and_f64, pick};
+
+/// Viscous damping `c` on `x'` and `y'` of the Cartesian pendulum is a torque `-c l^2 th'`
+/// about the pivot: it must track the simple pendulum with damping `b = c l^2`. RK4 (+
+/// projection) at dt = 1e-3 for 5 s from 1 rad: measured largest angle difference 1.5e-11 rad
+/// (f64), 1.6e-6 rad (f32); bounds 1e-10 and 1e-5 rad.
+fn damping_acts_through_the_rod<T: Real>() -> Result<(), Error> {
+    let (m, l, g, c) = (
+        T::from_f64(2.0),
+        T::from_f64(0.7),
+        T::from_f64(9.81),
+        T::from_f64(0.3),
+    );
+    let simple = SimplePendulum::new(m, l, g, c * l * l)?;
+    let cartesian = CartesianPendulum::new(m, l, g)?;
+    let damped = cartesian.with_force(ViscousDamping::uniform(c)?);
+    let tol = T::from_f64(pick::<T>(1e-5, 1e-13));
+    let mut stepper = Projected::new(Rk4, cartesian, Projection::new(tol, 4)?);
+    let dt = T::from_f64(1e-3);
+    let mut s = State::at_rest([T::one()]);
+    let mut cs = cartesian.state_from_angle(T::zero(), T::one(), T::zero());
+    let mut worst: f64 = 0.0;
+    for _ in 0..5000 {
+        s = Rk4.step(&simple, &s, dt)?;
+        cs = stepper.step(&damped, &cs, dt)?;
+        worst = worst.max((cartesian.angle(&cs).0 - s.q[0]).abs().to_f64());
+    }
+    println!("damped Cartesian vs damped angle, 5 s: {worst:.2e} rad");
+    assert!(worst < pick::<T>(1e-5, 1e-10), "{worst:e}");
+    assert!(simple.energy(&s) < simple.energy(&State::at_rest([T::one()])));
+    Ok(())
+}
+
+/// A drive torque `tau` on the rolling angle of the disk accelerates the rolling by
+/// `tau / (I_s + m R^2)` (the contact force makes the mass roll along), not by `tau / I_s`,
+/// and leaves the heading rate alone; to 8 ulps.
+fn drive_torque_acts_through_the_contact<T: Real>() -> Result<(), Error> {
+    let (m, r, tau) = (T::from_f64(2.0), T::from_f64(0.4), T::from_f64(0.6));
+    let disk = RollingDisk::new(m, r)?;
+    let driven = disk.with_force(Input::new([T::zero(), T::zero(), T::zero(), tau]));
+    let s = disk.rolling(
+        T::zero(),
+        [T::zero(); 4],
+        T::from_f64(0.5),
+        T::from_f64(3.0),
+    )?;
+    let a = driven.acceleration(&s)?;
+    let expected = tau / (T::HALF * m * r * r + m * r * r);
+    let tol = T::from_f64(8.0) * T::EPSILON * expected;
+    assert!((a[3] - expected).abs() <= tol, "{} vs {expected}", a[3]);
+    assert!(a[2].abs() <= tol);
+    Ok(())
+}
+
+for_f32_and_f64!(
+    damping_acts_through_the_rod,
+    drive_torque_acts_through_the_contact
+);
