@@ -454,7 +454,7 @@ fn lockstep(elf: &Path, decoder: &Path) -> Result<Vec<String>, String> {
          SysTick tick), {STEPS} steps of 1 ms:"
     );
     println!(
-        "{:>3}  {:<22} {:<16} {:<5} {:<12} {:>12} {:>8}",
+        "{:>3}  {:<22} {:<21} {:<5} {:<12} {:>12} {:>8}",
         "id", "system", "integrator", "type", "host = M4F", "instr/step", "stack B"
     );
     let mut per_step = BTreeMap::new();
@@ -490,7 +490,7 @@ fn lockstep(elf: &Path, decoder: &Path) -> Result<Vec<String>, String> {
             .get(&id)
             .map_or_else(|| "-".into(), u64::to_string);
         println!(
-            "{id:>3}  {:<22} {:<16} {:<5} {:<12} {cost:>12} {stack:>8}",
+            "{id:>3}  {:<22} {:<21} {:<5} {:<12} {cost:>12} {stack:>8}",
             case.system, case.method, case.precision, verdict
         );
     }

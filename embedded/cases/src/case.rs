@@ -3,7 +3,7 @@
 use core::hint::black_box;
 
 use lagrange_core::{Error, Real, State};
-use lagrange_integrators::Integrator;
+use lagrange_integrators::{Integrator, LagrangianSystem, VariationalMidpoint};
 
 use crate::Setup;
 
@@ -94,6 +94,24 @@ impl Case {
         }
     }
 
+    /// The case of setup `S` stepped by the variational midpoint integrator (which works on
+    /// the Lagrangian, so `S` must build a [`LagrangianSystem`]) in `T`.
+    #[must_use]
+    pub const fn variational<T, const N: usize, S>() -> Self
+    where
+        T: Precision,
+        S: Setup<T, N>,
+        S::Mechanism: LagrangianSystem<T, N>,
+    {
+        Self {
+            system: S::NAME,
+            method: "variational midpoint",
+            precision: T::NAME,
+            dof: N,
+            runner: run_variational::<T, N, S>,
+        }
+    }
+
     /// Builds the setup and takes `steps` steps; the final state's bits.
     ///
     /// # Errors
@@ -120,5 +138,24 @@ where
     for _ in 0..black_box(steps) {
         state = integrator.step(&mechanism, &state, dt)?;
     }
+    Ok(Outcome::of(&state))
+}
+
+/// As [`run`], with [`VariationalMidpoint`] in position-momentum form throughout.
+fn run_variational<T, const N: usize, S>(steps: u32) -> Result<Outcome, Error>
+where
+    T: Precision,
+    S: Setup<T, N>,
+    S::Mechanism: LagrangianSystem<T, N>,
+{
+    let (mechanism, start) = S::build()?;
+    let mechanism = black_box(mechanism);
+    let dt = black_box(T::from_f64(S::DT));
+    let state = VariationalMidpoint::default().integrate(
+        &mechanism,
+        &black_box(start),
+        dt,
+        u64::from(black_box(steps)),
+    )?;
     Ok(Outcome::of(&state))
 }

@@ -32,9 +32,12 @@ mod setups;
 pub use case::{Case, Outcome, Precision, MAX_WORDS};
 pub use kernels::{Kernel, KERNELS, KERNEL_CALLS};
 pub use libm_trig_pendulum::LibmTrigPendulum;
-pub use setups::{DoublePendulumSetup, LibmTrigPendulumSetup, PendulumSetup, Setup};
+pub use setups::{
+    CartPoleLagrangianSetup, CartPoleSetup, DoublePendulumSetup, LibmTrigPendulumSetup,
+    PendulumSetup, Setup,
+};
 
-use lagrange_integrators::{Rk4, SemiImplicitEuler, VelocityVerlet};
+use lagrange_integrators::{Rk4, SemiImplicitEuler, StormerVerlet, VelocityVerlet};
 
 /// Steps of every case in the lockstep comparison (1 s of simulated time at the setups' 1 ms).
 pub const STEPS: u32 = 1000;
@@ -47,8 +50,11 @@ pub const STEPS: u32 = 1000;
 /// Velocity Verlet and semi-implicit Euler are the symplectic methods (for the pendulum;
 /// velocity Verlet is not symplectic for the double pendulum, whose mass matrix depends on
 /// `q`). The libm-trig pendulum is the same pendulum with `libm::sinf`: the cost it is
-/// compared against.
-pub const CASES: [Case; 12] = [
+/// compared against. The cart-pole (mass matrix depending on `q`) is stepped by RK4, by
+/// Stormer-Verlet (symmetric, with an implicit kick), and by the variational midpoint rule,
+/// symplectic for any Lagrangian (on the automatic Euler-Lagrange path, Newton iterations in
+/// dual numbers).
+pub const CASES: [Case; 18] = [
     Case::new::<f32, 1, PendulumSetup, Rk4>(),
     Case::new::<f64, 1, PendulumSetup, Rk4>(),
     Case::new::<f32, 1, PendulumSetup, VelocityVerlet>(),
@@ -61,6 +67,12 @@ pub const CASES: [Case; 12] = [
     Case::new::<f64, 2, DoublePendulumSetup, Rk4>(),
     Case::new::<f32, 2, DoublePendulumSetup, VelocityVerlet>(),
     Case::new::<f64, 2, DoublePendulumSetup, VelocityVerlet>(),
+    Case::new::<f32, 2, CartPoleSetup, Rk4>(),
+    Case::new::<f64, 2, CartPoleSetup, Rk4>(),
+    Case::new::<f32, 2, CartPoleSetup, StormerVerlet<f32, 2>>(),
+    Case::new::<f64, 2, CartPoleSetup, StormerVerlet<f64, 2>>(),
+    Case::variational::<f32, 2, CartPoleLagrangianSetup>(),
+    Case::variational::<f64, 2, CartPoleLagrangianSetup>(),
 ];
 
 #[cfg(test)]

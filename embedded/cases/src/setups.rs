@@ -3,8 +3,8 @@
 
 use core::hint::black_box;
 
-use lagrange_core::{Error, Mechanism, Real, State};
-use lagrange_systems::{DoublePendulum, SimplePendulum};
+use lagrange_core::{Error, EulerLagrange, Mechanism, Real, State};
+use lagrange_systems::{CartPole, DoublePendulum, SimplePendulum};
 
 use crate::LibmTrigPendulum;
 
@@ -75,5 +75,40 @@ impl<T: Real> Setup<T, 2> for DoublePendulumSetup {
         let dp = DoublePendulum::new(one, one, one, one, black_box(T::from_f64(9.81)))?;
         let half_pi = T::from_f64(core::f64::consts::FRAC_PI_2);
         Ok((dp, State::at_rest([half_pi, half_pi])))
+    }
+}
+
+/// The classic cart-pole (cart 1 kg, pole 0.1 kg of half-length 0.5 m, g = 9.8 m/s^2) with a
+/// constant 1 N push on the cart, released at rest with the pole 0.3 rad from upright: it
+/// falls through the bottom and swings; 1 ms steps.
+pub struct CartPoleSetup;
+
+/// The cart-pole of [`CartPoleSetup`] for any scalar.
+fn cart_pole<T: Real>() -> Result<(CartPole<T>, State<T, 2>), Error> {
+    let v = |x: f64| black_box(T::from_f64(x));
+    let mut cp = CartPole::new(v(1.0), v(0.1), v(0.5), v(9.8))?;
+    cp.set_force(v(1.0))?;
+    Ok((cp, State::at_rest([T::zero(), T::from_f64(0.3)])))
+}
+
+impl<T: Real> Setup<T, 2> for CartPoleSetup {
+    type Mechanism = CartPole<T>;
+    const NAME: &'static str = "cart-pole";
+    const DT: f64 = 1e-3;
+    fn build() -> Result<(CartPole<T>, State<T, 2>), Error> {
+        cart_pole()
+    }
+}
+
+/// [`CartPoleSetup`] through the automatic Euler-Lagrange path ([`EulerLagrange`]), which the
+/// variational integrator needs (it works on the Lagrangian, in dual numbers).
+pub struct CartPoleLagrangianSetup;
+
+impl<T: Real> Setup<T, 2> for CartPoleLagrangianSetup {
+    type Mechanism = EulerLagrange<CartPole<T>>;
+    const NAME: &'static str = "cart-pole (automatic)";
+    const DT: f64 = 1e-3;
+    fn build() -> Result<(EulerLagrange<CartPole<T>>, State<T, 2>), Error> {
+        cart_pole().map(|(cp, s)| (EulerLagrange::new(cp), s))
     }
 }
