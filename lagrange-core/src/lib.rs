@@ -47,11 +47,13 @@ mod cholesky;
 pub mod constraints;
 mod dual;
 mod error;
+pub mod fast_trig;
 mod forces;
 mod jacobian;
 mod lagrangian;
 mod mechanism;
 mod scalar;
+mod scalar_trig;
 mod state;
 pub mod validate;
 

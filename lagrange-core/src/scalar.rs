@@ -1,11 +1,14 @@
 //! Scalars: [`Scalar`], what a Lagrangian is written over, and [`Real`], `f32` or `f64`.
 //!
-//! All math goes through these traits to `libm`, never to `std`'s inherent float methods, so the
-//! same code gives the same bits on a desktop and on a Cortex-M.
+//! All math goes through these traits to `libm` (or, for `f32` sine and cosine, to the pure-`f32`
+//! [`fast_trig`](crate::fast_trig)), never to `std`'s inherent float methods, so the same code
+//! gives the same bits on a desktop and on a Cortex-M.
 
 use core::fmt::{Debug, Display, LowerExp};
 use core::ops::{Add, AddAssign, Div, DivAssign, Mul, MulAssign, Neg, Sub, SubAssign};
 use num_traits::{One, Zero};
+
+use crate::scalar_trig;
 
 /// A number a Lagrangian can be evaluated in: `f32`, `f64`, or a [`Dual`](crate::Dual) number
 /// built on one of them (which is how the equations of motion are derived automatically).
@@ -126,7 +129,7 @@ pub(crate) fn powi_by_squaring<S: Scalar>(x: S, n: i32) -> S {
 }
 
 macro_rules! impl_real {
-    ($t:ident, $sin:ident, $cos:ident, $tan:ident, $sqrt:ident, $exp:ident,
+    ($t:ident, $sin:ident, $cos:ident, $sin_cos:ident, $tan:ident, $sqrt:ident, $exp:ident,
      $ln:ident, $fabs:ident, $atan2:ident, $floor:ident, $round:ident, $asin:ident,
      $acos:ident, $atan:ident, $pow:ident, $cbrt_eps:expr) => {
         impl Scalar for $t {
@@ -146,15 +149,15 @@ macro_rules! impl_real {
             }
             #[inline]
             fn sin(self) -> $t {
-                libm::$sin(self)
+                scalar_trig::$sin(self)
             }
             #[inline]
             fn cos(self) -> $t {
-                libm::$cos(self)
+                scalar_trig::$cos(self)
             }
             #[inline]
             fn sin_cos(self) -> ($t, $t) {
-                (libm::$sin(self), libm::$cos(self))
+                scalar_trig::$sin_cos(self)
             }
             #[inline]
             fn tan(self) -> $t {
@@ -247,6 +250,7 @@ impl_real!(
     f64,
     sin,
     cos,
+    sin_cos,
     tan,
     sqrt,
     exp,
@@ -265,6 +269,7 @@ impl_real!(
     f32,
     sinf,
     cosf,
+    sin_cosf,
     tanf,
     sqrtf,
     expf,

@@ -237,7 +237,9 @@ impl<T: Real, const N: usize, const S: usize> Lu<T, N, S> {
         let n = N * S;
         let mut x = *b;
         for k in 0..n {
-            let p = self.pivots[k / N][k % N];
+            // `p < n` by construction; `min` says so to the optimiser, which then drops the
+            // bounds checks of `flat` (the panic-free firmware image links only without them).
+            let p = self.pivots[k / N][k % N].min(n - 1);
             if p != k {
                 let tmp = flat(&x, k);
                 *flat_mut(&mut x, k) = flat(&x, p);

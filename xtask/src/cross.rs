@@ -12,7 +12,7 @@ use std::process::Command;
 use crate::cmd;
 
 /// The embedded target every build in this task uses.
-const TARGET: &str = "thumbv7em-none-eabihf";
+pub(crate) const TARGET: &str = "thumbv7em-none-eabihf";
 
 /// The library crates, each built for [`TARGET`] with every entry of [`FEATURE_SETS`].
 const CRATES: [&str; 3] = ["lagrange-core", "lagrange-integrators", "lagrange-systems"];
@@ -67,7 +67,7 @@ pub fn run() -> Result<(), String> {
 ///
 /// Without a working `rustup` (a toolchain from a distribution, say) it warns and goes on:
 /// the builds then show whether the target is there.
-fn ensure_target() -> Result<(), String> {
+pub(crate) fn ensure_target() -> Result<(), String> {
     let mut list = Command::new("rustup");
     list.args(["target", "list", "--installed"]);
     println!("$ {}", shown(&list));
@@ -93,7 +93,7 @@ fn ensure_target() -> Result<(), String> {
 }
 
 /// A command as `cmd::run` echoes it.
-fn shown(command: &Command) -> String {
+pub(crate) fn shown(command: &Command) -> String {
     format!("{command:?}").replace('"', "")
 }
 
@@ -133,7 +133,7 @@ fn print_sizes(elf: &Path, sizes: &[(&str, Option<u32>)]) {
 /// `.vector_table`, or an empty `.text`): `RUSTFLAGS` in the environment, for one, replaces the
 /// `-Tlink.x` of `embedded/smoke/.cargo/config.toml`, and the linker then silently drops every
 /// section.
-fn section_sizes(path: &Path) -> Result<Vec<(&'static str, Option<u32>)>, String> {
+pub(crate) fn section_sizes(path: &Path) -> Result<Vec<(&'static str, Option<u32>)>, String> {
     let bytes = std::fs::read(path).map_err(|e| format!("cannot read: {e}"))?;
     let sections = elf32_sections(&bytes)?;
     let size_of = |wanted: &str| {

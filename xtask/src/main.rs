@@ -10,7 +10,12 @@
 //!   `target/lagrange-bench/` (not part of `ci`). `--quick` for a smoke run.
 //! - `cross`: thumbv7em-none-eabihf builds of the library crates, with and without `defmt`,
 //!   and a linked no_std binary with no allocator, with its size.
-//! - `ci`: format check, clippy with `-D warnings`, test, cross.
+//! - `qemu`: the firmware on an emulated Cortex-M4F (QEMU `mps2-an386`), its defmt log compared
+//!   bit for bit with the host, instructions per step, stack and `.text` sizes, the panic-free
+//!   image; installs QEMU and `defmt-print` when missing.
+//! - `trig-fit`: derives the polynomials and constants of `lagrange_core::fast_trig` and
+//!   checks the library's against them.
+//! - `ci`: format check, clippy with `-D warnings`, test, cross, qemu.
 
 mod cmd;
 mod cross;
@@ -18,7 +23,9 @@ mod demo;
 mod demo_constraints;
 mod demo_integrators;
 mod demo_systems;
+mod qemu;
 mod svg;
+mod trig_fit;
 
 use std::process::ExitCode;
 
@@ -29,9 +36,11 @@ fn main() -> ExitCode {
         "test" => cmd::run_all(&TEST).and(cmd::run_all(&LONG_TEST)),
         "cross" => cross::run(),
         "bench" => cmd::run(cmd::cargo().args(BENCH).args(std::env::args().skip(2))),
+        "qemu" => qemu::run(),
         "ci" => ci(),
+        "trig-fit" => trig_fit::run(),
         _ => {
-            eprintln!("usage: cargo xtask <demo | test | cross | bench | ci>");
+            eprintln!("usage: cargo xtask <demo | test | cross | bench | qemu | trig-fit | ci>");
             return ExitCode::from(2);
         }
     };
@@ -97,6 +106,7 @@ fn ci() -> Result<(), String> {
         cmd::run_all(&DOC_TEST),
         cmd::run_all(&LONG_TEST),
         cross::run(),
+        qemu::run(),
     ]
     .into_iter()
     .filter_map(Result::err)

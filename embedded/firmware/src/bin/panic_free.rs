@@ -1,0 +1,152 @@
+//! The panic-free check: steps every shipped unconstrained mechanism with the shipped
+//! fixed-step integrators (explicit, symplectic, Yoshida, the one-stage implicit ones with
+//! Newton), in `f32` and `f64`, plus the automatic Euler-Lagrange path with a damping force
+//! and the variational integrator, from inputs the optimiser cannot see (`black_box`), with
+//! `panic-never` as the panic handler. That handler references an undefined symbol, so the
+//! image links only if the optimised stepping code holds no panic path at all (no bounds
+//! check, unwrap or overflow check left). `cargo xtask qemu` builds it in release (opt-level 3)
+//! and runs it.
+//!
+//! Not yet included: the two-stage implicit Runge-Kutta methods (`GaussLegendre2`,
+//! `RadauIIA2`), whose Newton solve (`lagrange_integrators::newton::solve` for `S = 2`) still
+//! holds a bounds check the optimiser cannot remove; adding them here makes the link fail.
+
+#![no_std]
+#![no_main]
+
+use core::hint::black_box;
+
+use cortex_m_rt::{entry, exception, ExceptionFrame};
+use lagrange_core::{Error, EulerLagrange, Mechanism, Real, State, ViscousDamping};
+use lagrange_firmware::exit;
+use lagrange_integrators::{
+    BackwardEuler, ExplicitEuler, ImplicitMidpoint, Integrator, Rk4, SemiImplicitEuler,
+    StormerVerlet, VariationalMidpoint, VelocityVerlet, Yoshida4,
+};
+use lagrange_systems::{
+    Acrobot, BeadOnRotatingHoop, CartPole, DoublePendulum, ElasticPendulum, FallingParticle,
+    Kepler, NLinkPendulum, SimplePendulum, SphericalPendulum, SpringMassDamper, SwingingAtwood,
+};
+use panic_never as _;
+
+/// Steps per run: the count is opaque to the optimiser anyway.
+const STEPS: u32 = 10;
+
+/// `STEPS` steps of `m` from `start` with every shipped integrator; `true` when all succeed.
+fn every_integrator<T: Real, const N: usize, M: Mechanism<T, N>>(
+    m: &M,
+    start: State<T, N>,
+) -> bool {
+    fn run<T: Real, const N: usize, M: Mechanism<T, N>, I: Integrator<T, N>>(
+        mut integrator: I,
+        m: &M,
+        start: State<T, N>,
+    ) -> Result<State<T, N>, Error> {
+        let dt = black_box(T::from_f64(1e-3));
+        let mut s = black_box(start);
+        for _ in 0..black_box(STEPS) {
+            s = integrator.step(black_box(m), &s, dt)?;
+        }
+        Ok(black_box(s))
+    }
+    run(ExplicitEuler, m, start).is_ok()
+        & run(SemiImplicitEuler, m, start).is_ok()
+        & run(VelocityVerlet, m, start).is_ok()
+        & run(Rk4, m, start).is_ok()
+        & run(StormerVerlet::default(), m, start).is_ok()
+        & run(Yoshida4::new(StormerVerlet::default()), m, start).is_ok()
+        & run(ImplicitMidpoint::default(), m, start).is_ok()
+        & run(BackwardEuler::default(), m, start).is_ok()
+}
+
+/// `STEPS` steps of the variational midpoint rule (which works on a Lagrangian).
+fn variational<T: Real, const N: usize, L: lagrange_integrators::LagrangianSystem<T, N>>(
+    sys: &L,
+    start: State<T, N>,
+) -> bool {
+    let dt = black_box(T::from_f64(1e-3));
+    VariationalMidpoint::default()
+        .integrate(
+            black_box(sys),
+            &black_box(start),
+            dt,
+            u64::from(black_box(STEPS)),
+        )
+        .is_ok()
+}
+
+/// Every shipped mechanism, and the automatic path, in `T`; `true` when every run succeeds.
+fn every_mechanism<T: Real>() -> Result<bool, Error> {
+    let v = |x: f64| black_box(T::from_f64(x));
+    let pendulum = SimplePendulum::new(v(1.0), v(1.0), v(9.81), v(0.1))?;
+    let automatic = EulerLagrange::new(SimplePendulum::new(v(1.0), v(1.0), v(9.81), v(0.0))?)
+        .with_force(ViscousDamping::uniform(v(0.1))?);
+    Ok(every_integrator(
+        &FallingParticle::new(v(1.0), v(9.81))?,
+        State::at_rest([v(1.0)]),
+    ) & every_integrator(&pendulum, State::at_rest([v(0.5)]))
+        & every_integrator(
+            &BeadOnRotatingHoop::new(v(1.0), v(1.0), v(5.0), v(9.81))?,
+            State::at_rest([v(0.5)]),
+        )
+        & every_integrator(
+            &DoublePendulum::new(v(1.0), v(1.0), v(1.0), v(1.0), v(9.81))?,
+            State::at_rest([v(1.5), v(-1.5)]),
+        )
+        & every_integrator(&automatic, State::at_rest([v(0.5)]))
+        & every_integrator(
+            &CartPole::new(v(1.0), v(0.1), v(0.5), v(9.8))?,
+            State::at_rest([v(0.0), v(0.3)]),
+        )
+        & every_integrator(
+            &Acrobot::new(
+                v(1.0),
+                v(1.0),
+                v(1.0),
+                v(2.0),
+                v(0.5),
+                v(1.0),
+                v(0.083),
+                v(0.33),
+                v(9.8),
+            )?,
+            State::at_rest([v(0.3), v(0.2)]),
+        )
+        & every_integrator(
+            &SpringMassDamper::new(v(1.0), v(4.0), v(0.1))?,
+            State::at_rest([v(1.0)]),
+        )
+        & every_integrator(
+            &ElasticPendulum::new(v(1.0), v(40.0), v(1.0), v(9.81))?,
+            State::at_rest([v(1.1), v(0.3)]),
+        )
+        & every_integrator(
+            &SwingingAtwood::new(v(3.0), v(1.0), v(9.81))?,
+            State::at_rest([v(1.0), v(0.5)]),
+        )
+        & every_integrator(
+            &Kepler::new(v(1.0))?,
+            State::new(v(0.0), [v(1.0), v(0.0)], [v(0.0), v(1.1)]),
+        )
+        & every_integrator(
+            &SphericalPendulum::new(v(1.0), v(1.0), v(9.81))?,
+            State::new(v(0.0), [v(0.5), v(0.0)], [v(0.0), v(1.0)]),
+        )
+        & every_integrator(
+            &NLinkPendulum::new([v(1.0); 3], [v(1.0); 3], v(9.81))?,
+            State::at_rest([v(0.5), v(-0.2), v(0.1)]),
+        )
+        & variational(&automatic, State::at_rest([v(0.5)])))
+}
+
+#[entry]
+fn main() -> ! {
+    let f32_ok = matches!(every_mechanism::<f32>(), Ok(true));
+    let f64_ok = matches!(every_mechanism::<f64>(), Ok(true));
+    exit(f32_ok && f64_ok)
+}
+
+#[exception]
+unsafe fn HardFault(_frame: &ExceptionFrame) -> ! {
+    exit(false)
+}
