@@ -88,10 +88,12 @@ const CHECKS: [&[&str]; 2] = [
 const DOC_TEST: [&[&str]; 1] = [&["test", "--workspace", "--doc", "--quiet"]];
 
 /// Long runs (10^6 steps and more) are `#[ignore]`d in the quick debug test run and run here,
-/// optimised.
+/// optimised. They all live in the `tests` crate, so the bench crate's heavy dependencies are
+/// not built in release for them.
 const LONG_TEST: [&[&str]; 1] = [&[
     "test",
-    "--workspace",
+    "-p",
+    "lagrange-tests",
     "--release",
     "--quiet",
     "--",
