@@ -5,6 +5,9 @@
 //!   cost per step and per acceleration), the chain's cost against N, and the Kepler orbit;
 //!   then a constrained and a colliding scene with their plots.
 //! - `test`: host tests of every crate, f32 and f64, the long runs (`#[ignore]`d) in release.
+//! - `bench`: run time against error (`benches/src/work_precision`): every integrator on the
+//!   standard problems, CSV, Markdown and SVG work-precision plots under
+//!   `target/lagrange-bench/` (not part of `ci`). `--quick` for a smoke run.
 //! - `cross`: thumbv7em-none-eabihf builds of the library crates, with and without `defmt`,
 //!   and a linked no_std binary with no allocator, with its size.
 //! - `qemu`: the firmware on an emulated Cortex-M4F (QEMU `mps2-an386`), its defmt log compared
@@ -32,11 +35,12 @@ fn main() -> ExitCode {
         "demo" => demo::run(),
         "test" => cmd::run_all(&TEST).and(cmd::run_all(&LONG_TEST)),
         "cross" => cross::run(),
+        "bench" => cmd::run(cmd::cargo().args(BENCH).args(std::env::args().skip(2))),
         "qemu" => qemu::run(),
         "ci" => ci(),
         "trig-fit" => trig_fit::run(),
         _ => {
-            eprintln!("usage: cargo xtask <demo | test | cross | qemu | trig-fit | ci>");
+            eprintln!("usage: cargo xtask <demo | test | cross | bench | qemu | trig-fit | ci>");
             return ExitCode::from(2);
         }
     };
@@ -48,6 +52,20 @@ fn main() -> ExitCode {
         }
     }
 }
+
+/// The work-precision bench, optimised like xtask itself (it lives in `benches/` so that its
+/// dependencies, `ode_solvers` among them, are not built by every `cargo xtask`).
+const BENCH: [&str; 9] = [
+    "run",
+    "--quiet",
+    "--profile",
+    "xtask",
+    "-p",
+    "lagrange-benches",
+    "--bin",
+    "work-precision",
+    "--",
+];
 
 /// Host tests of the whole workspace: unit, integration and doc tests, f32 and f64 alike.
 const TEST: [&[&str]; 1] = [&["test", "--workspace", "--all-targets", "--quiet"]];

@@ -1,0 +1,428 @@
+//! The [`Method`] contract of the bench (a way of solving a problem over `[0, T]` at a step size
+//! or a tolerance) and the methods table.
+
+use super::ode_peer::{OdeSolvers, Peer};
+use super::problem::Problem;
+use super::real::BenchReal;
+use lagrange_core::{Error, EulerLagrange, Mechanism, Real, State};
+use lagrange_integrators::{
+    AdaptiveSettings, BackwardEuler, Dop853Pair, Dopri5Pair, EmbeddedPair, EmbeddedRungeKutta,
+    ExplicitEuler, GaussLegendre2, ImplicitMidpoint, Integrator, RadauIIA2, Rk4, SemiImplicitEuler,
+    StormerVerlet, VariationalMidpoint, VelocityVerlet, Yoshida4,
+};
+use std::marker::PhantomData;
+
+/// Whose code a method is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Origin {
+    /// lagrange's own integrators.
+    Library,
+    /// A plain loop written by hand for one problem: the speed limit.
+    HandWritten,
+    /// The `ode_solvers` crate.
+    OdeSolvers,
+}
+
+impl Origin {
+    /// For tables.
+    pub fn label(self) -> &'static str {
+        match self {
+            Self::Library => "lagrange",
+            Self::HandWritten => "hand-written",
+            Self::OdeSolvers => "ode_solvers",
+        }
+    }
+}
+
+/// What a method's sweep varies.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Kind {
+    /// A fixed step `dt`, swept from the problem's coarsest step down by halves.
+    FixedStep,
+    /// An error tolerance (relative = absolute), swept down by decades.
+    Adaptive,
+}
+
+/// One point of a sweep.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Param {
+    /// `steps` steps of `dt`, with `dt * steps` the final time.
+    Step {
+        /// Step size, s.
+        dt: f64,
+        /// Number of steps.
+        steps: u64,
+    },
+    /// Relative and absolute tolerance.
+    Tolerance(f64),
+}
+
+impl Param {
+    /// `dt` or the tolerance.
+    pub fn value(self) -> f64 {
+        match self {
+            Self::Step { dt, .. } => dt,
+            Self::Tolerance(tol) => tol,
+        }
+    }
+}
+
+/// What a solve returns.
+pub struct Outcome<T: Real, const N: usize> {
+    /// The state at the final time.
+    pub end: State<T, N>,
+    /// Steps taken (accepted and rejected, for adaptive methods).
+    pub steps: u64,
+    /// Acceleration evaluations, when the method counts them itself (otherwise the runner
+    /// counts calls to `Mechanism::acceleration`).
+    pub evals: Option<u64>,
+}
+
+/// An observer of every state a solve passes through (`None` in timed runs).
+pub type Observer<'a, T, const N: usize> = Option<&'a mut dyn FnMut(&State<T, N>)>;
+
+/// A way of solving a problem: an integrator of the library, a hand-written loop, another
+/// crate's solver.
+pub trait Method {
+    /// Name for tables and legends.
+    fn name(&self) -> &'static str;
+    /// Whose code it is.
+    fn origin(&self) -> Origin;
+    /// Fixed step or adaptive.
+    fn kind(&self) -> Kind;
+    /// For an explicit fixed-step method, the largest `h w` for which it is stable on an
+    /// undamped linear oscillator of frequency `w` (`0` when no step is: explicit Euler).
+    fn linear_stability_limit(&self) -> Option<f64> {
+        None
+    }
+    /// True for a fixed-step method whose step is explicit (for the mechanisms of the
+    /// stability scan), so that it has a stability limit to find.
+    fn explicit(&self) -> bool {
+        false
+    }
+    /// Solves `problem` (whose mechanism in `T` is `mechanism`, possibly wrapped) from `start`
+    /// to `t_end` at `param`, calling `observe` with every new state when given.
+    ///
+    /// `None` when the method does not apply to the problem (a hand-written loop exists for
+    /// P1 and P2 only); `Some(Err)` when the solve failed (a blow-up past the stability limit,
+    /// a step size underflow), with the reason.
+    #[allow(clippy::too_many_arguments)]
+    fn solve<T, P, M, const N: usize, const N2: usize>(
+        &self,
+        problem: &P,
+        mechanism: &M,
+        start: &State<T, N>,
+        t_end: T,
+        param: Param,
+        observe: Observer<'_, T, N>,
+    ) -> Option<Result<Outcome<T, N>, String>>
+    where
+        T: BenchReal,
+        P: Problem<N, N2>,
+        M: Mechanism<T, N>;
+}
+
+/// Something done once per method of the table.
+pub trait MethodVisitor {
+    /// Called with each method.
+    fn visit<X: Method>(&mut self, method: &X);
+}
+
+/// The methods table: one line per method. A new fixed-step integrator of the library is one
+/// line in [`fixed_step!`]'s list below and one line here; an adaptive one, one line here.
+pub fn for_each(v: &mut impl MethodVisitor) {
+    v.visit(&Library(ExplicitEulerFamily));
+    v.visit(&Library(SemiImplicitEulerFamily));
+    v.visit(&Library(VelocityVerletFamily));
+    v.visit(&Library(StormerVerletFamily));
+    v.visit(&Library(Rk4Family));
+    v.visit(&Library(Yoshida4Family));
+    v.visit(&Library(ImplicitMidpointFamily));
+    v.visit(&Library(GaussLegendre2Family));
+    v.visit(&Library(BackwardEulerFamily));
+    v.visit(&Library(RadauIIA2Family));
+    v.visit(&Variational);
+    v.visit(&Adaptive::<7, 1, Dopri5Pair>(PhantomData));
+    v.visit(&Adaptive::<16, 4, Dop853Pair>(PhantomData));
+    v.visit(&HandRk4);
+    v.visit(&OdeSolvers(Peer::Dopri5));
+    v.visit(&OdeSolvers(Peer::Dop853));
+}
+
+/// A fixed-step integrator of the library, for every scalar and dimension at once (which a
+/// bound `Integrator<T, N>` cannot say for all `T` and `N`): a family of integrator types.
+pub trait FixedStep {
+    /// The integrator in precision `T` for `N` degrees of freedom.
+    type Of<T: Real, const N: usize>: Integrator<T, N>;
+    /// The largest stable `h w` on an undamped linear oscillator (the imaginary-axis extent
+    /// of the stability region), for the explicit methods whose value is classical.
+    const LINEAR_STABILITY_LIMIT: Option<f64>;
+    /// Explicit (no Newton iteration where `q''` does not depend on `q'`).
+    const EXPLICIT: bool;
+    /// A new integrator (default settings).
+    fn make<T: Real, const N: usize>() -> Self::Of<T, N>;
+}
+
+/// Declares a [`FixedStep`] family per line: its marker type, the integrator type (in terms of
+/// `T` and `N`), how to make one, whether it is explicit, and its linear stability limit.
+macro_rules! fixed_step {
+    ($($family:ident: $ty:ty = $make:expr, $explicit:expr, $limit:expr;)*) => {
+        $(
+            #[doc = concat!("The family of `", stringify!($ty), "`.")]
+            pub struct $family;
+            impl FixedStep for $family {
+                type Of<T: Real, const N: usize> = $ty;
+                const LINEAR_STABILITY_LIMIT: Option<f64> = $limit;
+                const EXPLICIT: bool = $explicit;
+                fn make<T: Real, const N: usize>() -> Self::Of<T, N> {
+                    $make
+                }
+            }
+        )*
+    };
+}
+
+// Stability on y' = i w y: explicit Euler |1 + i h w| > 1 for every h; semi-implicit Euler and
+// Stormer-Verlet are stable for h w < 2; RK4 for h w < 2 sqrt 2. Yoshida's and the implicit
+// methods' limits are left to the bench to measure.
+fixed_step! {
+    ExplicitEulerFamily: ExplicitEuler = ExplicitEuler, true, Some(0.0);
+    SemiImplicitEulerFamily: SemiImplicitEuler = SemiImplicitEuler, true, Some(2.0);
+    VelocityVerletFamily: VelocityVerlet = VelocityVerlet, true, Some(2.0);
+    StormerVerletFamily: StormerVerlet<T, N> = StormerVerlet::default(), true, Some(2.0);
+    Rk4Family: Rk4 = Rk4, true, Some(2.0 * std::f64::consts::SQRT_2);
+    Yoshida4Family: Yoshida4<StormerVerlet<T, N>> = Yoshida4::new(StormerVerlet::default()), true, None;
+    ImplicitMidpointFamily: ImplicitMidpoint<T> = ImplicitMidpoint::default(), false, None;
+    GaussLegendre2Family: GaussLegendre2<T> = GaussLegendre2::default(), false, None;
+    BackwardEulerFamily: BackwardEuler<T> = BackwardEuler::default(), false, None;
+    RadauIIA2Family: RadauIIA2<T> = RadauIIA2::default(), false, None;
+}
+
+/// The name of a family's integrator.
+fn family_name<F: FixedStep>() -> &'static str {
+    <F::Of<f64, 1> as Integrator<f64, 1>>::NAME
+}
+
+/// A fixed-step integrator of the library.
+pub struct Library<F>(pub F);
+
+impl<F: FixedStep> Method for Library<F> {
+    fn name(&self) -> &'static str {
+        family_name::<F>()
+    }
+    fn origin(&self) -> Origin {
+        Origin::Library
+    }
+    fn kind(&self) -> Kind {
+        Kind::FixedStep
+    }
+    fn linear_stability_limit(&self) -> Option<f64> {
+        F::LINEAR_STABILITY_LIMIT
+    }
+    fn explicit(&self) -> bool {
+        F::EXPLICIT
+    }
+    fn solve<T, P, M, const N: usize, const N2: usize>(
+        &self,
+        _problem: &P,
+        mechanism: &M,
+        start: &State<T, N>,
+        _t_end: T,
+        param: Param,
+        observe: Observer<'_, T, N>,
+    ) -> Option<Result<Outcome<T, N>, String>>
+    where
+        T: BenchReal,
+        P: Problem<N, N2>,
+        M: Mechanism<T, N>,
+    {
+        let Param::Step { dt, steps } = param else {
+            return None;
+        };
+        let mut integrator = F::make::<T, N>();
+        let dt = T::real(dt);
+        let end = match observe {
+            Some(o) => integrator.integrate_with(mechanism, start, dt, steps, o),
+            None => integrator.integrate(mechanism, start, dt, steps),
+        };
+        Some(
+            end.map(|end| Outcome {
+                end,
+                steps,
+                evals: None,
+            })
+            .map_err(|e| e.to_string()),
+        )
+    }
+}
+
+/// The variational midpoint integrator, on the problem's mechanism as a Lagrangian system
+/// (`EulerLagrange` over it: the discrete Euler-Lagrange equations need `L`, not `q''`).
+/// It evaluates the Lagrangian in dual numbers, never `acceleration`: its evaluation count is
+/// reported as 0.
+pub struct Variational;
+
+impl Method for Variational {
+    fn name(&self) -> &'static str {
+        "variational midpoint"
+    }
+    fn origin(&self) -> Origin {
+        Origin::Library
+    }
+    fn kind(&self) -> Kind {
+        Kind::FixedStep
+    }
+    fn solve<T, P, M, const N: usize, const N2: usize>(
+        &self,
+        problem: &P,
+        _mechanism: &M,
+        start: &State<T, N>,
+        _t_end: T,
+        param: Param,
+        observe: Observer<'_, T, N>,
+    ) -> Option<Result<Outcome<T, N>, String>>
+    where
+        T: BenchReal,
+        P: Problem<N, N2>,
+        M: Mechanism<T, N>,
+    {
+        let Param::Step { dt, steps } = param else {
+            return None;
+        };
+        let system = match problem.mechanism::<T>() {
+            Ok(m) => EulerLagrange::new(m),
+            Err(e) => return Some(Err(e.to_string())),
+        };
+        let mut integrator = VariationalMidpoint::<T, N>::default();
+        let dt = T::real(dt);
+        let end = match observe {
+            Some(o) => integrator.integrate_with(&system, start, dt, steps, |s, _| o(s)),
+            None => integrator.integrate(&system, start, dt, steps),
+        };
+        Some(
+            end.map(|end| Outcome {
+                end,
+                steps,
+                evals: None,
+            })
+            .map_err(|e| e.to_string()),
+        )
+    }
+}
+
+/// An adaptive embedded Runge-Kutta pair of the library (`S` stages, `R` dense-output rows).
+pub struct Adaptive<const S: usize, const R: usize, P>(pub PhantomData<P>);
+
+/// Most steps one adaptive solve may take.
+const MAX_ADAPTIVE_STEPS: u64 = 10_000_000;
+
+impl<const S: usize, const R: usize, Pair: EmbeddedPair<S, R>> Method for Adaptive<S, R, Pair> {
+    fn name(&self) -> &'static str {
+        Pair::NAME
+    }
+    fn origin(&self) -> Origin {
+        Origin::Library
+    }
+    fn kind(&self) -> Kind {
+        Kind::Adaptive
+    }
+    fn solve<T, P, M, const N: usize, const N2: usize>(
+        &self,
+        _problem: &P,
+        mechanism: &M,
+        start: &State<T, N>,
+        t_end: T,
+        param: Param,
+        observe: Observer<'_, T, N>,
+    ) -> Option<Result<Outcome<T, N>, String>>
+    where
+        T: BenchReal,
+        P: Problem<N, N2>,
+        M: Mechanism<T, N>,
+    {
+        let Param::Tolerance(tol) = param else {
+            return None;
+        };
+        let solve = || -> Result<Outcome<T, N>, Error> {
+            let tol = T::real(tol);
+            let settings = AdaptiveSettings::new(tol, tol)?.with_max_steps(MAX_ADAPTIVE_STEPS)?;
+            let mut rk = EmbeddedRungeKutta::<T, N, S, R, Pair>::new(settings, mechanism, start)?;
+            let end = match observe {
+                None => rk.integrate_to(mechanism, t_end)?,
+                Some(o) => {
+                    // Accepted steps one by one while they end before t_end, then the last
+                    // one (or few), shortened to land on it.
+                    while rk.state().t + rk.step_size() < t_end {
+                        o(&rk.step(mechanism)?);
+                    }
+                    let end = rk.integrate_to(mechanism, t_end)?;
+                    o(&end);
+                    end
+                }
+            };
+            let stats = rk.statistics();
+            Ok(Outcome {
+                end,
+                steps: stats.accepted + stats.rejected,
+                evals: None,
+            })
+        };
+        Some(solve().map_err(|e| e.to_string()))
+    }
+}
+
+/// The hand-written RK4 loop of a problem, where it has one.
+pub struct HandRk4;
+
+impl Method for HandRk4 {
+    fn name(&self) -> &'static str {
+        "hand-written RK4"
+    }
+    fn origin(&self) -> Origin {
+        Origin::HandWritten
+    }
+    fn kind(&self) -> Kind {
+        Kind::FixedStep
+    }
+    fn solve<T, P, M, const N: usize, const N2: usize>(
+        &self,
+        problem: &P,
+        _mechanism: &M,
+        start: &State<T, N>,
+        _t_end: T,
+        param: Param,
+        observe: Observer<'_, T, N>,
+    ) -> Option<Result<Outcome<T, N>, String>>
+    where
+        T: BenchReal,
+        P: Problem<N, N2>,
+        M: Mechanism<T, N>,
+    {
+        let Param::Step { dt, steps } = param else {
+            return None;
+        };
+        let dt = T::real(dt);
+        let end = match observe {
+            // The loop carries only the state, so one call per step does the same arithmetic
+            // as one call for all steps.
+            Some(o) => {
+                let mut s = *start;
+                for _ in 0..steps {
+                    s = problem.hand_rk4(&s, dt, 1)?;
+                    o(&s);
+                }
+                s
+            }
+            None => problem.hand_rk4(start, dt, steps)?,
+        };
+        Some(if end.is_finite() {
+            Ok(Outcome {
+                end,
+                steps,
+                evals: Some(4 * steps),
+            })
+        } else {
+            Err(Error::NonFiniteState.to_string())
+        })
+    }
+}

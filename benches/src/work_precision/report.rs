@@ -1,0 +1,486 @@
+//! The bench's output: `bench.csv` (every point), `report.md` (summary, budgets, stability
+//! limits, every point) and the SVG work-precision plots.
+
+use super::budgets::{Rk4Ratio, RK4_BUDGET};
+use super::chain_cost::ChainCost;
+use super::method::Origin;
+use super::plot::{log_log, Line};
+use super::stability::{Limit, STABLE_ENERGY_ERROR};
+use super::sweep::{Row, Sweeps};
+use super::timing::Budget;
+use super::work_precision::{curves, time_at, Reach};
+use std::fmt::Write;
+use std::path::Path;
+
+/// How the run went, for the report's header.
+pub struct Context {
+    /// A `--quick` smoke run.
+    pub quick: bool,
+    /// Wall time of the whole bench, s.
+    pub elapsed: f64,
+    /// 1-minute load average before and after.
+    pub load: (Option<f64>, Option<f64>),
+    /// Timing budget per point.
+    pub budget: Budget,
+}
+
+/// Error levels of the f64 summary tables and of the comparison with `ode_solvers`.
+pub const F64_LEVELS: [f64; 2] = [1e-6, 1e-10];
+/// Error level of the f32 summary table (f32 rounding floors most problems near 1e-6).
+pub const F32_LEVEL: f64 = 1e-4;
+
+/// Writes every output file into `dir` and returns their names.
+pub fn write(
+    dir: &Path,
+    context: &Context,
+    sweeps: &Sweeps,
+    ratios: &[Rk4Ratio],
+    chain: &ChainCost,
+    limits: &[Limit],
+) -> Result<Vec<String>, String> {
+    let mut files = Vec::new();
+    let mut put = |name: String, text: String| -> Result<(), String> {
+        let path = dir.join(&name);
+        std::fs::write(&path, text).map_err(|e| format!("{}: {e}", path.display()))?;
+        files.push(name);
+        Ok(())
+    };
+    put("bench.csv".into(), csv(&sweeps.rows))?;
+    let plots = plots(&sweeps.rows);
+    let names: Vec<String> = plots.iter().map(|(n, _)| n.clone()).collect();
+    for (name, svg) in plots {
+        put(name, svg)?;
+    }
+    put(
+        "report.md".into(),
+        markdown(context, sweeps, ratios, chain, limits, &names),
+    )?;
+    Ok(files)
+}
+
+/// Every point as CSV.
+fn csv(rows: &[Row]) -> String {
+    let mut s = String::from(
+        "problem,precision,method,origin,kind,param,t_end,steps,evals,jacobians,final_error,\
+         energy_error,seconds,seconds_per_simulated_second,ns_per_step,runs,failure\n",
+    );
+    // RFC 4180: a field holding a comma or a quote is quoted, its quotes doubled.
+    let field = |text: &str| {
+        if text.contains([',', '"']) {
+            format!("\"{}\"", text.replace('"', "\"\""))
+        } else {
+            text.to_string()
+        }
+    };
+    for r in rows {
+        let _ = writeln!(
+            s,
+            "{},{},{},{},{:?},{:e},{},{},{},{},{:e},{:e},{:e},{:e},{:.2},{},{}",
+            r.problem,
+            r.precision,
+            field(r.method),
+            r.origin.label(),
+            r.kind,
+            r.param,
+            r.t_end,
+            r.steps,
+            r.evals,
+            r.jacobians,
+            r.final_error,
+            r.energy_error,
+            r.seconds,
+            r.per_simulated_second(),
+            r.ns_per_step(),
+            r.runs,
+            field(r.failure.as_deref().unwrap_or(""))
+        );
+    }
+    s
+}
+
+/// One error plot and one energy plot per problem and precision.
+fn plots(rows: &[Row]) -> Vec<(String, String)> {
+    let all = curves(rows);
+    let mut keys: Vec<(&str, &str)> = Vec::new();
+    for c in &all {
+        if let Some(f) = c.first() {
+            if !keys.contains(&(f.problem, f.precision)) {
+                keys.push((f.problem, f.precision));
+            }
+        }
+    }
+    let mut out = Vec::new();
+    for (problem, precision) in keys {
+        let mine: Vec<&Vec<&Row>> = all
+            .iter()
+            .filter(|c| {
+                c.first()
+                    .is_some_and(|f| f.problem == problem && f.precision == precision)
+            })
+            .collect();
+        let lines = |x: fn(&Row) -> f64| -> Vec<Line> {
+            mine.iter()
+                .filter_map(|c| {
+                    let first = c.first()?;
+                    Some(Line {
+                        name: first.method.to_string(),
+                        points: c
+                            .iter()
+                            .filter(|r| r.ok())
+                            .map(|r| (x(r), r.per_simulated_second()))
+                            .collect(),
+                    })
+                })
+                .collect()
+        };
+        out.push((
+            format!("wp-{problem}-{precision}-error.svg"),
+            log_log(
+                &format!("{problem} ({precision}): work against final error"),
+                "final error max |y(T) - y_ref(T)|",
+                "wall time per simulated second (s)",
+                &lines(|r| r.final_error),
+            ),
+        ));
+        out.push((
+            format!("wp-{problem}-{precision}-energy.svg"),
+            log_log(
+                &format!("{problem} ({precision}): work against energy error"),
+                "max relative energy error max_t |E(t) - E(0)| / |E(0)|",
+                "wall time per simulated second (s)",
+                &lines(|r| r.energy_error),
+            ),
+        ));
+    }
+    out
+}
+
+/// A duration, human-readable.
+fn time(s: f64) -> String {
+    if !s.is_finite() {
+        "-".into()
+    } else if s < 1e-3 {
+        format!("{:.3} µs", s * 1e6)
+    } else if s < 1.0 {
+        format!("{:.3} ms", s * 1e3)
+    } else {
+        format!("{s:.3} s")
+    }
+}
+
+/// A reach, for a table cell.
+fn cell(reach: Reach) -> String {
+    match reach {
+        Reach::Interpolated(t) => time(t),
+        Reach::AtMost(t) => format!("≤ {}", time(t)),
+        Reach::NotReached { best } if best.is_finite() => format!("— ({best:.0e})"),
+        Reach::NotReached { .. } => "— (failed)".into(),
+    }
+}
+
+/// Problem ids in first-seen order.
+fn problem_ids(rows: &[Row]) -> Vec<&'static str> {
+    let mut ids = Vec::new();
+    for r in rows {
+        if !ids.contains(&r.problem) {
+            ids.push(r.problem);
+        }
+    }
+    ids
+}
+
+/// Method names (with origin) in first-seen order.
+fn method_names(rows: &[Row]) -> Vec<(&'static str, Origin)> {
+    let mut names = Vec::new();
+    for r in rows {
+        if !names.iter().any(|(n, _)| *n == r.method) {
+            names.push((r.method, r.origin));
+        }
+    }
+    names
+}
+
+/// The curve of one method on one problem in one precision.
+fn curve<'a>(rows: &'a [Row], problem: &str, precision: &str, method: &str) -> Vec<&'a Row> {
+    rows.iter()
+        .filter(|r| r.problem == problem && r.precision == precision && r.method == method)
+        .collect()
+}
+
+/// The summary table at `level` in `precision`: methods down, problems across.
+fn summary_table(s: &mut String, rows: &[Row], precision: &str, level: f64) {
+    let ids = problem_ids(rows);
+    let _ = write!(s, "| method |");
+    for id in &ids {
+        let _ = write!(s, " {id} |");
+    }
+    let _ = write!(s, "\n|---|");
+    for _ in &ids {
+        let _ = write!(s, "---:|");
+    }
+    s.push('\n');
+    for (method, _) in method_names(rows) {
+        let mut line = format!("| {method} |");
+        let mut any = false;
+        for id in &ids {
+            let c = curve(rows, id, precision, method);
+            if c.is_empty() {
+                line.push_str(" n/a |");
+            } else {
+                any = true;
+                let _ = write!(line, " {} |", cell(time_at(&c, level)));
+            }
+        }
+        if any {
+            s.push_str(&line);
+            s.push('\n');
+        }
+    }
+}
+
+/// The fastest method of `origin` at `level`: (method, time, reach).
+fn best_of(
+    rows: &[Row],
+    problem: &str,
+    origin: Origin,
+    level: f64,
+) -> Option<(&'static str, f64, Reach)> {
+    method_names(rows)
+        .into_iter()
+        .filter(|(_, o)| *o == origin)
+        .filter_map(|(m, _)| {
+            let reach = time_at(&curve(rows, problem, "f64", m), level);
+            reach.time().map(|t| (m, t, reach))
+        })
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+}
+
+/// The whole Markdown report.
+fn markdown(
+    context: &Context,
+    sweeps: &Sweeps,
+    ratios: &[Rk4Ratio],
+    chain: &ChainCost,
+    limits: &[Limit],
+    plots: &[String],
+) -> String {
+    let rows = &sweeps.rows;
+    let mut s = String::from("# lagrange: run time against error\n\n");
+    let cores = std::thread::available_parallelism().map_or(0, usize::from);
+    let load = |l: Option<f64>| l.map_or("?".into(), |v| format!("{v:.2}"));
+    let _ = writeln!(
+        s,
+        "Written by `cargo xtask bench{}` in {:.0} s on {cores} cores (1-minute load average {} \
+         before, {} after). Each time is the median of {}..{} whole solves over [0, T] (as \
+         many as fit about {} s per point), f64 and f32 alike; errors and energies are \
+         computed in f64. The machine may be shared: compare ratios and orders of magnitude, \
+         not the last digit.\n",
+        if context.quick { " --quick" } else { "" },
+        context.elapsed,
+        load(context.load.0),
+        load(context.load.1),
+        context.budget.min_runs,
+        context.budget.max_runs,
+        context.budget.seconds
+    );
+
+    s.push_str("## Problems and references\n\n");
+    s.push_str("| id | problem | T (s) | mechanism simulated | reference | its error | E(0) |\n|---|---|---:|---|---|---:|---:|\n");
+    for r in &sweeps.references {
+        let _ = writeln!(
+            s,
+            "| {} | {} | {:.6} | {} | {} | {:.1e} | {:.6} |",
+            r.problem, r.title, r.t_end, r.mechanism, r.source, r.error, r.e0
+        );
+    }
+    s.push_str(
+        "\nFinal error: `max_i |y_i(T) - y_ref,i(T)|` over angles (rad, unwrapped) and rates. \
+         Energy error: `max_t |E(t) - E(0)| / |E(0)|` over every step, with `V = 0` at the \
+         hanging rest state for pendulums and chains (`BENCH_PROBLEMS.md`).\n",
+    );
+
+    for level in F64_LEVELS {
+        let _ = writeln!(
+            s,
+            "\n## Summary (f64): wall time per simulated second at final error {level:.0e}\n"
+        );
+        summary_table(&mut s, rows, "f64", level);
+    }
+    let _ = writeln!(
+        s,
+        "\n## Summary (f32): wall time per simulated second at final error {F32_LEVEL:.0e}\n"
+    );
+    summary_table(&mut s, rows, "f32", F32_LEVEL);
+    s.push_str(
+        "\nInterpolated log-log between the two sweep points around the level; `≤ t`: the \
+         coarsest point of the sweep is already below the level; `— (e)`: the sweep never gets \
+         there, `e` its best error (rounding floor, stability, or the time cap per point).\n",
+    );
+
+    s.push_str("\n## Budgets\n\n### The library's RK4 against a hand-written RK4 loop\n\n");
+    s.push_str(
+        "Same problem, step and precision; whole solves timed in interleaved pairs; the ratio \
+         is the median of the per-pair ratios.\n\n\
+         | problem | precision | dt | steps | library ns/step | hand-written ns/step | ratio | ratio of fastest runs | within 1.1x | max difference of final states |\n\
+         |---|---|---:|---:|---:|---:|---:|---:|---|---:|\n",
+    );
+    for r in ratios {
+        let _ = writeln!(
+            s,
+            "| {} | {} | {:.0e} | {} | {:.1} | {:.1} | {:.3} | {:.3} | {} | {:.1e} |",
+            r.problem,
+            r.precision,
+            r.dt,
+            r.steps,
+            r.library_ns,
+            r.hand_ns,
+            r.ratio,
+            r.library_min_ns / r.hand_min_ns,
+            if r.ratio <= RK4_BUDGET {
+                "yes"
+            } else {
+                "**no**"
+            },
+            r.max_difference
+        );
+    }
+
+    s.push_str(
+        "\n### Best library method against `ode_solvers`' best at equal final error (f64)\n\n\
+         | problem | final error | best lagrange method | time / sim s | best ode_solvers method | time / sim s | lagrange faster by |\n\
+         |---|---:|---|---:|---|---:|---:|\n",
+    );
+    for id in problem_ids(rows) {
+        for level in F64_LEVELS {
+            let lib = best_of(rows, id, Origin::Library, level);
+            let peer = best_of(rows, id, Origin::OdeSolvers, level);
+            let show = |b: Option<(&str, f64, Reach)>| {
+                b.map_or(("not reached".to_string(), "-".to_string()), |(m, _, r)| {
+                    (m.to_string(), cell(r))
+                })
+            };
+            let ((lm, lt), (pm, pt)) = (show(lib), show(peer));
+            let factor = match (lib, peer) {
+                (Some((_, a, _)), Some((_, b, _))) => format!("{:.2}x", b / a),
+                _ => "-".into(),
+            };
+            let _ = writeln!(
+                s,
+                "| {id} | {level:.0e} | {lm} | {lt} | {pm} | {pt} | {factor} |"
+            );
+        }
+    }
+    s.push_str(
+        "\n`lagrange faster by` is ode_solvers' time over lagrange's: below 1, ode_solvers is \
+         faster. Both call the same `Mechanism::acceleration`.\n",
+    );
+
+    s.push_str("\n### The chain's cost per step against N\n\n");
+    if chain.points.is_empty() {
+        s.push_str("Not measured (P3 not selected).\n");
+    } else {
+        let _ = writeln!(
+            s,
+            "Mechanism: {}. One RK4 step (4 evaluations), one assembly of `M` and `f`, one \
+             fixed-size Cholesky solve, f64; and one RK4 step through the automatic \
+             Euler-Lagrange path on the same chain's Lagrangian.\n\n\
+             | N | ns per RK4 step | ns per assembly | ns per solve | ns per RK4 step, automatic path |\n\
+             |---:|---:|---:|---:|---:|",
+            chain.mechanism
+        );
+        for p in &chain.points {
+            let _ = writeln!(
+                s,
+                "| {} | {:.0} | {:.0} | {:.0} | {:.0} |",
+                p.n, p.ns_per_step, p.ns_assembly, p.ns_solve, p.ns_per_step_automatic
+            );
+        }
+        let _ = writeln!(
+            s,
+            "\nFitted exponents (least squares of log cost on log N): step **{:.2}** over \
+             N = 2..20, {:.2} over N = 8..20; assembly {:.2}; solve {:.2}; automatic path \
+             {:.2}. The budget is O(N^2) plus the fixed-size solve (O(N^3) with a small \
+             constant).",
+            chain.exponent_step,
+            chain.exponent_step_large,
+            chain.exponent_assembly,
+            chain.exponent_solve,
+            chain.exponent_automatic
+        );
+    }
+
+    let _ = writeln!(
+        s,
+        "\n## Stability limits (f64)\n\nLargest `dt` for which a whole solve over [0, T] finishes \
+         with relative energy error at most {STABLE_ENERGY_ERROR}: scanned upwards by doublings \
+         from T / (max steps), then bisected geometrically. `w`: the problem's fastest \
+         small-oscillation frequency; `h w` is comparable with the linear limit of each method \
+         (the extent of its stability region along the imaginary axis).\n\n\
+         | problem | method | w (rad/s) | largest stable dt | h w | first unstable dt | linear limit h w | how the first unstable run ended |\n\
+         |---|---|---:|---:|---:|---:|---:|---|"
+    );
+    for l in limits {
+        let stable = l
+            .largest_stable
+            .map_or(format!("< {:.2e}", l.smallest_tried), |d| {
+                format!("{d:.4e}")
+            });
+        let hw = l
+            .largest_stable
+            .map_or("-".into(), |d| format!("{:.3}", d * l.omega));
+        let unstable = l
+            .smallest_unstable
+            .map_or("-".into(), |d| format!("{d:.4e}"));
+        let theory = l.linear_limit.map_or("-".into(), |v| {
+            if v == 0.0 {
+                "0 (none)".into()
+            } else {
+                format!("{v:.3}")
+            }
+        });
+        let _ = writeln!(
+            s,
+            "| {} | {} | {:.3} | {stable} | {hw} | {unstable} | {theory} | {} |",
+            l.problem, l.method, l.omega, l.outcome
+        );
+    }
+
+    s.push_str("\n## Plots\n\n");
+    for p in plots {
+        let _ = writeln!(s, "- [{p}]({p})");
+    }
+
+    s.push_str("\n## Every point\n");
+    for id in problem_ids(rows) {
+        let _ = writeln!(
+            s,
+            "\n### {id}\n\n| method | precision | dt or tol | steps | evals | Jacobians | final error | energy error | time / sim s | ns/step | runs | failure |\n\
+             |---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|"
+        );
+        for r in rows.iter().filter(|r| r.problem == id) {
+            let _ = writeln!(
+                s,
+                "| {} | {} | {:.3e} | {} | {} | {} | {:.2e} | {:.2e} | {} | {:.1} | {} | {} |",
+                r.method,
+                r.precision,
+                r.param,
+                r.steps,
+                r.evals,
+                r.jacobians,
+                r.final_error,
+                r.energy_error,
+                time(r.per_simulated_second()),
+                r.ns_per_step(),
+                r.runs,
+                r.failure.as_deref().unwrap_or("")
+            );
+        }
+    }
+    if !sweeps.failures.is_empty() {
+        s.push_str("\n## Problems that could not run\n\n");
+        for f in &sweeps.failures {
+            let _ = writeln!(s, "- {f}");
+        }
+    }
+    s
+}
