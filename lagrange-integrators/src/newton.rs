@@ -115,25 +115,29 @@ impl<T: Real, const N: usize, const S: usize> BlockMatrix<T, N, S> {
         Self(core::array::from_fn(|i| core::array::from_fn(|j| f(i, j))))
     }
 
-    /// Entry `(r, c)` of the flattened matrix.
+    /// Entry `(r, c)` of the flattened matrix (`r, c < S N`).
+    ///
+    /// The block indices are taken `% S`, a no-op for indices in range, so that the optimiser
+    /// sees them in bounds and drops the checks (the panic-free firmware image links only
+    /// without them); likewise in [`flat`] and [`Lu::solve`].
     fn at(&self, r: usize, c: usize) -> T {
-        self.0[r / N][c / N][(r % N, c % N)]
+        self.0[(r / N) % S][(c / N) % S][(r % N, c % N)]
     }
 
     /// Entry `(r, c)` of the flattened matrix, to write.
     fn at_mut(&mut self, r: usize, c: usize) -> &mut T {
-        &mut self.0[r / N][c / N][(r % N, c % N)]
+        &mut self.0[(r / N) % S][(c / N) % S][(r % N, c % N)]
     }
 }
 
 /// `x[r]` of the flattened unknowns.
 fn flat<T: Real, const N: usize, const S: usize>(x: &Blocks<T, N, S>, r: usize) -> T {
-    x[r / N][r % N]
+    x[(r / N) % S][r % N]
 }
 
 /// `x[r]` of the flattened unknowns, to write.
 fn flat_mut<T: Real, const N: usize, const S: usize>(x: &mut Blocks<T, N, S>, r: usize) -> &mut T {
-    &mut x[r / N][r % N]
+    &mut x[(r / N) % S][r % N]
 }
 
 /// The largest absolute entry.
@@ -239,7 +243,7 @@ impl<T: Real, const N: usize, const S: usize> Lu<T, N, S> {
         for k in 0..n {
             // `p < n` by construction; `min` says so to the optimiser, which then drops the
             // bounds checks of `flat` (the panic-free firmware image links only without them).
-            let p = self.pivots[k / N][k % N].min(n - 1);
+            let p = self.pivots[(k / N) % S][k % N].min(n - 1);
             if p != k {
                 let tmp = flat(&x, k);
                 *flat_mut(&mut x, k) = flat(&x, p);

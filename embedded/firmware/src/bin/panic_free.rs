@@ -1,15 +1,11 @@
-//! The panic-free check: steps every shipped unconstrained mechanism with the shipped
-//! fixed-step integrators (explicit, symplectic, Yoshida, the one-stage implicit ones with
-//! Newton), in `f32` and `f64`, plus the automatic Euler-Lagrange path with a damping force
+//! The panic-free check: steps every shipped unconstrained mechanism with every shipped
+//! fixed-step integrator (explicit, symplectic, Yoshida, implicit Runge-Kutta with Newton), in
+//! `f32` and `f64`, plus the automatic Euler-Lagrange path with a damping force
 //! and the variational integrator, from inputs the optimiser cannot see (`black_box`), with
 //! `panic-never` as the panic handler. That handler references an undefined symbol, so the
 //! image links only if the optimised stepping code holds no panic path at all (no bounds
 //! check, unwrap or overflow check left). `cargo xtask qemu` builds it in release (opt-level 3)
 //! and runs it.
-//!
-//! Not yet included: the two-stage implicit Runge-Kutta methods (`GaussLegendre2`,
-//! `RadauIIA2`), whose Newton solve (`lagrange_integrators::newton::solve` for `S = 2`) still
-//! holds a bounds check the optimiser cannot remove; adding them here makes the link fail.
 
 #![no_std]
 #![no_main]
@@ -20,8 +16,8 @@ use cortex_m_rt::{entry, exception, ExceptionFrame};
 use lagrange_core::{Error, EulerLagrange, Mechanism, Real, State, ViscousDamping};
 use lagrange_firmware::exit;
 use lagrange_integrators::{
-    BackwardEuler, ExplicitEuler, ImplicitMidpoint, Integrator, Rk4, SemiImplicitEuler,
-    StormerVerlet, VariationalMidpoint, VelocityVerlet, Yoshida4,
+    BackwardEuler, ExplicitEuler, GaussLegendre2, ImplicitMidpoint, Integrator, RadauIIA2, Rk4,
+    SemiImplicitEuler, StormerVerlet, VariationalMidpoint, VelocityVerlet, Yoshida4,
 };
 use lagrange_systems::{
     Acrobot, BeadOnRotatingHoop, CartPole, DoublePendulum, ElasticPendulum, FallingParticle,
@@ -57,6 +53,8 @@ fn every_integrator<T: Real, const N: usize, M: Mechanism<T, N>>(
         & run(Yoshida4::new(StormerVerlet::default()), m, start).is_ok()
         & run(ImplicitMidpoint::default(), m, start).is_ok()
         & run(BackwardEuler::default(), m, start).is_ok()
+        & run(GaussLegendre2::default(), m, start).is_ok()
+        & run(RadauIIA2::default(), m, start).is_ok()
 }
 
 /// `STEPS` steps of the variational midpoint rule (which works on a Lagrangian).
