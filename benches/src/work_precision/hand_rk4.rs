@@ -3,8 +3,10 @@
 //! speed limit for RK4 on these two problems: the library's `Rk4` is measured against them.
 //!
 //! Each loop is written once in a macro and stamped out for `f64` and `f32`, so that both
-//! precisions run the same arithmetic. The sines and cosines come from `libm`, as in the
-//! library, so that the comparison measures the library's overhead, not two sine routines.
+//! precisions run the same arithmetic. The sines and cosines are the library's own for that
+//! precision (`libm` for `f64`; `lagrange_core::fast_trig`, or `libm` with the feature
+//! `libm-trig`, for `f32`), called on the concrete type, so that the comparison measures the
+//! library's overhead, not two sine routines.
 
 /// Stamps out `pendulum_$t`: RK4 on `th'' = -w2 sin th`.
 macro_rules! pendulum_loop {
@@ -78,7 +80,24 @@ macro_rules! double_loop {
     };
 }
 
-pendulum_loop!(pendulum_f64, f64, libm::sin);
-pendulum_loop!(pendulum_f32, f32, libm::sinf);
-double_loop!(double_f64, f64, libm::sin, libm::cos);
-double_loop!(double_f32, f32, libm::sinf, libm::cosf);
+use lagrange_core::Scalar;
+
+pendulum_loop!(pendulum_f64, f64, f64::sin_of);
+pendulum_loop!(pendulum_f32, f32, f32::sin_of);
+double_loop!(double_f64, f64, f64::sin_of, f64::cos_of);
+double_loop!(double_f32, f32, f32::sin_of, f32::cos_of);
+
+/// The library's sine and cosine of one concrete precision, as plain functions.
+trait Trig: Scalar {
+    /// `Scalar::sin`.
+    fn sin_of(x: Self) -> Self {
+        x.sin()
+    }
+    /// `Scalar::cos`.
+    fn cos_of(x: Self) -> Self {
+        x.cos()
+    }
+}
+
+impl Trig for f64 {}
+impl Trig for f32 {}
