@@ -31,6 +31,11 @@ pub struct SimplePendulum<T: Real> {
     length: T,
     gravity: T,
     damping: T,
+    /// `g / l`, `b / (m l^2)` and `1 / (m l^2)`, formed once: `th'' = -w2 sin th - rate th'`
+    /// costs one sine and no division.
+    w2: T,
+    rate: T,
+    inv_inertia: T,
 }
 
 impl<T: Real> SimplePendulum<T> {
@@ -40,11 +45,19 @@ impl<T: Real> SimplePendulum<T> {
     /// # Errors
     /// [`Error::InvalidParameter`] naming the first parameter out of range or not finite.
     pub fn new(mass: T, length: T, gravity: T, damping: T) -> Result<Self, Error> {
+        let mass = validate::positive("mass", mass)?;
+        let length = validate::positive("length", length)?;
+        let gravity = validate::non_negative("gravity", gravity)?;
+        let damping = validate::non_negative("damping", damping)?;
+        let inv_inertia = T::one() / (mass * length * length);
         Ok(Self {
-            mass: validate::positive("mass", mass)?,
-            length: validate::positive("length", length)?,
-            gravity: validate::non_negative("gravity", gravity)?,
-            damping: validate::non_negative("damping", damping)?,
+            mass,
+            length,
+            gravity,
+            damping,
+            w2: gravity / length,
+            rate: damping * inv_inertia,
+            inv_inertia,
         })
     }
     /// Mass, kg.
@@ -90,7 +103,17 @@ impl<T: Real> Mechanism<T, 1> for SimplePendulum<T> {
         -self.mass * self.gravity * self.length * s.q[0].cos()
     }
     fn solve_mass(&self, _s: &State<T, 1>, b: &SVector<T, 1>) -> Result<SVector<T, 1>, Error> {
-        Ok(b / self.inertia())
+        Ok(b * self.inv_inertia)
+    }
+    fn acceleration(&self, s: &State<T, 1>) -> Result<SVector<T, 1>, Error> {
+        Ok(Vector1::new(-self.w2 * s.q[0].sin() - self.rate * s.qd[0]))
+    }
+    fn acceleration_with(
+        &self,
+        s: &State<T, 1>,
+        extra: &SVector<T, 1>,
+    ) -> Result<SVector<T, 1>, Error> {
+        Ok(self.acceleration(s)? + extra * self.inv_inertia)
     }
 }
 

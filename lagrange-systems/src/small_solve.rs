@@ -11,16 +11,30 @@ use lagrange_core::{Error, Real, State};
 /// [`Error::SingularMassMatrix`] when `det m <= 0`.
 pub(crate) fn solve_sym2<T: Real>(m: &Matrix2<T>, b: &Vector2<T>) -> Result<Vector2<T>, Error> {
     let det = m[(0, 0)] * m[(1, 1)] - m[(0, 1)] * m[(1, 0)];
+    solve_sym2_det(m, det, b)
+}
+
+/// As [`solve_sym2`] with `det m` given, for a mechanism that knows a form of it free of
+/// cancellation. One division: the inverse determinant scales both components.
+///
+/// # Errors
+/// As [`solve_sym2`].
+pub(crate) fn solve_sym2_det<T: Real>(
+    m: &Matrix2<T>,
+    det: T,
+    b: &Vector2<T>,
+) -> Result<Vector2<T>, Error> {
     if !det.is_finite() {
         return Err(Error::NonFiniteState);
     }
     if det <= T::zero() {
         return Err(Error::SingularMassMatrix { pivot: 1 });
     }
+    let inv = T::one() / det;
     let x = Vector2::new(
-        m[(1, 1)] * b[0] - m[(0, 1)] * b[1],
-        m[(0, 0)] * b[1] - m[(1, 0)] * b[0],
-    ) / det;
+        (m[(1, 1)] * b[0] - m[(0, 1)] * b[1]) * inv,
+        (m[(0, 0)] * b[1] - m[(1, 0)] * b[0]) * inv,
+    );
     finite(x, Error::NonFiniteState)
 }
 
