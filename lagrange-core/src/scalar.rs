@@ -93,6 +93,11 @@ pub trait Real:
     fn is_finite(self) -> bool;
     /// Widen to `f64` (for reports and logs).
     fn to_f64(self) -> f64;
+    /// Round to `f32` (for heuristics that need no more, such as a step-size controller:
+    /// native single precision on a Cortex-M4F whatever the scalar).
+    fn to_f32(self) -> f32;
+    /// From an `f32`, exactly.
+    fn from_f32(x: f32) -> Self;
     /// The larger of two values (the other one where one is NaN).
     fn max(self, other: Self) -> Self;
     /// The smaller of two values (the other one where one is NaN).
@@ -209,6 +214,15 @@ macro_rules! impl_real {
             #[inline]
             fn to_f64(self) -> f64 {
                 f64::from(self)
+            }
+            #[inline]
+            #[allow(clippy::cast_possible_truncation)] // rounding to f32 is the point
+            fn to_f32(self) -> f32 {
+                self as f32
+            }
+            #[inline]
+            fn from_f32(x: f32) -> $t {
+                <$t>::from(x)
             }
             #[inline]
             fn max(self, other: $t) -> $t {

@@ -58,7 +58,9 @@ struct Compare<'a> {
 
 impl ProblemVisitor for Compare<'_> {
     fn visit<P: Problem<N, N2>, const N: usize, const N2: usize>(&mut self, p: &P) {
-        if !self.opts.selected(p.id()) {
+        if !self.opts.selected(p.id())
+            || !(self.opts.method_selected("RK4") || self.opts.method_selected("hand-written RK4"))
+        {
             return;
         }
         for ratio in [

@@ -45,7 +45,7 @@ pub struct ChainCost {
 
 /// Times the chain at N = 2 ... 20.
 pub fn measure(opts: &Options) -> ChainCost {
-    if !opts.selected("P3") {
+    if !opts.selected("P3") || !opts.method_selected("RK4") {
         return ChainCost {
             mechanism: "",
             points: Vec::new(),

@@ -1,6 +1,7 @@
 //! [`EmbeddedRungeKutta`]: one adaptive explicit Runge-Kutta engine for every embedded pair:
 //! stages, error estimate, PI step-size control, and the stepping loops.
 
+use super::controller::PiController;
 use super::AdaptiveSettings;
 use core::marker::PhantomData;
 use lagrange_core::nalgebra::SVector;
@@ -53,17 +54,6 @@ pub struct Statistics {
 /// The cubic Hermite part of a dense output: `(y1 - y0, c3, c4)`.
 pub(super) type Hermite<T, const N: usize> = [SVector<T, N>; 3];
 
-/// Safety factor of the step-size proposal.
-const SAFETY: f64 = 0.9;
-/// Smallest factor by which a step may shrink.
-const FAC_MIN: f64 = 0.2;
-/// Largest factor by which a step may grow.
-const FAC_MAX: f64 = 10.0;
-/// The PI controller's weight on the previous error (Hairer's `beta`).
-const BETA: f64 = 0.04;
-/// The floor of the previous error kept by the PI controller.
-const ERROR_FLOOR: f64 = 1e-4;
-
 /// An adaptive explicit Runge-Kutta integrator on the pair `P`: use the aliases
 /// [`DormandPrince54`](crate::DormandPrince54) and
 /// [`DormandPrince853`](crate::DormandPrince853).
@@ -93,9 +83,7 @@ pub struct EmbeddedRungeKutta<T: Real, const N: usize, const S: usize, const R: 
     pub(super) kv: [SVector<T, N>; S],
     /// The next step size to try.
     pub(super) h: T,
-    /// `ln` of the previous accepted step's error (floored), the PI controller's memory.
-    pub(super) log_error_previous: T,
-    pub(super) rejected_last: bool,
+    pub(super) controller: PiController,
     /// The start of the last accepted step and its size (zero before any).
     pub(super) previous: State<T, N>,
     pub(super) h_last: T,
@@ -115,18 +103,34 @@ pub(super) fn real<T: Real>(x: f64) -> T {
     T::from_f64(x)
 }
 
-/// `sum_j w_j k_j` over the stages with a non-zero weight.
-pub(super) fn combine<T: Real, const N: usize, const S: usize>(
-    w: &[f64; S],
-    k: &[SVector<T, N>; S],
-) -> SVector<T, N> {
+/// `sum_j w_j k_j` over the first `w.len()` stages with a non-zero weight.
+///
+/// Always inlined: where `w` is a row of the pair's constant tableau at a constant index (the
+/// stages of a step, see [`run_stages!`]), the loop unrolls and the zero weights fold away,
+/// as in a hand-written stage.
+#[inline(always)]
+pub(super) fn combine<T: Real, const N: usize>(w: &[f64], k: &[SVector<T, N>]) -> SVector<T, N> {
     let mut acc = SVector::zeros();
-    for (wj, kj) in w.iter().zip(k.iter()) {
+    for (wj, kj) in w.iter().zip(k) {
         if *wj != 0.0 {
             acc += kj * real::<T>(*wj);
         }
     }
     acc
+}
+
+/// Evaluates stages `1..=P::FSAL` of a step, each with a constant index (so that
+/// [`combine`] sees constant rows): one line per possible stage, those past `FSAL` skipped at
+/// compile time.
+macro_rules! run_stages {
+    ($rk:ident, $m:ident, $y0:ident, $h:ident; $($i:literal)*) => {
+        const { assert!(P::FSAL <= 12, "run_stages! covers pairs of up to 12 step stages") };
+        $(
+            if $i <= P::FSAL {
+                $rk.stage::<M, $i>($m, &$y0, $h)?;
+            }
+        )*
+    };
 }
 
 impl<T, const N: usize, const S: usize, const R: usize, P> EmbeddedRungeKutta<T, N, S, R, P>
@@ -153,8 +157,7 @@ where
             kq: [SVector::zeros(); S],
             kv: [SVector::zeros(); S],
             h: T::zero(),
-            log_error_previous: real::<T>(ERROR_FLOOR).ln(),
-            rejected_last: false,
+            controller: PiController::new(P::ERROR_EXPONENT),
             previous: *state,
             h_last: T::zero(),
             dense_end: state.t,
@@ -180,8 +183,7 @@ where
         state.check_finite()?;
         self.state = *state;
         self.stats = Statistics::default();
-        self.log_error_previous = real::<T>(ERROR_FLOOR).ln();
-        self.rejected_last = false;
+        self.controller.reset();
         self.h_last = T::zero();
         self.hermite = None;
         self.previous = *state;
@@ -298,26 +300,20 @@ where
     }
 
     /// The error norm of a step of `h` from `y0 = self.state` to `y1`, from the stages.
+    #[inline(always)]
     fn error_norm(&self, h: T, y1: &State<T, N>) -> T {
         let (rtol, atol) = (self.settings.rtol(), self.settings.atol());
         let y0 = &self.state;
-        let scale = |a: T, b: T| atol + rtol * a.abs().max(b.abs());
-        let sum_sq = |w: &[f64; S]| {
-            let (eq, ev) = (combine(w, &self.kq), combine(w, &self.kv));
-            let mut sum = T::zero();
-            for i in 0..N {
-                let a = eq[i] / scale(y0.q[i], y1.q[i]);
-                let b = ev[i] / scale(y0.qd[i], y1.qd[i]);
-                sum += a * a + b * b;
-            }
-            sum
-        };
+        // The weights 1 / (atol + rtol max(|y0|, |y1|)), divided once for both estimates.
+        let weight = |a: T, b: T| (atol + rtol * a.abs().max(b.abs())).recip();
+        let wq = SVector::<T, N>::from_fn(|i, _| weight(y0.q[i], y1.q[i]));
+        let wv = SVector::<T, N>::from_fn(|i, _| weight(y0.qd[i], y1.qd[i]));
         let n = T::from_f64(2.0 * N as f64);
-        let err5 = sum_sq(&P::E);
+        let err5 = self.weighted_sum_sq(&P::E[..=P::FSAL], &wq, &wv);
         match P::E3 {
             None => h.abs() * (err5 / n).sqrt(),
             Some(e3) => {
-                let err3 = sum_sq(&e3);
+                let err3 = self.weighted_sum_sq(&e3[..=P::FSAL], &wq, &wv);
                 let mut deno = err5 + real::<T>(0.01) * err3;
                 if deno <= T::zero() {
                     deno = T::one();
@@ -327,9 +323,33 @@ where
         }
     }
 
+    /// `|W_q e_q|^2 + |W_v e_v|^2` for the estimate `e = sum_j w_j k_j`.
+    #[inline(always)]
+    fn weighted_sum_sq(&self, w: &[f64], wq: &SVector<T, N>, wv: &SVector<T, N>) -> T {
+        let eq = combine(w, &self.kq).component_mul(wq);
+        let ev = combine(w, &self.kv).component_mul(wv);
+        eq.dot(&eq) + ev.dot(&ev)
+    }
+
+    /// Evaluates stage `I` of a step of `h` from `y0`.
+    #[inline(always)]
+    fn stage<M: Mechanism<T, N>, const I: usize>(
+        &mut self,
+        m: &M,
+        y0: &State<T, N>,
+        h: T,
+    ) -> Result<(), Error> {
+        let s = self.stage_state(y0, h, I);
+        self.kq[I] = s.qd;
+        self.kv[I] = self.eval(m, &s)?;
+        Ok(())
+    }
+
     /// The state at stage `i` of a step of `h` from `y0`, from the stages before it.
+    #[inline(always)]
     pub(super) fn stage_state(&self, y0: &State<T, N>, h: T, i: usize) -> State<T, N> {
-        let (row, c) = (&P::A[i], P::C[i]);
+        // A is strictly lower triangular: stage i combines the stages before it.
+        let (row, c) = (&P::A[i][..i], P::C[i]);
         State {
             t: y0.t + h * real::<T>(c),
             q: y0.q + combine(row, &self.kq) * h,
@@ -349,8 +369,6 @@ where
         self.kv[0] = fv;
         let y0 = self.state;
         let mut h = self.h.min(self.settings.h_max());
-        let k = T::from_f64(f64::from(P::ERROR_EXPONENT));
-        let alpha = k.recip() - real::<T>(0.75 * BETA);
         loop {
             let mut last = false;
             if let Some(te) = t_end {
@@ -363,39 +381,22 @@ where
             if !last && (h < self.settings.h_min() || y0.t + h == y0.t) {
                 return Err(Error::StepSizeUnderflow);
             }
-            for i in 1..=P::FSAL {
-                let s = self.stage_state(&y0, h, i);
-                self.kq[i] = s.qd;
-                self.kv[i] = self.eval(m, &s)?;
-            }
+            run_stages!(self, m, y0, h; 1 2 3 4 5 6 7 8 9 10 11 12);
             let mut y1 = self.stage_state(&y0, h, P::FSAL);
             if let (true, Some(te)) = (last, t_end) {
                 y1.t = te;
             }
             let err = self.error_norm(h, &y1);
             if err <= T::one() {
-                // err^-alpha err_prev^beta, by one logarithm and one exponential.
-                let log_err = err.max(real(ERROR_FLOOR)).ln();
-                let growth = if err == T::zero() {
-                    real(FAC_MAX)
-                } else {
-                    real::<T>(SAFETY)
-                        * (real::<T>(BETA) * self.log_error_previous - alpha * err.ln()).exp()
-                };
-                let mut factor = growth.max(real(FAC_MIN)).min(real(FAC_MAX));
-                if self.rejected_last {
-                    factor = factor.min(T::one());
-                }
-                let proposal = h * factor;
+                let rejected_last = self.controller.rejected_last();
+                let proposal = h * T::from_f32(self.controller.accept(err.to_f32()));
                 // A last step shortened to land on t_end says nothing against the proposal
                 // it was shortened from.
-                self.h = if last && !self.rejected_last {
+                self.h = if last && !rejected_last {
                     self.h.max(proposal)
                 } else {
                     proposal
                 };
-                self.log_error_previous = log_err;
-                self.rejected_last = false;
                 self.previous = y0;
                 self.h_last = h;
                 self.dense_end = y1.t;
@@ -406,13 +407,7 @@ where
                 return Ok(());
             }
             // Rejected (a NaN error estimate from a blown-up stage counts as rejected).
-            let shrink = if err.is_finite() {
-                (real::<T>(SAFETY) * (-err.ln() / k).exp()).max(real(FAC_MIN))
-            } else {
-                real(FAC_MIN)
-            };
-            h *= shrink;
-            self.rejected_last = true;
+            h *= T::from_f32(self.controller.reject(err.to_f32()));
             self.stats.rejected += 1;
         }
     }

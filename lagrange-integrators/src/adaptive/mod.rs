@@ -1,5 +1,6 @@
 //! Adaptive explicit Runge-Kutta integrators: error control, dense output, events.
 
+mod controller;
 mod dop853;
 mod dopri5;
 mod embedded;
