@@ -110,13 +110,16 @@ pub(super) fn real<T: Real>(x: f64) -> T {
 /// as in a hand-written stage.
 #[inline(always)]
 pub(super) fn combine<T: Real, const N: usize>(w: &[f64], k: &[SVector<T, N>]) -> SVector<T, N> {
-    let mut acc = SVector::zeros();
-    for (wj, kj) in w.iter().zip(k) {
-        if *wj != 0.0 {
-            acc += kj * real::<T>(*wj);
+    // Component by component, so that each sum stays in a register however large N is.
+    SVector::from_fn(|i, _| {
+        let mut acc = T::zero();
+        for (wj, kj) in w.iter().zip(k) {
+            if *wj != 0.0 {
+                acc += kj[i] * real::<T>(*wj);
+            }
         }
-    }
-    acc
+        acc
+    })
 }
 
 /// Evaluates stages `1..=P::FSAL` of a step, each with a constant index (so that
