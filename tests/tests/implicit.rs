@@ -11,7 +11,7 @@ use lagrange_integrators::{
     StormerVerlet, VariationalMidpoint, Yoshida4,
 };
 use lagrange_systems::exact::pendulum_from_rest;
-use lagrange_systems::{DoublePendulum, Kepler, SimplePendulum};
+use lagrange_systems::{DoublePendulum, Kepler, NLinkPendulum, SimplePendulum};
 use lagrange_tests::{fitted_order, for_f32_and_f64, kepler_periapsis, pick, state_error, Rng};
 
 /// The automatic path's Jacobian is exact: for the pendulum, `dq''/dth = -(g/l) cos th`
@@ -297,7 +297,36 @@ fn variational_conserves_cyclic_momentum<T: Real>() -> Result<(), Error> {
     Ok(())
 }
 
+/// A chain falling from rest, observed step by step: each observation converts the momenta
+/// back to velocities, where the upper links barely move while the lower ones already swing.
+/// Each velocity converges relative to the largest (not to its own size, which left nothing to
+/// converge to and made every such run fail with `NoConvergence`). The observed run ends in
+/// the unobserved run's state: the conversions do not feed back.
+fn variational_observes_a_chain_falling_from_rest<T: Real>() -> Result<(), Error> {
+    let chain = EulerLagrange::new(NLinkPendulum::new(
+        [T::one(); 8],
+        [T::one(); 8],
+        T::from_f64(9.81),
+    )?);
+    let start = State::new(
+        T::zero(),
+        [T::from_f64(core::f64::consts::FRAC_PI_4); 8],
+        [T::zero(); 8],
+    );
+    let dt = T::from_f64(1e-3);
+    let mut observed = 0;
+    let end = VariationalMidpoint::default().integrate_with(&chain, &start, dt, 500, |s, _| {
+        assert!(s.is_finite());
+        observed += 1;
+    })?;
+    let unobserved = VariationalMidpoint::default().integrate(&chain, &start, dt, 500)?;
+    assert_eq!(observed, 500);
+    assert_eq!(end.q, unobserved.q);
+    Ok(())
+}
+
 for_f32_and_f64!(
+    variational_observes_a_chain_falling_from_rest,
     pendulum_jacobian_exact_and_approximate,
     double_pendulum_jacobians_agree,
     newton_failure_is_reported,
