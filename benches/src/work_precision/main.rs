@@ -12,7 +12,9 @@
 //! work-precision plots.
 //!
 //! Flags: `--quick` (a smoke run: small budgets, short sweeps), `--only P1,P3-N5` (problems
-//! whose id starts with one of these), `--method RK4` (methods whose name contains this).
+//! whose id starts with one of these), `--method RK4` (methods whose name contains this),
+//! `--peers` (also SciPy's `solve_ivp` and `odeint` from a venv under `target/`, see
+//! [`scipy_peer`]).
 
 mod budgets;
 mod chain_cost;
@@ -25,6 +27,7 @@ mod problem;
 mod problems;
 mod real;
 mod report;
+mod scipy_peer;
 mod stability;
 mod sweep;
 mod timing;
@@ -43,6 +46,8 @@ pub struct Options {
     pub only: Vec<String>,
     /// Method name fragments to run (all when empty).
     pub methods: Vec<String>,
+    /// Also run SciPy (`--peers`).
+    pub peers: bool,
     /// Timing budget per point.
     pub budget: Budget,
     /// A sweep stops after a point whose solve takes longer than this, s.
@@ -58,6 +63,7 @@ impl Options {
             quick: false,
             only: Vec::new(),
             methods: Vec::new(),
+            peers: false,
             budget: sweep::DEFAULT_BUDGET,
             max_solve: 0.2,
             max_steps: 20_000_000,
@@ -73,9 +79,7 @@ impl Options {
                 }
                 "--only" => opts.only = list(it.next())?,
                 "--method" => opts.methods = list(it.next())?,
-                "--peers" => {
-                    return Err("--peers (SciPy) is not implemented; see the report's notes".into())
-                }
+                "--peers" => opts.peers = true,
                 other => return Err(format!("unknown bench flag `{other}`\n{USAGE}")),
             }
         }
@@ -100,7 +104,8 @@ fn list(arg: Option<&String>) -> Result<Vec<String>, String> {
 }
 
 /// Usage of `cargo xtask bench`.
-const USAGE: &str = "usage: cargo xtask bench [--quick] [--only P1,P2,...] [--method NAME,...]";
+const USAGE: &str =
+    "usage: cargo xtask bench [--quick] [--only P1,P2,...] [--method NAME,...] [--peers]";
 
 /// The workspace root (the parent of this crate's manifest directory).
 fn project_root() -> PathBuf {
@@ -125,7 +130,14 @@ fn run(args: &[String]) -> Result<(), String> {
     let opts = Options::parse(args)?;
     let clock = Instant::now();
     let load_before = load_average();
-    let sweeps = sweep::run(&opts);
+    let mut sweeps = sweep::run(&opts);
+    let dir = project_root().join("target").join("lagrange-bench");
+    if opts.peers {
+        println!("\n== SciPy (--peers)");
+        if let Err(e) = scipy_peer::run(&opts, &dir.join("scipy-venv"), &mut sweeps) {
+            sweeps.failures.push(format!("--peers: {e}"));
+        }
+    }
     println!("\n== budgets");
     let ratios = budgets::rk4_against_hand(&opts);
     let chain = chain_cost::measure(&opts);
@@ -133,7 +145,6 @@ fn run(args: &[String]) -> Result<(), String> {
     let limits = stability::scan(&opts);
     let elapsed = clock.elapsed().as_secs_f64();
 
-    let dir = project_root().join("target").join("lagrange-bench");
     std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
     let context = report::Context {
         quick: opts.quick,

@@ -21,6 +21,8 @@ pub enum Origin {
     HandWritten,
     /// The `ode_solvers` crate.
     OdeSolvers,
+    /// SciPy (`--peers`), on the problem's equations written in Python.
+    SciPy,
 }
 
 impl Origin {
@@ -30,6 +32,7 @@ impl Origin {
             Self::Library => "lagrange",
             Self::HandWritten => "hand-written",
             Self::OdeSolvers => "ode_solvers",
+            Self::SciPy => "scipy",
         }
     }
 }

@@ -52,6 +52,12 @@ pub trait Problem<const N: usize, const N2: usize> {
     /// `h w` (the number that stability regions are drawn in).
     fn fastest_frequency(&self) -> f64;
 
+    /// The equations of motion in Python, for SciPy (`--peers`): source defining
+    /// `rhs(t, y)` for `y = (q, q')`, with `math` imported; `None` where not written.
+    fn python_rhs(&self) -> Option<&'static str> {
+        None
+    }
+
     /// The hand-written RK4 loop for this problem in precision `T`, where there is one.
     fn hand_rk4<T: BenchReal>(
         &self,

@@ -64,6 +64,10 @@ impl Problem<1, 2> for OriginPendulum {
     fn fastest_frequency(&self) -> f64 {
         G.sqrt()
     }
+    fn python_rhs(&self) -> Option<&'static str> {
+        // G and L = 1 as above.
+        Some("def rhs(t, y):\n    return [y[1], -9.81 * math.sin(y[0])]\n")
+    }
     fn hand_rk4<T: BenchReal>(&self, s: &State<T, 1>, dt: T, steps: u64) -> Option<State<T, 1>> {
         let [th, thd] = T::hand_rk4_pendulum(G, [s.q[0], s.qd[0]], dt, steps);
         Some(State::new(s.t + dt * T::real(steps as f64), [th], [thd]))

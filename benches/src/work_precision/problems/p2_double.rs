@@ -61,6 +61,19 @@ impl Problem<2, 4> for ChaoticDouble {
         // The faster normal mode of the unit double pendulum: w^2 = (2 + sqrt 2) g / l.
         ((2.0 + std::f64::consts::SQRT_2) * G).sqrt()
     }
+    fn python_rhs(&self) -> Option<&'static str> {
+        // Unit masses and rods, G as above: M = [[2, c], [c, 1]], the same closed-form
+        // inverse as the hand-written loop.
+        Some(
+            "def rhs(t, y):\n\
+             \x20   a, b, wa, wb = y\n\
+             \x20   s, c = math.sin(a - b), math.cos(a - b)\n\
+             \x20   f1 = -s * wb * wb - 2.0 * 9.81 * math.sin(a)\n\
+             \x20   f2 = s * wa * wa - 9.81 * math.sin(b)\n\
+             \x20   det = 2.0 - c * c\n\
+             \x20   return [wa, wb, (f1 - c * f2) / det, (2.0 * f2 - c * f1) / det]\n",
+        )
+    }
     fn hand_rk4<T: BenchReal>(&self, s: &State<T, 2>, dt: T, steps: u64) -> Option<State<T, 2>> {
         let [a, b, c, d] = T::hand_rk4_double(G, [s.q[0], s.q[1], s.qd[0], s.qd[1]], dt, steps);
         Some(State::new(s.t + dt * T::real(steps as f64), [a, b], [c, d]))

@@ -68,6 +68,15 @@ impl Problem<2, 4> for KeplerOrbit {
     fn coarsest_dt(&self) -> f64 {
         0.1
     }
+    fn python_rhs(&self) -> Option<&'static str> {
+        // Polar coordinates (r, phi) with MU = 1, as `Kepler`:
+        // r'' = r phi'^2 - mu / r^2, phi'' = -2 r' phi' / r.
+        Some(
+            "def rhs(t, y):\n\
+             \x20   r, phi, rd, phid = y\n\
+             \x20   return [rd, phid, r * phid * phid - 1.0 / (r * r), -2.0 * rd * phid / r]\n",
+        )
+    }
     fn fastest_frequency(&self) -> f64 {
         // The angular rate at periapsis, sqrt(mu a (1 - e^2)) / r_p^2.
         (MU * A * (1.0 - E * E)).sqrt() / (A * (1.0 - E)).powi(2)
