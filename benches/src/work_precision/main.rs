@@ -148,6 +148,7 @@ fn run(args: &[String]) -> Result<(), String> {
     std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
     let context = report::Context {
         quick: opts.quick,
+        peers: opts.peers,
         elapsed,
         load: (load_before, load_average()),
         budget: opts.budget,

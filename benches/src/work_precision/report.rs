@@ -16,6 +16,8 @@ use std::path::Path;
 pub struct Context {
     /// A `--quick` smoke run.
     pub quick: bool,
+    /// SciPy ran too (`--peers`).
+    pub peers: bool,
     /// Wall time of the whole bench, s.
     pub elapsed: f64,
     /// 1-minute load average before and after.
@@ -319,7 +321,12 @@ fn markdown(
          many as fit about {} s per point), f64 and f32 alike; errors and energies are \
          computed in f64. The machine may be shared: compare ratios and orders of magnitude, \
          not the last digit.\n",
-        if context.quick { " --quick" } else { "" },
+        match (context.quick, context.peers) {
+            (true, true) => " --quick --peers",
+            (true, false) => " --quick",
+            (false, true) => " --peers",
+            (false, false) => "",
+        },
         context.elapsed,
         load(context.load.0),
         load(context.load.1),
