@@ -52,15 +52,28 @@ pub trait Integrator<T: Real, const N: usize> {
         state: &State<T, N>,
         dt: T,
         steps: u64,
-        mut observe: F,
+        observe: F,
     ) -> Result<State<T, N>, Error> {
-        let mut s = *state;
-        for _ in 0..steps {
-            s = self.step(mechanism, &s, dt)?;
-            observe(&s);
-        }
-        Ok(s)
+        step_loop(state, steps, |s| self.step(mechanism, s, dt), observe)
     }
+}
+
+/// `steps` applications of `advance` from `state`, calling `observe` with each new state: the
+/// loop of [`Integrator::integrate_with`], shared with the methods that override it to inline
+/// their stages.
+#[inline(always)]
+pub(crate) fn step_loop<T: Real, const N: usize>(
+    state: &State<T, N>,
+    steps: u64,
+    mut advance: impl FnMut(&State<T, N>) -> Result<State<T, N>, Error>,
+    mut observe: impl FnMut(&State<T, N>),
+) -> Result<State<T, N>, Error> {
+    let mut s = *state;
+    for _ in 0..steps {
+        s = advance(&s)?;
+        observe(&s);
+    }
+    Ok(s)
 }
 
 /// `dt` when it is finite and not zero and the state it is to step from is finite.

@@ -1,6 +1,6 @@
 //! The classical fourth-order Runge-Kutta method.
 
-use crate::integrator::{check_step, finish};
+use crate::integrator::{check_step, finish, step_loop};
 use crate::Integrator;
 use lagrange_core::{Error, Mechanism, Real, State};
 
@@ -47,15 +47,10 @@ impl<T: Real, const N: usize> Integrator<T, N> for Rk4 {
         state: &State<T, N>,
         dt: T,
         steps: u64,
-        mut observe: F,
+        observe: F,
     ) -> Result<State<T, N>, Error> {
         let h = check_step(state, dt)?;
-        let mut s = *state;
-        for _ in 0..steps {
-            s = finish(stages(m, &s, h)?)?;
-            observe(&s);
-        }
-        Ok(s)
+        step_loop(state, steps, |s| finish(stages(m, s, h)?), observe)
     }
 }
 

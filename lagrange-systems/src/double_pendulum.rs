@@ -57,8 +57,8 @@ struct Coefficients<T> {
     weight1: T,
     /// `m2 g l2`.
     weight2: T,
-    /// `l1^2 l2^2`, so that `det M = m2 l1^2 l2^2 (m1 + m2 sin^2(th1 - th2))`.
-    l1l2_sq: T,
+    /// `m2 l1^2 l2^2`, so that `det M = m2 l1^2 l2^2 (m1 + m2 sin^2(th1 - th2))`.
+    det_scale: T,
 }
 
 impl<T: Real> DoublePendulum<T> {
@@ -79,7 +79,7 @@ impl<T: Real> DoublePendulum<T> {
             coupling: m2 * l1 * l2,
             weight1: mu * gravity * l1,
             weight2: m2 * gravity * l2,
-            l1l2_sq: l1 * l1 * l2 * l2,
+            det_scale: m2 * l1 * l1 * l2 * l2,
         };
         Ok(Self {
             m1,
@@ -106,44 +106,50 @@ impl<T: Real> DoublePendulum<T> {
         self.gravity
     }
 
+    /// `M` from `cos(th1 - th2)`.
+    #[inline]
+    fn mass(&self, cos: T) -> Matrix2<T> {
+        let off = self.k.coupling * cos;
+        Matrix2::new(self.k.m11, off, off, self.k.m22)
+    }
+
+    /// `det M` from `sin(th1 - th2)`, in its product form, free of cancellation.
+    #[inline]
+    fn det(&self, sin: T) -> T {
+        self.k.det_scale * (self.m1 + self.m2 * sin * sin)
+    }
+
     /// The mass matrix, the right-hand side and `det M` together, sharing one
-    /// `sin_cos(th1 - th2)`; the determinant in its product form, free of cancellation.
+    /// `sin_cos(th1 - th2)`.
     #[inline]
     fn terms(&self, s: &State<T, 2>) -> (Matrix2<T>, Vector2<T>, T) {
         let k = &self.k;
         let (sin, cos) = (s.q[0] - s.q[1]).sin_cos();
-        let off = k.coupling * cos;
-        let m = Matrix2::new(k.m11, off, off, k.m22);
         let f = Vector2::new(
             -k.coupling * sin * s.qd[1] * s.qd[1] - k.weight1 * s.q[0].sin(),
             k.coupling * sin * s.qd[0] * s.qd[0] - k.weight2 * s.q[1].sin(),
         );
-        let det = self.m2 * k.l1l2_sq * (self.m1 + self.m2 * sin * sin);
-        (m, f, det)
+        (self.mass(cos), f, self.det(sin))
     }
 }
 
 impl<T: Real> Mechanism<T, 2> for DoublePendulum<T> {
     fn mass_matrix(&self, s: &State<T, 2>) -> Matrix2<T> {
-        let off = self.k.coupling * (s.q[0] - s.q[1]).cos();
-        Matrix2::new(self.k.m11, off, off, self.k.m22)
+        self.mass((s.q[0] - s.q[1]).cos())
     }
     fn rhs(&self, s: &State<T, 2>) -> Vector2<T> {
         self.terms(s).1
     }
     fn kinetic_energy(&self, s: &State<T, 2>) -> T {
-        let (a, b) = (s.qd[0], s.qd[1]);
-        let mu = self.m1 + self.m2;
-        T::HALF * (mu * self.l1 * self.l1 * a * a + self.m2 * self.l2 * self.l2 * b * b)
-            + self.m2 * self.l1 * self.l2 * a * b * (s.q[0] - s.q[1]).cos()
+        let (a, b, k) = (s.qd[0], s.qd[1], &self.k);
+        T::HALF * (k.m11 * a * a + k.m22 * b * b) + k.coupling * a * b * (s.q[0] - s.q[1]).cos()
     }
     fn potential_energy(&self, s: &State<T, 2>) -> T {
-        let mu = self.m1 + self.m2;
-        -self.gravity * (mu * self.l1 * s.q[0].cos() + self.m2 * self.l2 * s.q[1].cos())
+        -(self.k.weight1 * s.q[0].cos() + self.k.weight2 * s.q[1].cos())
     }
     fn solve_mass(&self, s: &State<T, 2>, b: &Vector2<T>) -> Result<Vector2<T>, Error> {
-        let (m, _, det) = self.terms(s);
-        solve_sym2_det(&m, det, b)
+        let (sin, cos) = (s.q[0] - s.q[1]).sin_cos();
+        solve_sym2_det(&self.mass(cos), self.det(sin), b)
     }
     // Inlined into the integrators' stages: a call would spill every live float around it
     // (no callee-saved float registers on x86-64), 15% of an RK4 step here.

@@ -93,9 +93,10 @@ impl PiController {
     }
 }
 
-/// `log2 x` for a positive normal `x`, to about 1e-7 plus the rounding of the result to `f32`: `x = 2^e m` with
-/// `m` in `[sqrt(1/2), sqrt 2)`, then `ln m = 2 atanh((m - 1)/(m + 1))` by its series to
-/// `t^7` (`|t| <= 0.172`, so the first omitted term is below 3e-8).
+/// `log2 x` for a positive normal `x`, to about 1e-7 plus the rounding of the result to
+/// `f32`: `x = 2^e m` with `m` in `[sqrt(1/2), sqrt 2)`, then
+/// `ln m = 2 atanh((m - 1)/(m + 1))` by its series to `t^7` (`|t| <= 0.172`, so the first
+/// omitted term is below 3e-8).
 fn log2(x: f32) -> f32 {
     let bits = x.to_bits();
     #[allow(clippy::cast_possible_wrap)] // an 8-bit field

@@ -124,13 +124,13 @@ pub(super) fn combine<T: Real, const N: usize>(w: &[f64], k: &[SVector<T, N>]) -
 
 /// Evaluates stages `1..=P::FSAL` of a step, each with a constant index (so that
 /// [`combine`] sees constant rows): one line per possible stage, those past `FSAL` skipped at
-/// compile time.
+/// compile time. Leaves the state of stage `FSAL`, `(t0 + h, y1)`, in `$last`.
 macro_rules! run_stages {
-    ($rk:ident, $m:ident, $y0:ident, $h:ident; $($i:literal)*) => {
+    ($rk:ident, $m:ident, $y0:ident, $h:ident, $last:ident; $($i:literal)*) => {
         const { assert!(P::FSAL <= 12, "run_stages! covers pairs of up to 12 step stages") };
         $(
             if $i <= P::FSAL {
-                $rk.stage::<M, $i>($m, &$y0, $h)?;
+                $last = $rk.stage::<M, $i>($m, &$y0, $h)?;
             }
         )*
     };
@@ -334,18 +334,18 @@ where
         eq.dot(&eq) + ev.dot(&ev)
     }
 
-    /// Evaluates stage `I` of a step of `h` from `y0`.
+    /// Evaluates stage `I` of a step of `h` from `y0`; returns its state.
     #[inline(always)]
     fn stage<M: Mechanism<T, N>, const I: usize>(
         &mut self,
         m: &M,
         y0: &State<T, N>,
         h: T,
-    ) -> Result<(), Error> {
+    ) -> Result<State<T, N>, Error> {
         let s = self.stage_state(y0, h, I);
         self.kq[I] = s.qd;
         self.kv[I] = self.eval(m, &s)?;
-        Ok(())
+        Ok(s)
     }
 
     /// The state at stage `i` of a step of `h` from `y0`, from the stages before it.
@@ -384,8 +384,8 @@ where
             if !last && (h < self.settings.h_min() || y0.t + h == y0.t) {
                 return Err(Error::StepSizeUnderflow);
             }
-            run_stages!(self, m, y0, h; 1 2 3 4 5 6 7 8 9 10 11 12);
-            let mut y1 = self.stage_state(&y0, h, P::FSAL);
+            let mut y1 = y0;
+            run_stages!(self, m, y0, h, y1; 1 2 3 4 5 6 7 8 9 10 11 12);
             if let (true, Some(te)) = (last, t_end) {
                 y1.t = te;
             }
