@@ -15,6 +15,8 @@
 //!   image; installs QEMU and `defmt-print` when missing.
 //! - `trig-fit`: derives the polynomials and constants of `lagrange_core::fast_trig` and
 //!   checks the library's against them.
+//! - `mutants`: mutation testing of the numerical core with `cargo-mutants`, a report per file
+//!   under `target/mutants/` (hours; not part of `ci`).
 //! - `ci`: format check, clippy with `-D warnings`, test, cross, qemu.
 
 mod cmd;
@@ -23,6 +25,7 @@ mod demo;
 mod demo_constraints;
 mod demo_integrators;
 mod demo_systems;
+mod mutants;
 mod qemu;
 mod svg;
 mod trig_fit;
@@ -37,10 +40,11 @@ fn main() -> ExitCode {
         "cross" => cross::run(),
         "bench" => cmd::run(cmd::cargo().args(BENCH).args(std::env::args().skip(2))),
         "qemu" => qemu::run(),
+        "mutants" => mutants::run(&std::env::args().skip(2).collect::<Vec<_>>()),
         "ci" => ci(),
         "trig-fit" => trig_fit::run(),
         _ => {
-            eprintln!("usage: cargo xtask <demo | test | cross | bench | qemu | trig-fit | ci>");
+            eprintln!("usage: cargo xtask <demo | test | cross | bench | qemu | mutants | trig-fit | ci>");
             return ExitCode::from(2);
         }
     };

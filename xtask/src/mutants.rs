@@ -1,0 +1,538 @@
+//! `cargo xtask mutants`: mutation testing of the numerical core with `cargo-mutants`.
+//!
+//! Each [`Area`] of the numerical core (the integrators' steps and tableaux, the systems'
+//! accelerations, the constraint solve and its stabilization, the impact law, `fast_trig`) is
+//! mutated on its own, and each mutant runs only the test binaries that exercise that area, so
+//! that the whole run fits in about two hours on two cores. The outcomes are tallied per file
+//! (killed, survived, timed out, unviable, equivalent) into `target/mutants/report.md`; a
+//! surviving mutant is either killed by a new test or recorded, with the reason, in
+//! [`EQUIVALENT_LIST`]. Not part of `cargo xtask ci`.
+//!
+//! ```text
+//! cargo xtask mutants                       every area
+//! cargo xtask mutants --area rk,adaptive    some areas
+//! cargo xtask mutants --list                the areas and how many mutants each holds
+//! cargo xtask mutants --iterate             skip the mutants caught by the last run
+//! cargo xtask mutants --report              tally the last run again (after editing the list)
+//! ```
+
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::time::Instant;
+
+use crate::cmd;
+
+/// The pinned `cargo-mutants`, installed with `cargo install --locked` when missing.
+const CARGO_MUTANTS: &str = "cargo-mutants";
+const CARGO_MUTANTS_VERSION: &str = "27.1.0";
+
+/// The committed list of surviving mutants that are equivalent to the original code.
+const EQUIVALENT_LIST: &str = "xtask/mutants-equivalent.txt";
+
+/// The kill rate each file of the numerical core must reach, over its non-equivalent viable
+/// mutants (a timed-out mutant counts as killed: the run detected it).
+const GOAL: f64 = 0.9;
+
+/// Seconds a mutant's tests may run before it counts as timed out (the slowest subset runs in
+/// about 15 s in a debug build).
+const TEST_TIMEOUT_S: &str = "90";
+
+/// A part of the numerical core, mutated on its own and tested by its own test binaries.
+struct Area {
+    /// Name for `--area` and the output directory.
+    name: &'static str,
+    /// The package whose files are mutated.
+    package: &'static str,
+    /// The files mutated (globs relative to the root).
+    files: &'static [&'static str],
+    /// Only mutants whose name matches this regex (the functions of the area), if any.
+    only: Option<&'static str>,
+    /// Arguments of `cargo test -p lagrange-tests` for each mutant: the test binaries to run.
+    tests: &'static [&'static str],
+}
+
+/// The areas, in the order they run.
+const AREAS: [Area; 9] = [
+    Area {
+        name: "explicit",
+        package: "lagrange-integrators",
+        files: &[
+            "lagrange-integrators/src/rk4.rs",
+            "lagrange-integrators/src/explicit_euler.rs",
+            "lagrange-integrators/src/semi_implicit_euler.rs",
+            "lagrange-integrators/src/velocity_verlet.rs",
+            "lagrange-integrators/src/stormer_verlet.rs",
+            "lagrange-integrators/src/yoshida.rs",
+        ],
+        only: None,
+        tests: &[
+            "--test",
+            "convergence",
+            "--test",
+            "driven",
+            "--test",
+            "origin_pendulum",
+            "--test",
+            "forces_and_energy",
+        ],
+    },
+    Area {
+        name: "implicit",
+        package: "lagrange-integrators",
+        files: &[
+            "lagrange-integrators/src/implicit_rk.rs",
+            "lagrange-integrators/src/implicit_midpoint.rs",
+            "lagrange-integrators/src/gauss_legendre.rs",
+            "lagrange-integrators/src/backward_euler.rs",
+            "lagrange-integrators/src/radau_iia.rs",
+            "lagrange-integrators/src/newton.rs",
+            "lagrange-integrators/src/variational.rs",
+        ],
+        only: None,
+        tests: &[
+            "--test",
+            "convergence",
+            "--test",
+            "driven",
+            "--test",
+            "implicit",
+            "--test",
+            "stiff",
+        ],
+    },
+    Area {
+        name: "adaptive",
+        package: "lagrange-integrators",
+        files: &[
+            "lagrange-integrators/src/adaptive/embedded.rs",
+            "lagrange-integrators/src/adaptive/dopri5.rs",
+            "lagrange-integrators/src/adaptive/dop853.rs",
+            "lagrange-integrators/src/adaptive/controller.rs",
+        ],
+        only: None,
+        tests: &["--test", "adaptive", "--test", "driven", "--test", "kepler"],
+    },
+    Area {
+        name: "impacts",
+        package: "lagrange-integrators",
+        files: &["lagrange-integrators/src/impacts/impulse.rs"],
+        only: None,
+        tests: &[
+            "--test",
+            "bouncing_ball",
+            "--test",
+            "double_pendulum_floor",
+            "--test",
+            "pendulum_wall",
+            "--test",
+            "friction",
+        ],
+    },
+    Area {
+        name: "constraints",
+        package: "lagrange-core",
+        files: &[
+            "lagrange-core/src/constraints/constrained.rs",
+            "lagrange-core/src/constraints/schur.rs",
+            "lagrange-core/src/constraints/projection.rs",
+        ],
+        only: None,
+        tests: &[
+            "--test",
+            "cartesian_pendulum",
+            "--test",
+            "constraints_automatic",
+            "--test",
+            "constrained_forces",
+            "--test",
+            "four_bar_linkage",
+            "--test",
+            "rolling_disk",
+        ],
+    },
+    Area {
+        name: "fast-trig",
+        package: "lagrange-core",
+        files: &["lagrange-core/src/fast_trig.rs"],
+        only: None,
+        tests: &["--test", "fast_trig", "--test", "fast_trig_pendulum"],
+    },
+    Area {
+        name: "systems-one",
+        package: "lagrange-systems",
+        files: &[
+            "lagrange-systems/src/simple_pendulum.rs",
+            "lagrange-systems/src/falling_particle.rs",
+            "lagrange-systems/src/spring_mass_damper.rs",
+            "lagrange-systems/src/bead_on_rotating_hoop.rs",
+        ],
+        only: Some(ACCELERATIONS),
+        tests: SYSTEM_TESTS,
+    },
+    Area {
+        name: "systems-two",
+        package: "lagrange-systems",
+        files: &[
+            "lagrange-systems/src/double_pendulum.rs",
+            "lagrange-systems/src/elastic_pendulum.rs",
+            "lagrange-systems/src/spherical_pendulum.rs",
+            "lagrange-systems/src/cart_pole.rs",
+            "lagrange-systems/src/acrobot.rs",
+            "lagrange-systems/src/swinging_atwood.rs",
+            "lagrange-systems/src/kepler.rs",
+            "lagrange-systems/src/small_solve.rs",
+        ],
+        only: Some(ACCELERATIONS),
+        tests: SYSTEM_TESTS,
+    },
+    Area {
+        name: "systems-chains",
+        package: "lagrange-systems",
+        files: &[
+            "lagrange-systems/src/n_link_pendulum.rs",
+            "lagrange-systems/src/cartesian_pendulum.rs",
+            "lagrange-systems/src/four_bar_linkage.rs",
+            "lagrange-systems/src/rolling_disk.rs",
+        ],
+        only: Some(ACCELERATIONS),
+        tests: &[
+            "--test",
+            "mechanisms_automatic",
+            "--test",
+            "mechanisms_reference",
+            "--test",
+            "mechanisms_physics",
+            "--test",
+            "four_bar_linkage",
+            "--test",
+            "rolling_disk",
+            "--test",
+            "cartesian_pendulum",
+        ],
+    },
+];
+
+/// The mutants of a system that change how it moves: its equations (mass matrix, right-hand
+/// side, forces, solves, accelerations, constraint rows) and the private helpers they call.
+/// Constructors, accessors, energies and conversions are tested elsewhere and left out.
+const ACCELERATIONS: &str = "impl Mechanism|impl Constraints|small_solve|::terms|::det\\b|\
+                             ::tension_solve|::solve_mass_from|::rhs_from|::phi_from|\
+                             ::jacobian_from|::velocity_product_from|::solve_with|::inertias|\
+                             ::weights|solve_diagonal2|solve_sym2";
+
+/// The test binaries of the systems' areas.
+const SYSTEM_TESTS: &[&str] = &[
+    "--test",
+    "mechanisms_automatic",
+    "--test",
+    "mechanisms_reference",
+    "--test",
+    "mechanisms_physics",
+    "--test",
+    "mechanisms_energy",
+];
+
+/// The outcome classes of `cargo-mutants`, by the file it lists them in.
+const OUTCOMES: [(&str, Outcome); 4] = [
+    ("caught.txt", Outcome::Killed),
+    ("missed.txt", Outcome::Survived),
+    ("timeout.txt", Outcome::TimedOut),
+    ("unviable.txt", Outcome::Unviable),
+];
+
+/// What happened to one mutant.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Outcome {
+    Killed,
+    Survived,
+    TimedOut,
+    Unviable,
+}
+
+/// The tally of one file.
+#[derive(Debug, Default, Clone, Copy)]
+struct Tally {
+    killed: u32,
+    survived: u32,
+    timed_out: u32,
+    unviable: u32,
+    equivalent: u32,
+}
+
+impl Tally {
+    /// Killed (timeouts included) over the non-equivalent viable mutants; 1 when there are none.
+    fn rate(&self) -> f64 {
+        let detected = f64::from(self.killed + self.timed_out);
+        let counted = detected + f64::from(self.survived);
+        if counted == 0.0 {
+            1.0
+        } else {
+            detected / counted
+        }
+    }
+}
+
+/// Options of one invocation.
+struct Options {
+    areas: Vec<&'static Area>,
+    jobs: String,
+    iterate: bool,
+    list: bool,
+    report_only: bool,
+}
+
+fn options(args: &[String]) -> Result<Options, String> {
+    let mut o = Options {
+        areas: AREAS.iter().collect(),
+        jobs: "2".into(),
+        iterate: false,
+        list: false,
+        report_only: false,
+    };
+    let mut it = args.iter();
+    while let Some(a) = it.next() {
+        match a.as_str() {
+            "--area" => {
+                let names = it.next().ok_or("--area needs names, e.g. --area rk,adaptive")?;
+                o.areas = names
+                    .split(',')
+                    .map(|n| {
+                        AREAS
+                            .iter()
+                            .find(|a| a.name == n)
+                            .ok_or_else(|| format!("no area {n}; see --list"))
+                    })
+                    .collect::<Result<_, _>>()?;
+            }
+            "--jobs" => o.jobs = it.next().ok_or("--jobs needs a number")?.clone(),
+            "--iterate" => o.iterate = true,
+            "--list" => o.list = true,
+            "--report" => o.report_only = true,
+            other => return Err(format!("unknown option {other}")),
+        }
+    }
+    Ok(o)
+}
+
+/// Runs the mutation tests and writes the report.
+pub fn run(args: &[String]) -> Result<(), String> {
+    let o = options(args)?;
+    ensure_cargo_mutants()?;
+    let root = cmd::project_root();
+    let out = root.join("target").join("mutants");
+    if o.list {
+        for area in &o.areas {
+            let n = mutants_command(area, &out, &o, true)
+                .output()
+                .map_err(|e| format!("cargo mutants --list: {e}"))?;
+            let count = String::from_utf8_lossy(&n.stdout).lines().count();
+            println!("{:<16} {count:>5} mutants in {:?}", area.name, area.files);
+        }
+        return Ok(());
+    }
+    if !o.report_only {
+        for area in &o.areas {
+            let start = Instant::now();
+            // A surviving mutant is a finding, not a failure of the command: the report says.
+            let status = cmd::run(&mut mutants_command(area, &out, &o, false));
+            println!(
+                "area {}: {:.0} s ({})",
+                area.name,
+                start.elapsed().as_secs_f64(),
+                status.err().unwrap_or_else(|| "every mutant killed".into())
+            );
+        }
+    }
+    report(&root, &out, &o.areas)
+}
+
+/// `cargo mutants` for one area, its outcomes under `out/<area>/mutants.out`; with `list`, only
+/// listing the mutants.
+fn mutants_command(area: &Area, out: &Path, o: &Options, list: bool) -> Command {
+    let mut c = cmd::cargo();
+    c.args(["mutants", "--package", area.package]);
+    for f in area.files {
+        c.args(["--file", f]);
+    }
+    if let Some(re) = area.only {
+        c.args(["--re", re]);
+    }
+    if list {
+        c.arg("--list");
+        return c;
+    }
+    c.args(["--test-package", "lagrange-tests", "--jobs", &o.jobs]);
+    c.args(["--timeout", TEST_TIMEOUT_S]);
+    c.args(["--cap-lints", "true", "--no-shuffle"]);
+    c.arg("--output").arg(out.join(area.name));
+    if o.iterate {
+        c.arg("--iterate");
+    }
+    c.arg("--").args(area.tests);
+    c
+}
+
+/// Installs the pinned `cargo-mutants` when `cargo mutants` is not there.
+fn ensure_cargo_mutants() -> Result<(), String> {
+    let present = cmd::cargo()
+        .args(["mutants", "--version"])
+        .output()
+        .is_ok_and(|o| {
+            o.status.success() && String::from_utf8_lossy(&o.stdout).contains(CARGO_MUTANTS_VERSION)
+        });
+    if present {
+        return Ok(());
+    }
+    cmd::run(cmd::cargo().args([
+        "install",
+        "--locked",
+        &format!("{CARGO_MUTANTS}@{CARGO_MUTANTS_VERSION}"),
+    ]))
+}
+
+/// One recorded equivalent mutant: the file, the mutation as `cargo-mutants` names it without
+/// its position, and the mutated source line (trimmed), so that an entry survives edits that
+/// move the line.
+#[derive(Debug, PartialEq, Eq, PartialOrd, Ord, Clone)]
+struct Key {
+    file: String,
+    mutation: String,
+    line: String,
+}
+
+/// The entries of [`EQUIVALENT_LIST`]: `file | mutation | source line | reason` per line, `#`
+/// starting a comment.
+fn equivalents(root: &Path) -> Result<BTreeMap<Key, String>, String> {
+    let path = root.join(EQUIVALENT_LIST);
+    let text = std::fs::read_to_string(&path).unwrap_or_default();
+    let mut map = BTreeMap::new();
+    for (n, raw) in text.lines().enumerate() {
+        let entry = raw.trim();
+        if entry.is_empty() || entry.starts_with('#') {
+            continue;
+        }
+        let parts: Vec<&str> = entry.splitn(4, " | ").collect();
+        let [file, mutation, line, reason] = parts[..] else {
+            return Err(format!(
+                "{EQUIVALENT_LIST}:{}: expected `file | mutation | source line | reason`",
+                n + 1
+            ));
+        };
+        map.insert(
+            Key {
+                file: file.into(),
+                mutation: mutation.into(),
+                line: line.into(),
+            },
+            reason.into(),
+        );
+    }
+    Ok(map)
+}
+
+/// `file:line:col: mutation` as `cargo-mutants` lists it, with the source line it mutates.
+fn key_of(root: &Path, listed: &str) -> Option<Key> {
+    let (file, rest) = listed.split_once(':')?;
+    let (line, rest) = rest.split_once(':')?;
+    let (_col, mutation) = rest.split_once(": ")?;
+    let number: usize = line.parse().ok()?;
+    let source = std::fs::read_to_string(root.join(file)).ok()?;
+    let text = source.lines().nth(number.checked_sub(1)?)?.trim().to_string();
+    Some(Key {
+        file: file.into(),
+        mutation: mutation.into(),
+        line: text,
+    })
+}
+
+/// Tallies the outcomes of `areas` per file, writes `out/report.md` and prints it; `Err` when a
+/// file misses [`GOAL`].
+fn report(root: &Path, out: &Path, areas: &[&Area]) -> Result<(), String> {
+    let equivalent = equivalents(root)?;
+    let mut used = vec![false; equivalent.len()];
+    let mut files: BTreeMap<String, Tally> = BTreeMap::new();
+    let mut survivors: Vec<String> = Vec::new();
+    for area in areas {
+        let dir: PathBuf = out.join(area.name).join("mutants.out");
+        if !dir.exists() {
+            continue;
+        }
+        for (list, outcome) in OUTCOMES {
+            let text = std::fs::read_to_string(dir.join(list)).unwrap_or_default();
+            for listed in text.lines().filter(|l| !l.trim().is_empty()) {
+                let file = listed.split(':').next().unwrap_or_default().to_string();
+                let tally = files.entry(file).or_default();
+                match outcome {
+                    Outcome::Killed => tally.killed += 1,
+                    Outcome::TimedOut => tally.timed_out += 1,
+                    Outcome::Unviable => tally.unviable += 1,
+                    Outcome::Survived => {
+                        let known = key_of(root, listed)
+                            .and_then(|k| equivalent.keys().position(|e| *e == k));
+                        if let Some(i) = known {
+                            used[i] = true;
+                            tally.equivalent += 1;
+                        } else {
+                            tally.survived += 1;
+                            survivors.push(listed.to_string());
+                        }
+                    }
+                }
+            }
+        }
+    }
+    let mut md = String::from(
+        "# Mutation testing of the numerical core (cargo xtask mutants)\n\n\
+         | file | killed | survived | timed out | unviable | equivalent | kill rate |\n\
+         |---|---:|---:|---:|---:|---:|---:|\n",
+    );
+    let mut short = Vec::new();
+    for (file, t) in &files {
+        let _ = writeln!(
+            md,
+            "| {file} | {} | {} | {} | {} | {} | {:.1}% |",
+            t.killed,
+            t.survived,
+            t.timed_out,
+            t.unviable,
+            t.equivalent,
+            100.0 * t.rate()
+        );
+        if t.rate() < GOAL {
+            short.push(format!("{file} ({:.1}%)", 100.0 * t.rate()));
+        }
+    }
+    if !survivors.is_empty() {
+        md.push_str("\n## Surviving mutants (kill them with a test, or record them as equivalent)\n\n");
+        for s in &survivors {
+            let _ = writeln!(md, "- {s}");
+        }
+    }
+    let stale: Vec<&Key> = equivalent
+        .keys()
+        .zip(&used)
+        .filter(|(_, u)| !**u)
+        .map(|(k, _)| k)
+        .collect();
+    if !stale.is_empty() {
+        md.push_str("\n## Entries of the equivalent list no survivor matched this run\n\n");
+        for k in stale {
+            let _ = writeln!(md, "- {} | {} | {}", k.file, k.mutation, k.line);
+        }
+    }
+    let path = out.join("report.md");
+    std::fs::create_dir_all(out).map_err(|e| format!("{}: {e}", out.display()))?;
+    std::fs::write(&path, &md).map_err(|e| format!("{}: {e}", path.display()))?;
+    println!("{md}\nwritten to {}", path.display());
+    if short.is_empty() {
+        Ok(())
+    } else {
+        Err(format!(
+            "below the {:.0}% goal: {}",
+            100.0 * GOAL,
+            short.join(", ")
+        ))
+    }
+}
