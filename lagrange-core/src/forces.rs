@@ -1,14 +1,24 @@
 //! Composable generalized forces: damping, inputs and user forces added by wrapping a
 //! mechanism, never by editing it.
 
-use crate::{central_difference_jacobian, validate, Error, Jacobian, Mechanism, Real, State};
+use crate::constraints::Constraints;
+use crate::{
+    central_difference_jacobian, validate, Error, Jacobian, Lagrangian, Mechanism, Real, Scalar,
+    State,
+};
 use nalgebra::{SMatrix, SVector};
 
 /// A generalized force `Q(t, q, q')` that can be added to any mechanism with
-/// [`Mechanism::with_force`].
+/// [`Mechanism::with_force`], or passed as the extra force of
+/// [`Mechanism::acceleration_with`].
 ///
-/// Closures `Fn(&State<T, N>) -> SVector<T, N>` are generalized forces.
+/// Closures `Fn(&State<T, N>) -> SVector<T, N>` are generalized forces, and so is a pair of
+/// them, `(a, b)`, acting together.
 pub trait GeneralizedForce<T: Real, const N: usize> {
+    /// True for a force that is zero everywhere ([`NoForce`]): a law may skip adding it, so
+    /// that a mechanism stepped without extra forces pays nothing for them.
+    const IS_ZERO: bool = false;
+
     /// The force at `state`.
     fn force(&self, state: &State<T, N>) -> SVector<T, N>;
 
@@ -18,11 +28,76 @@ pub trait GeneralizedForce<T: Real, const N: usize> {
     fn jacobian(&self, state: &State<T, N>) -> Jacobian<T, N> {
         central_difference_jacobian(state, |s| self.force(s))
     }
+
+    /// `b` plus this force at `state`; `b` itself, at no cost, for a zero force.
+    #[inline]
+    fn added_to(&self, state: &State<T, N>, b: SVector<T, N>) -> SVector<T, N> {
+        if Self::IS_ZERO {
+            b
+        } else {
+            b + self.force(state)
+        }
+    }
 }
 
 impl<T: Real, const N: usize, F: Fn(&State<T, N>) -> SVector<T, N>> GeneralizedForce<T, N> for F {
     fn force(&self, state: &State<T, N>) -> SVector<T, N> {
         self(state)
+    }
+}
+
+/// No force: the extra force of [`Mechanism::acceleration`]. Adding it costs nothing.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct NoForce;
+
+impl<T: Real, const N: usize> GeneralizedForce<T, N> for NoForce {
+    const IS_ZERO: bool = true;
+    fn force(&self, _state: &State<T, N>) -> SVector<T, N> {
+        SVector::zeros()
+    }
+    fn jacobian(&self, _state: &State<T, N>) -> Jacobian<T, N> {
+        Jacobian::zeros()
+    }
+}
+
+/// Two forces acting together (their sum); a zero one costs nothing.
+impl<T, const N: usize, A, B> GeneralizedForce<T, N> for (A, B)
+where
+    T: Real,
+    A: GeneralizedForce<T, N>,
+    B: GeneralizedForce<T, N>,
+{
+    const IS_ZERO: bool = A::IS_ZERO && B::IS_ZERO;
+    fn force(&self, state: &State<T, N>) -> SVector<T, N> {
+        match (A::IS_ZERO, B::IS_ZERO) {
+            (true, _) => self.1.force(state),
+            (_, true) => self.0.force(state),
+            _ => self.0.force(state) + self.1.force(state),
+        }
+    }
+    fn jacobian(&self, state: &State<T, N>) -> Jacobian<T, N> {
+        match (A::IS_ZERO, B::IS_ZERO) {
+            (true, _) => self.1.jacobian(state),
+            (_, true) => self.0.jacobian(state),
+            _ => self.0.jacobian(state) + self.1.jacobian(state),
+        }
+    }
+}
+
+/// A force borrowed: how a wrapper passes its own force on with the caller's.
+#[derive(Debug, Clone, Copy)]
+pub struct Borrowed<'a, F>(pub &'a F);
+
+impl<T: Real, const N: usize, F: GeneralizedForce<T, N>> GeneralizedForce<T, N>
+    for Borrowed<'_, F>
+{
+    const IS_ZERO: bool = F::IS_ZERO;
+    fn force(&self, state: &State<T, N>) -> SVector<T, N> {
+        self.0.force(state)
+    }
+    fn jacobian(&self, state: &State<T, N>) -> Jacobian<T, N> {
+        self.0.jacobian(state)
     }
 }
 
@@ -105,8 +180,9 @@ impl<T: Real, const N: usize> GeneralizedForce<T, N> for Input<T, N> {
 
 /// A mechanism with an extra generalized force: `M q'' = f + Q + force`.
 ///
-/// Made by [`Mechanism::with_force`]; wrap again to add more forces. The inner mechanism's
-/// closed-form mass solve is kept.
+/// Made by [`Mechanism::with_force`]; wrap again to add more forces. Its acceleration law is
+/// the inner mechanism's with the force added ([`Mechanism::law`] with the force beside the
+/// caller's), so a closed-form law, a constrained one and their Jacobians all keep working.
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Forced<M, F> {
@@ -135,6 +211,24 @@ impl<M, F> Forced<M, F> {
     }
 }
 
+impl<T, const N: usize, M, F> Lagrangian<T, N> for Forced<M, F>
+where
+    T: Real,
+    M: Lagrangian<T, N>,
+    F: GeneralizedForce<T, N>,
+{
+    const EXPLICIT_TIME: bool = M::EXPLICIT_TIME;
+    fn kinetic<S: Scalar<Real = T>>(&self, t: S, q: &SVector<S, N>, qd: &SVector<S, N>) -> S {
+        self.mechanism.kinetic(t, q, qd)
+    }
+    fn potential<S: Scalar<Real = T>>(&self, t: S, q: &SVector<S, N>) -> S {
+        self.mechanism.potential(t, q)
+    }
+    fn non_conservative_force(&self, state: &State<T, N>) -> SVector<T, N> {
+        self.mechanism.non_conservative_force(state) + self.force.force(state)
+    }
+}
+
 impl<T, const N: usize, M, F> Mechanism<T, N> for Forced<M, F>
 where
     T: Real,
@@ -147,34 +241,49 @@ where
     fn rhs(&self, state: &State<T, N>) -> SVector<T, N> {
         self.mechanism.rhs(state)
     }
-    fn generalized_force(&self, state: &State<T, N>) -> SVector<T, N> {
-        self.mechanism.generalized_force(state) + self.force.force(state)
-    }
-    fn kinetic_energy(&self, state: &State<T, N>) -> T {
-        self.mechanism.kinetic_energy(state)
-    }
-    fn potential_energy(&self, state: &State<T, N>) -> T {
-        self.mechanism.potential_energy(state)
-    }
     fn solve_mass(&self, state: &State<T, N>, b: &SVector<T, N>) -> Result<SVector<T, N>, Error> {
         self.mechanism.solve_mass(state, b)
     }
-    /// The inner mechanism's acceleration law with this force added, so that a constrained
-    /// mechanism keeps its constraint forces when wrapped.
-    fn acceleration(&self, state: &State<T, N>) -> Result<SVector<T, N>, Error> {
-        self.mechanism
-            .acceleration_with(state, &self.force.force(state))
-    }
-    fn acceleration_with(
+    fn law<G: GeneralizedForce<T, N>>(
         &self,
         state: &State<T, N>,
-        extra: &SVector<T, N>,
+        extra: &G,
     ) -> Result<SVector<T, N>, Error> {
         self.mechanism
-            .acceleration_with(state, &(self.force.force(state) + extra))
+            .law(state, &(Borrowed(&self.force), Borrowed(extra)))
     }
-    fn equation_jacobian(&self, state: &State<T, N>, qdd: &SVector<T, N>) -> Jacobian<T, N> {
-        self.mechanism.equation_jacobian(state, qdd) - self.force.jacobian(state)
+    fn law_jacobian<G: GeneralizedForce<T, N>>(
+        &self,
+        state: &State<T, N>,
+        extra: &G,
+    ) -> Result<(SVector<T, N>, Jacobian<T, N>), Error> {
+        self.mechanism
+            .law_jacobian(state, &(Borrowed(&self.force), Borrowed(extra)))
+    }
+    fn law_force<G: GeneralizedForce<T, N>>(
+        &self,
+        state: &State<T, N>,
+        extra: &G,
+    ) -> Result<SVector<T, N>, Error> {
+        self.mechanism
+            .law_force(state, &(Borrowed(&self.force), Borrowed(extra)))
+    }
+}
+
+/// A forced constrained mechanism keeps its rows: what a projection reads.
+impl<T, const N: usize, const C: usize, M, F> Constraints<T, N, C> for Forced<M, F>
+where
+    T: Real,
+    M: Constraints<T, N, C>,
+{
+    fn position_residual(&self, q: &SVector<T, N>) -> SVector<T, C> {
+        self.mechanism.position_residual(q)
+    }
+    fn jacobian(&self, q: &SVector<T, N>) -> SMatrix<T, C, N> {
+        self.mechanism.jacobian(q)
+    }
+    fn velocity_product(&self, q: &SVector<T, N>, qd: &SVector<T, N>) -> SVector<T, C> {
+        self.mechanism.velocity_product(q, qd)
     }
 }
 

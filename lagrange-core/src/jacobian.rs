@@ -1,7 +1,7 @@
 //! [`Jacobian`]: derivatives with respect to `q` and `q'`, and the central-difference default
 //! ([`central_difference_jacobian`]) that exact dual-number Jacobians override.
 
-use crate::{Error, Mechanism, Real, State};
+use crate::{Real, State};
 use nalgebra::{SMatrix, SVector};
 
 /// The derivatives of a vector function `g(t, q, q')` of a state: `dg/dq` and `dg/dq'`, column
@@ -103,41 +103,6 @@ pub fn central_difference_jacobian<T: Real, const N: usize>(
         }
     }
     j
-}
-
-/// The accelerations of `mechanism` at `state` and their Jacobian by central differences of
-/// [`Mechanism::acceleration`] itself.
-///
-/// For mechanisms whose acceleration law is more than `M^-1 (f + Q)` (the constrained ones,
-/// whose multipliers depend on the state), where the default
-/// [`Mechanism::acceleration_jacobian`] built on [`Mechanism::equation_jacobian`] would miss
-/// the constraint forces: they override `acceleration_jacobian` with this. `4 N` more
-/// acceleration evaluations.
-///
-/// # Errors
-/// The first error of any acceleration evaluation; [`Error::NonFiniteState`] when the
-/// Jacobian is not finite.
-pub fn acceleration_jacobian_by_differences<
-    T: Real,
-    const N: usize,
-    M: Mechanism<T, N> + ?Sized,
->(
-    mechanism: &M,
-    state: &State<T, N>,
-) -> Result<(SVector<T, N>, Jacobian<T, N>), Error> {
-    let qdd = mechanism.acceleration(state)?;
-    let mut failure = None;
-    let j = central_difference_jacobian(state, |s| {
-        mechanism.acceleration(s).unwrap_or_else(|e| {
-            failure = Some(e);
-            qdd
-        })
-    });
-    match failure {
-        Some(e) => Err(e),
-        None if j.is_finite() => Ok((qdd, j)),
-        None => Err(Error::NonFiniteState),
-    }
 }
 
 #[cfg(test)]

@@ -1,35 +1,44 @@
 //! Automatic Euler-Lagrange: write `T` and `V` once, generic over a [`Scalar`], and get the
 //! equations of motion by differentiating them with nested [`Dual`] numbers.
 
-use crate::{central_difference_jacobian, Dual, Jacobian, Mechanism, Real, Scalar, State};
+use crate::mechanism::finite;
+use crate::{
+    central_difference_jacobian, Dual, Error, GeneralizedForce, Jacobian, Mechanism, Real, Scalar,
+    State,
+};
 use nalgebra::{SMatrix, SVector};
 
 /// A mechanism given by its Lagrangian `L = T - V`, written generic over the scalar so that it
-/// can be both evaluated (`S = f64`) and differentiated (`S` a [`Dual`] number).
+/// can be both evaluated (`S = f64`) and differentiated (`S` a [`Dual`] number), and its
+/// non-conservative forces `Q`.
 ///
-/// Convert parameters with [`Scalar::from_real`] and literals with [`Scalar::from_f64`]; do all
-/// math through [`Scalar`]'s methods. Wrap it in [`EulerLagrange`] to get a [`Mechanism`].
+/// This is where a mechanism's physics is written, once: its energies are these functions at
+/// real scalars ([`Lagrangian::energy`]), [`EulerLagrange`] derives its equations of motion
+/// from them, and every hand-derived [`Mechanism`] is one of these too (and is checked against
+/// the automatic path). A scalar mixes with plain numbers on its right, so `T` and `V` read
+/// like the formulas: `qd[0] * qd[0] * (0.5 * self.m)`. Do all math through [`Scalar`]'s
+/// methods (`q[0].cos()`), so that `f32` and `f64` give the same bits on every target.
 ///
 /// ```
-/// use lagrange_core::{EulerLagrange, Lagrangian, Mechanism, Scalar, State};
-/// use nalgebra::SVector;
+/// use lagrange_core::prelude::*;
 ///
 /// /// A pendulum of length `l` in gravity `g`, unit mass.
 /// struct Pendulum { l: f64, g: f64 }
 ///
 /// impl Lagrangian<f64, 1> for Pendulum {
 ///     fn kinetic<S: Scalar<Real = f64>>(&self, _t: S, _q: &SVector<S, 1>, qd: &SVector<S, 1>) -> S {
-///         let l = S::from_real(self.l);
-///         S::from_f64(0.5) * l * l * qd[0] * qd[0]
+///         qd[0] * qd[0] * (0.5 * self.l * self.l)
 ///     }
 ///     fn potential<S: Scalar<Real = f64>>(&self, _t: S, q: &SVector<S, 1>) -> S {
-///         -S::from_real(self.g * self.l) * q[0].cos()
+///         -q[0].cos() * (self.g * self.l)
 ///     }
 /// }
 ///
 /// let m = EulerLagrange::new(Pendulum { l: 1.0, g: 9.81 });
-/// let a = m.acceleration(&State::new(0.0, [0.5], [0.0]))?;
+/// let s = State::new(0.0, [0.5], [0.0]);
+/// let a = m.acceleration(&s)?;
 /// assert!((a[0] + 9.81 * 0.5f64.sin()).abs() < 1e-14);
+/// assert!((m.energy(&s) + 9.81 * 0.5f64.cos()).abs() < 1e-15);
 /// # Ok::<(), lagrange_core::Error>(())
 /// ```
 pub trait Lagrangian<T: Real, const N: usize> {
@@ -47,6 +56,21 @@ pub trait Lagrangian<T: Real, const N: usize> {
     fn non_conservative_force(&self, state: &State<T, N>) -> SVector<T, N> {
         let _ = state;
         SVector::zeros()
+    }
+
+    /// Kinetic energy `T` at `state` (computed only when asked, never inside a step).
+    fn kinetic_energy(&self, state: &State<T, N>) -> T {
+        self.kinetic(state.t, &state.q, &state.qd)
+    }
+
+    /// Potential energy `V` at `state`.
+    fn potential_energy(&self, state: &State<T, N>) -> T {
+        self.potential(state.t, &state.q)
+    }
+
+    /// Total energy `T + V` at `state`.
+    fn energy(&self, state: &State<T, N>) -> T {
+        self.kinetic_energy(state) + self.potential_energy(state)
     }
 }
 
@@ -70,11 +94,13 @@ type Directional<T> = Dual<T, 1>;
 /// general path for a user's own mechanism and the oracle the hand-derived systems are tested
 /// against.
 ///
-/// [`Mechanism::equation_jacobian`] is exact too: `M` and `f` are computed once more per
-/// coordinate and per velocity over a one-direction dual number (third derivatives of `T`,
-/// `2 N` evaluations of `M` and `f` at about twice their plain cost), which keeps the stack
-/// use of a long chain at that of `M` itself. Only the Lagrangian's
-/// [`Lagrangian::non_conservative_force`] is differentiated by central differences.
+/// Its [`Mechanism::law_jacobian`] is exact too: differentiating `M q'' = f + Q + extra` gives
+/// `M dq''/dx = d(f + Q + extra)/dx - (dM/dx) q''`, with `dM/dx` and `df/dx` from `M` and `f`
+/// computed once more per coordinate and per velocity over a one-direction dual number (third
+/// derivatives of `T`, `2 N` evaluations of `M` and `f` at about twice their plain cost, which
+/// keeps the stack use of a long chain at that of `M` itself), then `2 N` mass solves. Only the
+/// Lagrangian's [`Lagrangian::non_conservative_force`] is differentiated by central
+/// differences, and an extra force by its own [`GeneralizedForce::jacobian`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct EulerLagrange<L> {
@@ -179,6 +205,45 @@ fn seeded<T: Real, const N: usize>(
     })
 }
 
+impl<T: Real, const N: usize, L: Lagrangian<T, N>> Lagrangian<T, N> for EulerLagrange<L> {
+    const EXPLICIT_TIME: bool = L::EXPLICIT_TIME;
+    fn kinetic<S: Scalar<Real = T>>(&self, t: S, q: &SVector<S, N>, qd: &SVector<S, N>) -> S {
+        self.lagrangian.kinetic(t, q, qd)
+    }
+    fn potential<S: Scalar<Real = T>>(&self, t: S, q: &SVector<S, N>) -> S {
+        self.lagrangian.potential(t, q)
+    }
+    fn non_conservative_force(&self, state: &State<T, N>) -> SVector<T, N> {
+        self.lagrangian.non_conservative_force(state)
+    }
+}
+
+/// `(d r/dq, d r/dq')` of the residual `r = M a - f` of `l` at `s` with `a` held fixed: exact,
+/// from `M` and `f` over one-direction dual numbers.
+fn residual_jacobian<T: Real, const N: usize, L: Lagrangian<T, N>>(
+    l: &L,
+    s: &State<T, N>,
+    a: &SVector<T, N>,
+) -> Jacobian<T, N> {
+    let t = Directional::constant(s.t);
+    let mut j = Jacobian::<T, N>::zeros();
+    for k in 0..N {
+        for velocity in [false, true] {
+            let q = seeded(&s.q, k, !velocity);
+            let qd = seeded(&s.qd, k, velocity);
+            let m = mass_matrix_in(l, t, &q, &qd);
+            let f = rhs_in(l, t, &q, &qd);
+            let column = m.map(|x| x.eps[0]) * a - f.map(|x| x.eps[0]);
+            if velocity {
+                j.wrt_qd.set_column(k, &column);
+            } else {
+                j.wrt_q.set_column(k, &column);
+            }
+        }
+    }
+    j
+}
+
 impl<T: Real, const N: usize, L: Lagrangian<T, N>> Mechanism<T, N> for EulerLagrange<L> {
     fn mass_matrix(&self, s: &State<T, N>) -> SMatrix<T, N, N> {
         mass_matrix_in(&self.lagrangian, s.t, &s.q, &s.qd)
@@ -188,36 +253,37 @@ impl<T: Real, const N: usize, L: Lagrangian<T, N>> Mechanism<T, N> for EulerLagr
         rhs_in(&self.lagrangian, s.t, &s.q, &s.qd)
     }
 
-    fn generalized_force(&self, state: &State<T, N>) -> SVector<T, N> {
-        self.lagrangian.non_conservative_force(state)
-    }
-
-    fn kinetic_energy(&self, s: &State<T, N>) -> T {
-        self.lagrangian.kinetic(s.t, &s.q, &s.qd)
-    }
-
-    fn potential_energy(&self, s: &State<T, N>) -> T {
-        self.lagrangian.potential(s.t, &s.q)
-    }
-
-    fn equation_jacobian(&self, s: &State<T, N>, qdd: &SVector<T, N>) -> Jacobian<T, N> {
-        let t = Directional::constant(s.t);
+    /// Exact: `M dq''/dx = d(f + Q + extra)/dx - (dM/dx) q''` (see the type's docs).
+    fn law_jacobian<F: GeneralizedForce<T, N>>(
+        &self,
+        s: &State<T, N>,
+        extra: &F,
+    ) -> Result<(SVector<T, N>, Jacobian<T, N>), Error> {
+        let qdd = finite(self.law(s, extra)?)?;
+        let mut forces =
+            central_difference_jacobian(s, |x| self.lagrangian.non_conservative_force(x));
+        if !F::IS_ZERO {
+            forces = forces + extra.jacobian(s);
+        }
+        let r = residual_jacobian(&self.lagrangian, s, &qdd) - forces;
         let mut j = Jacobian::<T, N>::zeros();
         for k in 0..N {
-            for velocity in [false, true] {
-                let q = seeded(&s.q, k, !velocity);
-                let qd = seeded(&s.qd, k, velocity);
-                let m = mass_matrix_in(&self.lagrangian, t, &q, &qd);
-                let f = rhs_in(&self.lagrangian, t, &q, &qd);
-                let column = m.map(|x| x.eps[0]) * qdd - f.map(|x| x.eps[0]);
-                if velocity {
-                    j.wrt_qd.set_column(k, &column);
-                } else {
-                    j.wrt_q.set_column(k, &column);
-                }
-            }
+            let dq = self.solve_mass(s, &-r.wrt_q.column(k).into_owned())?;
+            let dqd = self.solve_mass(s, &-r.wrt_qd.column(k).into_owned())?;
+            j.wrt_q.set_column(k, &dq);
+            j.wrt_qd.set_column(k, &dqd);
         }
-        j - central_difference_jacobian(s, |x| self.lagrangian.non_conservative_force(x))
+        Ok((qdd, j))
+    }
+
+    /// `Q + extra` exactly: the law is unconstrained.
+    fn law_force<F: GeneralizedForce<T, N>>(
+        &self,
+        s: &State<T, N>,
+        extra: &F,
+    ) -> Result<SVector<T, N>, Error> {
+        let q = self.lagrangian.non_conservative_force(s);
+        Ok(if F::IS_ZERO { q } else { q + extra.force(s) })
     }
 }
 

@@ -52,6 +52,7 @@ mod forces;
 mod jacobian;
 mod lagrangian;
 mod mechanism;
+pub mod prelude;
 mod scalar;
 mod scalar_trig;
 mod state;
@@ -59,15 +60,15 @@ pub mod validate;
 
 pub use cholesky::solve_spd;
 pub use constraints::{
-    Constrained, Constraints, Holonomic, HolonomicConstraints, Pfaffian, PfaffianConstraints,
+    Constrained, Constraints, Held, Holonomic, HolonomicConstraints, Pfaffian, PfaffianConstraints,
     Projection, Stabilization,
 };
 pub use dual::Dual;
 pub use error::Error;
-pub use forces::{Forced, GeneralizedForce, Input, ViscousDamping};
-pub use jacobian::{acceleration_jacobian_by_differences, central_difference_jacobian, Jacobian};
+pub use forces::{Borrowed, Forced, GeneralizedForce, Input, NoForce, ViscousDamping};
+pub use jacobian::{central_difference_jacobian, Jacobian};
 pub use lagrangian::{EulerLagrange, Lagrangian};
-pub use mechanism::Mechanism;
+pub use mechanism::{jacobian_by_differences, Mechanism};
 pub use nalgebra;
 pub use scalar::{Real, Scalar};
 pub use state::State;

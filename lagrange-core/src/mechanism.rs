@@ -1,26 +1,48 @@
-//! The [`Mechanism`] contract: what an integrator needs to know about a system.
+//! The [`Mechanism`] contract: what an integrator needs to know about a system, with its
+//! acceleration law stated once ([`Mechanism::law`]).
 
-use crate::forces::Forced;
-use crate::{central_difference_jacobian, solve_spd, Error, Jacobian, Real, State};
+use crate::constraints::{Constrained, Constraints, Held};
+use crate::forces::{Forced, NoForce};
+use crate::{
+    central_difference_jacobian, solve_spd, Error, GeneralizedForce, Jacobian, Lagrangian, Real,
+    State,
+};
 use nalgebra::{SMatrix, SVector};
 
 /// A mechanical system with `N` generalized coordinates, in the form
 ///
 /// ```text
-/// M(t, q, q') q'' = f(t, q, q') + Q(t, q, q')
+/// M(t, q, q') q'' = f(t, q, q') + Q(t, q, q') + extra
 /// ```
 ///
 /// where `M` is the mass matrix, `f` ([`Mechanism::rhs`]) everything else the Euler-Lagrange
-/// equations give (`dL/dq` less the velocity-product terms of `d/dt dL/dq'`) and `Q`
-/// ([`Mechanism::generalized_force`]) the non-conservative generalized forces.
+/// equations give (`dL/dq` less the velocity-product terms of `d/dt dL/dq'`), `Q`
+/// ([`Lagrangian::non_conservative_force`]) the mechanism's own non-conservative forces, and
+/// `extra` any generalized force added from outside ([`GeneralizedForce`]: a drive, an input,
+/// a wrapper's force).
 ///
-/// Implementors give `M`, `f` and the energies; [`Mechanism::acceleration`] solves for `q''`
-/// through [`Mechanism::solve_mass`], whose default is a fixed-size Cholesky solve. A
-/// hand-derived system overrides `solve_mass` with its closed-form inverse; wrappers such as
-/// [`Forced`] add to `Q` and keep that fast path.
+/// **Physics written once.** A mechanism is a [`Lagrangian`]: its energies are `T` and `V`
+/// evaluated at real scalars ([`Lagrangian::energy`]), never written a second time. It adds
+/// `M`, `f` and, for speed, a closed-form solve ([`Mechanism::solve_mass`]) or a closed-form
+/// law.
 ///
-/// Energies are computed only when asked, never inside a step.
-pub trait Mechanism<T: Real, const N: usize> {
+/// **One law.** How the mechanism moves is stated in one place, [`Mechanism::law`]: `q''` under
+/// an extra force. Everything an integrator asks derives from it, so a wrapper cannot be right
+/// for explicit methods and wrong for implicit ones:
+///
+/// - [`Mechanism::acceleration`] and [`Mechanism::acceleration_with`] call it (and refuse a
+///   non-finite result);
+/// - its Jacobian ([`Mechanism::law_jacobian`], what Newton's method in the implicit
+///   integrators needs) is by default central differences of the law itself, correct for any
+///   law; a type overrides it only for its own law (exact dual-number Jacobians of
+///   [`EulerLagrange`](crate::EulerLagrange));
+/// - the force the law applies besides `f` ([`Mechanism::law_force`], what a variational
+///   integrator discretises) is by default `M q'' - f`, again correct for any law.
+///
+/// A wrapper ([`Forced`], [`Constrained`]) passes its own force on to the inner law with the
+/// caller's, or states a new law (constraint forces); it never has to keep several hooks in
+/// step. Energies are computed only when asked, never inside a step.
+pub trait Mechanism<T: Real, const N: usize>: Lagrangian<T, N> {
     /// The mass matrix `M = d2L/dq'2`, symmetric positive definite away from singular
     /// configurations.
     fn mass_matrix(&self, state: &State<T, N>) -> SMatrix<T, N, N>;
@@ -28,24 +50,8 @@ pub trait Mechanism<T: Real, const N: usize> {
     /// The right-hand side `f` of `M q'' = f + Q`, without the generalized forces `Q`.
     fn rhs(&self, state: &State<T, N>) -> SVector<T, N>;
 
-    /// The non-conservative generalized forces `Q` (damping, drives, inputs); zero by default.
-    fn generalized_force(&self, state: &State<T, N>) -> SVector<T, N> {
-        let _ = state;
-        SVector::zeros()
-    }
-
-    /// Kinetic energy `T`.
-    fn kinetic_energy(&self, state: &State<T, N>) -> T;
-
-    /// Potential energy `V`.
-    fn potential_energy(&self, state: &State<T, N>) -> T;
-
-    /// Total energy `T + V`.
-    fn energy(&self, state: &State<T, N>) -> T {
-        self.kinetic_energy(state) + self.potential_energy(state)
-    }
-
-    /// Solves `M x = b` at `state`.
+    /// Solves `M x = b` at `state`: a fixed-size Cholesky solve by default
+    /// ([`solve_spd`]); a hand-derived mechanism overrides it with its closed-form inverse.
     ///
     /// # Errors
     /// [`Error::SingularMassMatrix`] where `M` is singular or indefinite, or a system's own
@@ -54,81 +60,108 @@ pub trait Mechanism<T: Real, const N: usize> {
         solve_spd(&self.mass_matrix(state), b)
     }
 
-    /// The generalized accelerations `q''`.
+    /// **The acceleration law**: `q''` at `state` under the mechanism's own forces and `extra`.
+    ///
+    /// The default is the unconstrained law `M^-1 (f + Q + extra)` (one [`solve_mass`]); a
+    /// hand-derived mechanism overrides it with its closed form, a constrained one adds its
+    /// constraint forces. Call it through [`Mechanism::acceleration`] or
+    /// [`Mechanism::acceleration_with`], which check the result.
+    ///
+    /// [`solve_mass`]: Mechanism::solve_mass
     ///
     /// # Errors
-    /// As [`Mechanism::solve_mass`].
+    /// As [`Mechanism::solve_mass`]; a system's own [`Error::Singularity`].
+    fn law<F: GeneralizedForce<T, N>>(
+        &self,
+        state: &State<T, N>,
+        extra: &F,
+    ) -> Result<SVector<T, N>, Error> {
+        let b = self.rhs(state) + self.non_conservative_force(state);
+        self.solve_mass(state, &extra.added_to(state, b))
+    }
+
+    /// The law's accelerations and their Jacobian `(dq''/dq, dq''/dq')` at `state`, `extra`
+    /// included (a force that depends on the state enters through its own Jacobian).
+    ///
+    /// The default takes central differences of [`Mechanism::law`] itself
+    /// ([`central_difference_jacobian`], `4 N` more evaluations, relative accuracy about
+    /// `EPSILON^(2/3)`): correct for any law. Override it only with the Jacobian of the law
+    /// this type states.
+    ///
+    /// # Errors
+    /// The first error of any evaluation of the law.
+    fn law_jacobian<F: GeneralizedForce<T, N>>(
+        &self,
+        state: &State<T, N>,
+        extra: &F,
+    ) -> Result<(SVector<T, N>, Jacobian<T, N>), Error> {
+        jacobian_by_differences(self, state, extra)
+    }
+
+    /// The generalized force the law applies besides `f`: `M q'' - f`, that is `Q + extra`
+    /// for an unconstrained law, plus the constraint forces for a constrained one. The
+    /// default evaluates exactly that (one law, one mass matrix, one `f`); a type may
+    /// override it with the same force in closed form.
+    ///
+    /// # Errors
+    /// As [`Mechanism::law`].
+    fn law_force<F: GeneralizedForce<T, N>>(
+        &self,
+        state: &State<T, N>,
+        extra: &F,
+    ) -> Result<SVector<T, N>, Error> {
+        let qdd = self.law(state, extra)?;
+        Ok(self.mass_matrix(state) * qdd - self.rhs(state))
+    }
+
+    /// The generalized accelerations `q''` (the law with no extra force).
+    ///
+    /// # Errors
+    /// As [`Mechanism::law`]; [`Error::NonFiniteState`] when they are not finite.
     fn acceleration(&self, state: &State<T, N>) -> Result<SVector<T, N>, Error> {
-        self.solve_mass(state, &(self.rhs(state) + self.generalized_force(state)))
+        self.acceleration_with(state, &NoForce)
     }
 
     /// The generalized accelerations with the extra generalized force `extra` acting besides
-    /// `Q`: `M^-1 (f + Q + extra)` by default.
+    /// the mechanism's own (an input, a drive, an impulse spread over time).
     ///
-    /// [`Forced`] calls this, so that a mechanism whose acceleration law is more than
-    /// `M^-1 (f + Q)` keeps that law when a force is added by wrapping: a constrained mechanism
-    /// (see [`constraints`](crate::constraints)) overrides both this method and
-    /// [`Mechanism::acceleration`] to add its constraint forces.
-    ///
-    /// # Errors
-    /// As [`Mechanism::solve_mass`].
-    fn acceleration_with(
-        &self,
-        state: &State<T, N>,
-        extra: &SVector<T, N>,
-    ) -> Result<SVector<T, N>, Error> {
-        self.solve_mass(
-            state,
-            &(self.rhs(state) + self.generalized_force(state) + extra),
-        )
-    }
-
-    /// The Jacobian of the equations of motion written as a residual,
-    ///
-    /// ```text
-    /// r(t, q, q') = M(t, q, q') a - f(t, q, q') - Q(t, q, q')
+    /// ```
+    /// use lagrange_core::prelude::*;
+    /// use lagrange_core::nalgebra::Vector1;
+    /// # struct Spring;
+    /// # impl Lagrangian<f64, 1> for Spring {
+    /// #     fn kinetic<S: Scalar<Real = f64>>(&self, _: S, _: &SVector<S, 1>, qd: &SVector<S, 1>) -> S { qd[0] * qd[0] * 0.5 }
+    /// #     fn potential<S: Scalar<Real = f64>>(&self, _: S, q: &SVector<S, 1>) -> S { q[0] * q[0] * 0.5 }
+    /// # }
+    /// let spring = EulerLagrange::new(Spring);
+    /// let push = |_: &State<f64, 1>| Vector1::new(3.0);
+    /// let a = spring.acceleration_with(&State::new(0.0, [1.0], [0.0]), &push)?;
+    /// assert!((a[0] - (-1.0 + 3.0)).abs() < 1e-15);
+    /// # Ok::<(), lagrange_core::Error>(())
     /// ```
     ///
-    /// with the acceleration `a` held fixed: `(dr/dq, dr/dq')`. It composes: a wrapper that
-    /// adds a force subtracts that force's Jacobian. At `a = q''` it gives the Jacobian of the
-    /// acceleration ([`Mechanism::acceleration_jacobian`]), which Newton's method in the
-    /// implicit integrators needs.
-    ///
-    /// The default takes central differences of `r` ([`central_difference_jacobian`]):
-    /// `4 N` evaluations of `M`, `f` and `Q`, relative accuracy about `EPSILON^(2/3)`.
-    /// [`EulerLagrange`](crate::EulerLagrange) overrides it with exact derivatives from dual
-    /// numbers; a hand-derived system may override it with its own.
-    fn equation_jacobian(&self, state: &State<T, N>, qdd: &SVector<T, N>) -> Jacobian<T, N> {
-        central_difference_jacobian(state, |s| {
-            self.mass_matrix(s) * qdd - self.rhs(s) - self.generalized_force(s)
-        })
+    /// # Errors
+    /// As [`Mechanism::acceleration`].
+    fn acceleration_with<F: GeneralizedForce<T, N>>(
+        &self,
+        state: &State<T, N>,
+        extra: &F,
+    ) -> Result<SVector<T, N>, Error> {
+        finite(self.law(state, extra)?)
     }
 
-    /// The accelerations `q''` and their Jacobian `(dq''/dq, dq''/dq')`.
-    ///
-    /// Differentiating `M q'' = f + Q` gives `M dq''/dx = -dr/dx` with `r` from
-    /// [`Mechanism::equation_jacobian`] at `a = q''`: one acceleration, one equation Jacobian
-    /// and `2 N` solves with `M` ([`Mechanism::solve_mass`], so a closed-form inverse is used
-    /// where a system has one). Exact where `equation_jacobian` is.
+    /// The accelerations `q''` and their Jacobian `(dq''/dq, dq''/dq')`, for Newton's method
+    /// in the implicit integrators ([`Mechanism::law_jacobian`] with no extra force).
     ///
     /// # Errors
-    /// As [`Mechanism::acceleration`]; [`Error::NonFiniteState`] when the Jacobian is not
-    /// finite.
+    /// As [`Mechanism::law_jacobian`]; [`Error::NonFiniteState`] when either is not finite.
     fn acceleration_jacobian(
         &self,
         state: &State<T, N>,
     ) -> Result<(SVector<T, N>, Jacobian<T, N>), Error> {
-        let qdd = self.acceleration(state)?;
-        let r = self.equation_jacobian(state, &qdd);
-        let mut j = Jacobian::<T, N>::zeros();
-        for k in 0..N {
-            let dq = self.solve_mass(state, &-r.wrt_q.column(k).into_owned())?;
-            let dqd = self.solve_mass(state, &-r.wrt_qd.column(k).into_owned())?;
-            j.wrt_q.set_column(k, &dq);
-            j.wrt_qd.set_column(k, &dqd);
-        }
+        let (qdd, j) = self.law_jacobian(state, &NoForce)?;
         if j.is_finite() {
-            Ok((qdd, j))
+            Ok((finite(qdd)?, j))
         } else {
             Err(Error::NonFiniteState)
         }
@@ -137,13 +170,11 @@ pub trait Mechanism<T: Real, const N: usize> {
     /// This mechanism with `force` added to its generalized forces.
     ///
     /// ```
-    /// use lagrange_core::{Mechanism, ViscousDamping};
-    /// # use lagrange_core::{EulerLagrange, Lagrangian, Scalar, State};
-    /// # use nalgebra::SVector;
+    /// use lagrange_core::prelude::*;
     /// # struct Spring;
     /// # impl Lagrangian<f64, 1> for Spring {
-    /// #     fn kinetic<S: Scalar<Real = f64>>(&self, _: S, _: &SVector<S, 1>, qd: &SVector<S, 1>) -> S { qd[0] * qd[0] * S::from_f64(0.5) }
-    /// #     fn potential<S: Scalar<Real = f64>>(&self, _: S, q: &SVector<S, 1>) -> S { q[0] * q[0] * S::from_f64(0.5) }
+    /// #     fn kinetic<S: Scalar<Real = f64>>(&self, _: S, _: &SVector<S, 1>, qd: &SVector<S, 1>) -> S { qd[0] * qd[0] * 0.5 }
+    /// #     fn potential<S: Scalar<Real = f64>>(&self, _: S, q: &SVector<S, 1>) -> S { q[0] * q[0] * 0.5 }
     /// # }
     /// let damped = EulerLagrange::new(Spring).with_force(ViscousDamping::uniform(0.5)?);
     /// let a = damped.acceleration(&State::new(0.0, [1.0], [2.0]))?;
@@ -155,5 +186,54 @@ pub trait Mechanism<T: Real, const N: usize> {
         Self: Sized,
     {
         Forced::new(self, force)
+    }
+
+    /// This (unconstrained) mechanism held by the constraint rows `rows`: the generic
+    /// constrained mechanism ([`Constrained`]), without drift control.
+    fn held_by<K, const C: usize>(self, rows: K) -> Constrained<T, C, Held<Self, K>>
+    where
+        Self: Sized,
+        K: Constraints<T, N, C>,
+    {
+        Constrained::new(Held::new(self, rows))
+    }
+}
+
+/// `v` when every component is finite, else [`Error::NonFiniteState`].
+pub(crate) fn finite<T: Real, const N: usize>(v: SVector<T, N>) -> Result<SVector<T, N>, Error> {
+    if v.iter().all(|x| x.is_finite()) {
+        Ok(v)
+    } else {
+        Err(Error::NonFiniteState)
+    }
+}
+
+/// The law of `mechanism` at `state` with `extra`, and its Jacobian by central differences of
+/// the law: the default of [`Mechanism::law_jacobian`].
+///
+/// # Errors
+/// The first error of any evaluation of the law; [`Error::NonFiniteState`] when the
+/// accelerations are not finite.
+pub fn jacobian_by_differences<T, const N: usize, M, F>(
+    mechanism: &M,
+    state: &State<T, N>,
+    extra: &F,
+) -> Result<(SVector<T, N>, Jacobian<T, N>), Error>
+where
+    T: Real,
+    M: Mechanism<T, N> + ?Sized,
+    F: GeneralizedForce<T, N>,
+{
+    let qdd = finite(mechanism.law(state, extra)?)?;
+    let mut failure = None;
+    let j = central_difference_jacobian(state, |s| {
+        mechanism.law(s, extra).unwrap_or_else(|e| {
+            failure = Some(e);
+            qdd
+        })
+    });
+    match failure {
+        Some(e) => Err(e),
+        None => Ok((qdd, j)),
     }
 }

@@ -13,8 +13,11 @@ use crate::scalar_trig;
 /// A number a Lagrangian can be evaluated in: `f32`, `f64`, or a [`Dual`](crate::Dual) number
 /// built on one of them (which is how the equations of motion are derived automatically).
 ///
-/// Write kinetic and potential energies generic over `S: Scalar<Real = T>` with parameters
-/// converted by [`Scalar::from_real`], and they can be both evaluated and differentiated.
+/// Write kinetic and potential energies generic over `S: Scalar<Real = T>`, and they can be
+/// both evaluated and differentiated. A scalar mixes with plain numbers of its [`Real`] type
+/// (parameters, literals) on its right: `qd[0] * qd[0] * (0.5 * self.m)`, `q[1] * self.g`,
+/// `x + 1.0`, `r / 2.0`. (Put the plain number on the right: Rust cannot make `0.5 * x` mean a
+/// dual number `x` in code generic over `S`; there, [`Scalar::from_real`] lifts a value.)
 pub trait Scalar:
     Copy
     + Debug
@@ -29,6 +32,14 @@ pub trait Scalar:
     + SubAssign
     + MulAssign
     + DivAssign
+    + Add<<Self as Scalar>::Real, Output = Self>
+    + Sub<<Self as Scalar>::Real, Output = Self>
+    + Mul<<Self as Scalar>::Real, Output = Self>
+    + Div<<Self as Scalar>::Real, Output = Self>
+    + AddAssign<<Self as Scalar>::Real>
+    + SubAssign<<Self as Scalar>::Real>
+    + MulAssign<<Self as Scalar>::Real>
+    + DivAssign<<Self as Scalar>::Real>
     + Zero
     + One
 {

@@ -37,7 +37,7 @@
 //! contacts.
 //!
 //! ```
-//! use lagrange_core::{Mechanism, State};
+//! use lagrange_core::prelude::*;
 //! use lagrange_integrators::{Integrator, Rk4};
 //! use lagrange_systems::SimplePendulum;
 //!

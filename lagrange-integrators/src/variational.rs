@@ -81,7 +81,7 @@ impl<T: Real, const N: usize> defmt::Format for PhaseState<T, N> {
 /// velocities, exact in one iteration for a kinetic energy quadratic in `q'`).
 ///
 /// ```
-/// use lagrange_core::{EulerLagrange, Mechanism, State};
+/// use lagrange_core::prelude::*;
 /// use lagrange_integrators::VariationalMidpoint;
 /// use lagrange_systems::DoublePendulum;
 /// let dp = EulerLagrange::new(DoublePendulum::new(1.0_f64, 1.0, 1.0, 1.0, 9.81)?);

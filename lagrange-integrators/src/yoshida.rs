@@ -37,7 +37,7 @@ pub const YOSHIDA4_WEIGHTS: [f64; 3] = [
 /// same cost on short runs; its point is the long run.
 ///
 /// ```
-/// use lagrange_core::{Mechanism, State};
+/// use lagrange_core::prelude::*;
 /// use lagrange_integrators::{Integrator, StormerVerlet, Yoshida4};
 /// use lagrange_systems::SimplePendulum;
 /// let p = SimplePendulum::new(1.0, 1.0, 9.81, 0.0)?;

@@ -2,7 +2,9 @@
 
 use crate::small_solve::solve_sym2;
 use lagrange_core::nalgebra::{Matrix2, SVector, Vector2};
-use lagrange_core::{validate, Error, Lagrangian, Mechanism, Real, Scalar, State};
+use lagrange_core::{
+    validate, Error, GeneralizedForce, Lagrangian, Mechanism, Real, Scalar, State,
+};
 
 /// Spong's acrobot: two rigid links in a vertical plane, the first hinged to a fixed pivot
 /// (unactuated), the second hinged to the end of the first and driven there by a torque `tau`,
@@ -201,29 +203,20 @@ impl<T: Real> Mechanism<T, 2> for Acrobot<T> {
     fn rhs(&self, s: &State<T, 2>) -> Vector2<T> {
         self.terms(s).1
     }
-    fn generalized_force(&self, _s: &State<T, 2>) -> Vector2<T> {
-        Vector2::new(T::zero(), self.torque)
-    }
-    fn kinetic_energy(&self, s: &State<T, 2>) -> T {
-        let (w1, w2) = (s.qd[0], s.qd[1]);
-        let w12 = w1 + w2;
-        let (m2, l1, lc2) = (self.m2, self.l1, self.lc2);
-        T::HALF
-            * ((self.m1 * self.lc1 * self.lc1 + self.i1 + m2 * l1 * l1) * w1 * w1
-                + (m2 * lc2 * lc2 + self.i2) * w12 * w12)
-            + m2 * l1 * lc2 * s.q[1].cos() * w1 * w12
-    }
-    fn potential_energy(&self, s: &State<T, 2>) -> T {
-        let c1 = s.q[0].cos();
-        let c12 = (s.q[0] + s.q[1]).cos();
-        -self.gravity * ((self.m1 * self.lc1 + self.m2 * self.l1) * c1 + self.m2 * self.lc2 * c12)
-    }
     fn solve_mass(&self, s: &State<T, 2>, b: &Vector2<T>) -> Result<Vector2<T>, Error> {
         solve_sym2(&self.mass_matrix(s), b)
     }
-    fn acceleration(&self, s: &State<T, 2>) -> Result<Vector2<T>, Error> {
+    /// The closed form.
+    fn law<F: GeneralizedForce<T, 2>>(
+        &self,
+        s: &State<T, 2>,
+        extra: &F,
+    ) -> Result<SVector<T, 2>, Error> {
         let (mass, f) = self.terms(s);
-        solve_sym2(&mass, &(f + self.generalized_force(s)))
+        solve_sym2(
+            &mass,
+            &extra.added_to(s, f + self.non_conservative_force(s)),
+        )
     }
 }
 
@@ -259,7 +252,7 @@ impl<T: Real> Lagrangian<T, 2> for Acrobot<T> {
         let y2 = -S::from_real(self.l1) * c1 - S::from_real(self.lc2) * c12;
         S::from_real(self.gravity) * (S::from_real(self.m1) * y1 + S::from_real(self.m2) * y2)
     }
-    fn non_conservative_force(&self, s: &State<T, 2>) -> SVector<T, 2> {
-        Mechanism::generalized_force(self, s)
+    fn non_conservative_force(&self, _s: &State<T, 2>) -> Vector2<T> {
+        Vector2::new(T::zero(), self.torque)
     }
 }

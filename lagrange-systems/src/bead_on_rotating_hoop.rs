@@ -19,7 +19,7 @@ use lagrange_core::{validate, Error, Lagrangian, Mechanism, Real, Scalar, State}
 /// `cos th = g / (R omega^2)`. No singular configurations.
 ///
 /// ```
-/// use lagrange_core::{Mechanism, State};
+/// use lagrange_core::prelude::*;
 /// use lagrange_systems::BeadOnRotatingHoop;
 /// let hoop = BeadOnRotatingHoop::new(0.1, 0.5, 10.0, 9.81)?;
 /// // At the off-axis equilibrium the bead does not move.
@@ -93,14 +93,6 @@ impl<T: Real> Mechanism<T, 1> for BeadOnRotatingHoop<T> {
         let (sin, cos) = s.q[0].sin_cos();
         let w2 = self.omega * self.omega;
         Vector1::new(self.inertia() * w2 * sin * cos - self.mass * self.gravity * self.radius * sin)
-    }
-    fn kinetic_energy(&self, s: &State<T, 1>) -> T {
-        let sin = s.q[0].sin();
-        let w = self.omega;
-        T::HALF * self.inertia() * (s.qd[0] * s.qd[0] + w * w * sin * sin)
-    }
-    fn potential_energy(&self, s: &State<T, 1>) -> T {
-        -self.mass * self.gravity * self.radius * s.q[0].cos()
     }
     fn solve_mass(&self, _s: &State<T, 1>, b: &SVector<T, 1>) -> Result<SVector<T, 1>, Error> {
         Ok(b / self.inertia())

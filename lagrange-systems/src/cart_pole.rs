@@ -2,7 +2,9 @@
 
 use crate::small_solve::solve_sym2;
 use lagrange_core::nalgebra::{Matrix2, SVector, Vector2};
-use lagrange_core::{validate, Error, Lagrangian, Mechanism, Real, Scalar, State};
+use lagrange_core::{
+    validate, Error, GeneralizedForce, Lagrangian, Mechanism, Real, Scalar, State,
+};
 
 /// The cart-pole: a cart of mass `M` on a frictionless horizontal track, driven by a horizontal
 /// force `F`, carries a uniform pole of mass `m` and length `2 l` on a frictionless hinge, in
@@ -130,25 +132,20 @@ impl<T: Real> Mechanism<T, 2> for CartPole<T> {
     fn rhs(&self, s: &State<T, 2>) -> Vector2<T> {
         self.terms(s).1
     }
-    fn generalized_force(&self, _s: &State<T, 2>) -> Vector2<T> {
-        Vector2::new(self.force, T::zero())
-    }
-    fn kinetic_energy(&self, s: &State<T, 2>) -> T {
-        let (xd, thd) = (s.qd[0], s.qd[1]);
-        let (m, l) = (self.pole_mass, self.pole_half_length);
-        T::HALF * (self.cart_mass + m) * xd * xd
-            + m * l * s.q[1].cos() * xd * thd
-            + T::from_f64(2.0 / 3.0) * m * l * l * thd * thd
-    }
-    fn potential_energy(&self, s: &State<T, 2>) -> T {
-        self.pole_mass * self.gravity * self.pole_half_length * s.q[1].cos()
-    }
     fn solve_mass(&self, s: &State<T, 2>, b: &Vector2<T>) -> Result<Vector2<T>, Error> {
         solve_sym2(&self.mass_matrix(s), b)
     }
-    fn acceleration(&self, s: &State<T, 2>) -> Result<Vector2<T>, Error> {
+    /// The closed form.
+    fn law<F: GeneralizedForce<T, 2>>(
+        &self,
+        s: &State<T, 2>,
+        extra: &F,
+    ) -> Result<SVector<T, 2>, Error> {
         let (mass, f) = self.terms(s);
-        solve_sym2(&mass, &(f + self.generalized_force(s)))
+        solve_sym2(
+            &mass,
+            &extra.added_to(s, f + self.non_conservative_force(s)),
+        )
     }
 }
 
@@ -171,7 +168,7 @@ impl<T: Real> Lagrangian<T, 2> for CartPole<T> {
     fn potential<S: Scalar<Real = T>>(&self, _t: S, q: &SVector<S, 2>) -> S {
         S::from_real(self.pole_mass * self.gravity * self.pole_half_length) * q[1].cos()
     }
-    fn non_conservative_force(&self, s: &State<T, 2>) -> SVector<T, 2> {
-        Mechanism::generalized_force(self, s)
+    fn non_conservative_force(&self, _s: &State<T, 2>) -> Vector2<T> {
+        Vector2::new(self.force, T::zero())
     }
 }

@@ -1,14 +1,8 @@
 //! [`CartesianPendulum`]: the simple pendulum in Cartesian coordinates, held by a constraint.
 
-use lagrange_core::constraints::{
-    constrained_acceleration, ConstrainedAcceleration, Constraints, HolonomicConstraints,
-    Stabilization,
-};
+use lagrange_core::constraints::{Constraints, HolonomicConstraints};
 use lagrange_core::nalgebra::{Matrix1x2, Matrix2, SMatrix, SVector, Vector1, Vector2};
-use lagrange_core::{
-    acceleration_jacobian_by_differences, validate, Error, Jacobian, Lagrangian, Mechanism, Real,
-    Scalar, State,
-};
+use lagrange_core::{validate, Error, Lagrangian, Mechanism, Real, Scalar, State};
 
 /// A point mass `m` at `(x, y)` from a fixed pivot, in gravity `g`, held at distance `l` by a
 /// massless rod: the same pendulum as [`SimplePendulum`](crate::SimplePendulum), written in two
@@ -26,17 +20,25 @@ use lagrange_core::{
 /// On the constraint, `x = l sin th`, `y = -l cos th` with `th` the simple pendulum's angle
 /// from the downward vertical ([`CartesianPendulum::state_from_angle`],
 /// [`CartesianPendulum::angle`]). Singular configuration: the bob at the pivot (`x = y = 0`,
-/// where `J = 0`), reported as [`Error::RedundantConstraints`]. [`Mechanism::acceleration`]
-/// includes the rod's force; `mass_matrix`, `rhs` and `solve_mass` are the free particle's.
-/// Energy `T + V` is conserved by the exact motion.
+/// where `J = 0`), reported as [`Error::RedundantConstraints`]. Energy `T + V` is conserved
+/// by the exact motion.
+///
+/// This type is the two parts of the pendulum: as a [`Mechanism`] it is the free particle
+/// (mass matrix, `f`, closed-form mass solve), and as [`Constraints`] it is the rod. The
+/// pendulum itself, whose acceleration includes the rod's force, is
+/// [`Constrained::new`](lagrange_core::Constrained::new) of it; drift control and the
+/// multiplier come from there.
 ///
 /// ```
-/// use lagrange_core::{Mechanism, State};
+/// use lagrange_core::prelude::*;
 /// use lagrange_systems::CartesianPendulum;
-/// let p = CartesianPendulum::new(1.0_f64, 1.0, 9.81)?;
+/// let p = Constrained::new(CartesianPendulum::new(1.0_f64, 1.0, 9.81)?);
 /// // Horizontal at rest: the rod carries nothing, the bob falls freely.
 /// let a = p.acceleration(&State::new(0.0, [1.0, 0.0], [0.0, 0.0]))?;
 /// assert!(a[0].abs() < 1e-15 && (a[1] + 9.81).abs() < 1e-15);
+/// // Hanging at rest: the rod's tension, -lambda, carries the weight.
+/// let hanging = p.parts().state_from_angle(0.0, 0.0, 0.0);
+/// assert!((p.solve(&hanging)?.multipliers[0] + 9.81).abs() < 1e-14);
 /// # Ok::<(), lagrange_core::Error>(())
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -45,12 +47,10 @@ pub struct CartesianPendulum<T: Real> {
     mass: T,
     length: T,
     gravity: T,
-    stabilization: Stabilization<T>,
 }
 
 impl<T: Real> CartesianPendulum<T> {
-    /// A bob of `mass` (kg, > 0) on a rod of `length` (m, > 0) in `gravity` (m/s^2, >= 0),
-    /// without drift control.
+    /// A bob of `mass` (kg, > 0) on a rod of `length` (m, > 0) in `gravity` (m/s^2, >= 0).
     ///
     /// # Errors
     /// [`Error::InvalidParameter`] naming the first parameter out of range or not finite.
@@ -59,17 +59,7 @@ impl<T: Real> CartesianPendulum<T> {
             mass: validate::positive("mass", mass)?,
             length: validate::positive("length", length)?,
             gravity: validate::non_negative("gravity", gravity)?,
-            stabilization: Stabilization::None,
         })
-    }
-
-    /// The same pendulum with `stabilization` in its acceleration.
-    #[must_use]
-    pub fn with_stabilization(self, stabilization: Stabilization<T>) -> Self {
-        Self {
-            stabilization,
-            ..self
-        }
     }
 
     /// Mass, kg.
@@ -104,22 +94,6 @@ impl<T: Real> CartesianPendulum<T> {
         let r2 = x * x + y * y;
         (x.atan2(-y), (x * state.qd[1] - y * state.qd[0]) / r2)
     }
-
-    /// Accelerations and the multiplier at `state`.
-    ///
-    /// # Errors
-    /// [`Error::RedundantConstraints`] with the bob at the pivot; [`Error::NonFiniteState`].
-    pub fn solve(&self, state: &State<T, 2>) -> Result<ConstrainedAcceleration<T, 2, 1>, Error> {
-        self.solve_with(state, &SVector::zeros())
-    }
-
-    fn solve_with(
-        &self,
-        state: &State<T, 2>,
-        extra: &Vector2<T>,
-    ) -> Result<ConstrainedAcceleration<T, 2, 1>, Error> {
-        constrained_acceleration(self, self, &self.stabilization, state, extra, &[true])
-    }
 }
 
 impl<T: Real> Mechanism<T, 2> for CartesianPendulum<T> {
@@ -129,26 +103,8 @@ impl<T: Real> Mechanism<T, 2> for CartesianPendulum<T> {
     fn rhs(&self, _s: &State<T, 2>) -> Vector2<T> {
         Vector2::new(T::zero(), -self.mass * self.gravity)
     }
-    fn kinetic_energy(&self, s: &State<T, 2>) -> T {
-        T::HALF * self.mass * (s.qd[0] * s.qd[0] + s.qd[1] * s.qd[1])
-    }
-    fn potential_energy(&self, s: &State<T, 2>) -> T {
-        self.mass * self.gravity * s.q[1]
-    }
     fn solve_mass(&self, _s: &State<T, 2>, b: &Vector2<T>) -> Result<Vector2<T>, Error> {
         Ok(b / self.mass)
-    }
-    fn acceleration(&self, s: &State<T, 2>) -> Result<Vector2<T>, Error> {
-        Ok(self.solve(s)?.acceleration)
-    }
-    fn acceleration_with(&self, s: &State<T, 2>, extra: &Vector2<T>) -> Result<Vector2<T>, Error> {
-        Ok(self.solve_with(s, extra)?.acceleration)
-    }
-    fn acceleration_jacobian(
-        &self,
-        s: &State<T, 2>,
-    ) -> Result<(Vector2<T>, Jacobian<T, 2>), Error> {
-        acceleration_jacobian_by_differences(self, s)
     }
 }
 

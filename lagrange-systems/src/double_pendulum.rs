@@ -2,7 +2,9 @@
 
 use crate::small_solve::solve_sym2_det;
 use lagrange_core::nalgebra::{Matrix2, SVector, Vector2};
-use lagrange_core::{validate, Error, Lagrangian, Mechanism, Real, Scalar, State};
+use lagrange_core::{
+    validate, Error, GeneralizedForce, Lagrangian, Mechanism, Real, Scalar, State,
+};
 
 /// Point masses `m1`, `m2` on massless rods `l1`, `l2`: the first hangs from a fixed pivot,
 /// the second from the first mass, in gravity `g`.
@@ -140,27 +142,21 @@ impl<T: Real> Mechanism<T, 2> for DoublePendulum<T> {
     fn rhs(&self, s: &State<T, 2>) -> Vector2<T> {
         self.terms(s).1
     }
-    fn kinetic_energy(&self, s: &State<T, 2>) -> T {
-        let (a, b, k) = (s.qd[0], s.qd[1], &self.k);
-        T::HALF * (k.m11 * a * a + k.m22 * b * b) + k.coupling * a * b * (s.q[0] - s.q[1]).cos()
-    }
-    fn potential_energy(&self, s: &State<T, 2>) -> T {
-        -(self.k.weight1 * s.q[0].cos() + self.k.weight2 * s.q[1].cos())
-    }
     fn solve_mass(&self, s: &State<T, 2>, b: &Vector2<T>) -> Result<Vector2<T>, Error> {
         let (sin, cos) = (s.q[0] - s.q[1]).sin_cos();
         solve_sym2_det(&self.mass(cos), self.det(sin), b)
     }
+    /// The closed form.
     // Inlined into the integrators' stages: a call would spill every live float around it
     // (no callee-saved float registers on x86-64), 15% of an RK4 step here.
     #[inline(always)]
-    fn acceleration(&self, s: &State<T, 2>) -> Result<Vector2<T>, Error> {
+    fn law<F: GeneralizedForce<T, 2>>(
+        &self,
+        s: &State<T, 2>,
+        extra: &F,
+    ) -> Result<SVector<T, 2>, Error> {
         let (m, f, det) = self.terms(s);
-        solve_sym2_det(&m, det, &f)
-    }
-    fn acceleration_with(&self, s: &State<T, 2>, extra: &Vector2<T>) -> Result<Vector2<T>, Error> {
-        let (m, f, det) = self.terms(s);
-        solve_sym2_det(&m, det, &(f + extra))
+        solve_sym2_det(&m, det, &extra.added_to(s, f))
     }
 }
 

@@ -101,15 +101,6 @@ impl<T: Real> Mechanism<T, 2> for ElasticPendulum<T> {
             -T::TWO * m * r * rd * thd - m * g * r * sin,
         )
     }
-    fn kinetic_energy(&self, s: &State<T, 2>) -> T {
-        let (r, rd, thd) = (s.q[0], s.qd[0], s.qd[1]);
-        T::HALF * self.mass * (rd * rd + r * r * thd * thd)
-    }
-    fn potential_energy(&self, s: &State<T, 2>) -> T {
-        let stretch = s.q[0] - self.rest_length;
-        -self.mass * self.gravity * s.q[0] * s.q[1].cos()
-            + T::HALF * self.stiffness * stretch * stretch
-    }
     fn solve_mass(&self, s: &State<T, 2>, b: &Vector2<T>) -> Result<Vector2<T>, Error> {
         let r = s.q[0];
         positive_radius(s, SPRING_COLLAPSED)?;

@@ -58,12 +58,6 @@ impl<T: Real> Mechanism<T, 1> for FallingParticle<T> {
     fn rhs(&self, _s: &State<T, 1>) -> SVector<T, 1> {
         Vector1::new(-self.mass * self.gravity)
     }
-    fn kinetic_energy(&self, s: &State<T, 1>) -> T {
-        T::HALF * self.mass * s.qd[0] * s.qd[0]
-    }
-    fn potential_energy(&self, s: &State<T, 1>) -> T {
-        self.mass * self.gravity * s.q[0]
-    }
     fn solve_mass(&self, _s: &State<T, 1>, b: &SVector<T, 1>) -> Result<SVector<T, 1>, Error> {
         Ok(b / self.mass)
     }

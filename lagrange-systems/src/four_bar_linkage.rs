@@ -1,13 +1,10 @@
 //! [`FourBarLinkage`]: a planar closed chain of three moving bars, held closed by two
 //! holonomic constraints.
 
-use lagrange_core::constraints::{
-    solve_kkt, ConstrainedAcceleration, Constraints, HolonomicConstraints, Schur, Stabilization,
-};
+use lagrange_core::constraints::{Constraints, HolonomicConstraints};
 use lagrange_core::nalgebra::{Matrix2x3, SMatrix, SVector, Vector2, Vector3};
 use lagrange_core::{
-    acceleration_jacobian_by_differences, validate, Error, Jacobian, Lagrangian, Mechanism, Real,
-    Scalar, State,
+    validate, Error, GeneralizedForce, Lagrangian, Mechanism, Real, Scalar, State,
 };
 
 /// Which of the two ways to close the loop at a given crank angle: the coupler-rocker joint
@@ -49,15 +46,19 @@ pub enum Branch {
 /// `det = I3 (I1 I2 - k^2 cos^2) > 0` always. Singular configurations: where `J` loses rank,
 /// all three moving links parallel (possible only when `a +- b +- c = d` for some signs);
 /// reported as [`Error::RedundantConstraints`]. A Grashof crank-rocker (`a` shortest and
-/// `a + max <= sum of the other two`) never reaches one. [`Mechanism::acceleration`] includes
-/// the constraint forces; `mass_matrix`, `rhs` and `solve_mass` are those of the open chain.
-/// Energy `T + V` is conserved by the exact motion.
+/// `a + max <= sum of the other two`) never reaches one. Energy `T + V` is conserved by the
+/// exact motion.
+///
+/// This type is the two parts of the linkage: as a [`Mechanism`] the open chain (mass matrix,
+/// `f`, closed-form mass solve and law, each computing its trigonometry once), as
+/// [`Constraints`] the loop closure. The linkage itself, whose acceleration includes the
+/// constraint forces, is [`Constrained::new`](lagrange_core::Constrained::new) of it.
 ///
 /// ```
-/// use lagrange_core::{Constraints, Mechanism};
+/// use lagrange_core::prelude::*;
 /// use lagrange_systems::{Branch, FourBarLinkage};
-/// let linkage = FourBarLinkage::new([1.0_f64, 0.3, 1.0, 0.8], [1.0, 1.0, 1.0], 9.81)?;
-/// let s = linkage.assemble(0.0, 0.5, 2.0, Branch::Right)?;
+/// let linkage = Constrained::new(FourBarLinkage::new([1.0_f64, 0.3, 1.0, 0.8], [1.0, 1.0, 1.0], 9.81)?);
+/// let s = linkage.parts().assemble(0.0, 0.5, 2.0, Branch::Right)?;
 /// assert!(linkage.residual(&s).position < 1e-15 && linkage.residual(&s).velocity < 1e-15);
 /// let a = linkage.acceleration(&s)?;
 /// assert!(a.iter().all(|x| x.is_finite()));
@@ -69,13 +70,11 @@ pub struct FourBarLinkage<T: Real> {
     lengths: [T; 4],
     masses: [T; 3],
     gravity: T,
-    stabilization: Stabilization<T>,
 }
 
 impl<T: Real> FourBarLinkage<T> {
     /// `lengths = [ground d, crank a, coupler b, rocker c]` (m, each > 0),
-    /// `masses = [crank, coupler, rocker]` (kg, each > 0), `gravity` (m/s^2, >= 0); without
-    /// drift control.
+    /// `masses = [crank, coupler, rocker]` (kg, each > 0), `gravity` (m/s^2, >= 0).
     ///
     /// # Errors
     /// [`Error::InvalidParameter`] `lengths`, `masses` or `gravity` when out of range or not
@@ -91,17 +90,7 @@ impl<T: Real> FourBarLinkage<T> {
             lengths,
             masses,
             gravity: validate::non_negative("gravity", gravity)?,
-            stabilization: Stabilization::None,
         })
-    }
-
-    /// The same linkage with `stabilization` in its acceleration.
-    #[must_use]
-    pub fn with_stabilization(self, stabilization: Stabilization<T>) -> Self {
-        Self {
-            stabilization,
-            ..self
-        }
     }
 
     /// `[ground, crank, coupler, rocker]` lengths, m.
@@ -172,35 +161,6 @@ impl<T: Real> FourBarLinkage<T> {
         let w2 = (-c * s3 * r0 + c * c3 * r1) / det;
         let w3 = (-b * s2 * r0 + b * c2 * r1) / det;
         Ok(State::new(t, [crank, th2, th3], [crank_rate, w2, w3]))
-    }
-
-    /// Accelerations and the two multipliers (the force at `C`, N) at `state`.
-    ///
-    /// # Errors
-    /// [`Error::RedundantConstraints`] at a singular configuration; [`Error::NonFiniteState`].
-    pub fn solve(&self, state: &State<T, 3>) -> Result<ConstrainedAcceleration<T, 3, 2>, Error> {
-        self.solve_with(state, &SVector::zeros())
-    }
-
-    /// The hand-derived fast path: every trigonometric term computed once, then the shared
-    /// Schur-complement solve.
-    fn solve_with(
-        &self,
-        state: &State<T, 3>,
-        extra: &Vector3<T>,
-    ) -> Result<ConstrainedAcceleration<T, 3, 2>, Error> {
-        let trig = Trig::new(&state.q);
-        let force = self.rhs_from(&trig, &state.qd) + self.generalized_force(state) + extra;
-        let solve = |b: &Vector3<T>| self.solve_mass_from(&trig, b);
-        let a0 = solve(&force)?;
-        let jacobian = self.jacobian_from(&trig);
-        let target = self.stabilization.target(
-            &self.velocity_product_from(&trig, &state.qd),
-            &(jacobian * state.qd),
-            || self.phi_from(&trig),
-        );
-        let schur = Schur::from_parts(jacobian, solve, &[true; 2])?;
-        solve_kkt(&schur, &a0, &target)
     }
 
     /// `M`, from the angles' sines and cosines.
@@ -312,30 +272,17 @@ impl<T: Real> Mechanism<T, 3> for FourBarLinkage<T> {
     fn rhs(&self, s: &State<T, 3>) -> Vector3<T> {
         self.rhs_from(&Trig::new(&s.q), &s.qd)
     }
-    fn kinetic_energy(&self, s: &State<T, 3>) -> T {
-        let (i1, i2, i3, k) = self.inertias();
-        let v = &s.qd;
-        T::HALF * (i1 * v[0] * v[0] + i2 * v[1] * v[1] + i3 * v[2] * v[2])
-            + k * (s.q[0] - s.q[1]).cos() * v[0] * v[1]
-    }
-    fn potential_energy(&self, s: &State<T, 3>) -> T {
-        let [w1, w2, w3] = self.weights();
-        -(w1 * s.q[0].cos() + w2 * s.q[1].cos() + w3 * s.q[2].cos())
-    }
     fn solve_mass(&self, s: &State<T, 3>, b: &Vector3<T>) -> Result<Vector3<T>, Error> {
         self.solve_mass_from(&Trig::new(&s.q), b)
     }
-    fn acceleration(&self, s: &State<T, 3>) -> Result<Vector3<T>, Error> {
-        Ok(self.solve(s)?.acceleration)
-    }
-    fn acceleration_with(&self, s: &State<T, 3>, extra: &Vector3<T>) -> Result<Vector3<T>, Error> {
-        Ok(self.solve_with(s, extra)?.acceleration)
-    }
-    fn acceleration_jacobian(
+    /// The open chain's law with its trigonometry computed once.
+    fn law<F: GeneralizedForce<T, 3>>(
         &self,
         s: &State<T, 3>,
-    ) -> Result<(Vector3<T>, Jacobian<T, 3>), Error> {
-        acceleration_jacobian_by_differences(self, s)
+        extra: &F,
+    ) -> Result<Vector3<T>, Error> {
+        let trig = Trig::new(&s.q);
+        self.solve_mass_from(&trig, &extra.added_to(s, self.rhs_from(&trig, &s.qd)))
     }
 }
 

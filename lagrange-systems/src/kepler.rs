@@ -35,7 +35,7 @@ const AT_CENTRE: &str = "radius r <= 0: orbiting body at the centre of attractio
 /// periapsis passage needs a step much smaller than `r / |v|` there.
 ///
 /// ```
-/// use lagrange_core::{Mechanism, State};
+/// use lagrange_core::prelude::*;
 /// use lagrange_systems::Kepler;
 /// let k = Kepler::new(1.0)?;
 /// // A circular orbit of radius 2: phi'^2 = mu / r^3, no radial acceleration.
@@ -81,13 +81,6 @@ impl<T: Real> Mechanism<T, 2> for Kepler<T> {
     fn rhs(&self, s: &State<T, 2>) -> Vector2<T> {
         let (r, rd, phid) = (s.q[0], s.qd[0], s.qd[1]);
         Vector2::new(r * phid * phid - self.mu / (r * r), -T::TWO * r * rd * phid)
-    }
-    fn kinetic_energy(&self, s: &State<T, 2>) -> T {
-        let (r, rd, phid) = (s.q[0], s.qd[0], s.qd[1]);
-        T::HALF * (rd * rd + r * r * phid * phid)
-    }
-    fn potential_energy(&self, s: &State<T, 2>) -> T {
-        -self.mu / s.q[0]
     }
     fn solve_mass(&self, s: &State<T, 2>, b: &Vector2<T>) -> Result<Vector2<T>, Error> {
         let r = s.q[0];

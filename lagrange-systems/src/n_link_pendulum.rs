@@ -2,7 +2,9 @@
 
 use crate::small_solve::finite;
 use lagrange_core::nalgebra::{SMatrix, SVector};
-use lagrange_core::{validate, Error, Lagrangian, Mechanism, Real, Scalar, State};
+use lagrange_core::{
+    validate, Error, GeneralizedForce, Lagrangian, Mechanism, Real, Scalar, State,
+};
 
 /// A planar chain of `N` point masses `m_j` on massless rods of lengths `l_j`: rod 1 hangs from
 /// a fixed pivot, rod `j` from mass `j - 1`, in gravity `g`. One implementation for every
@@ -265,28 +267,6 @@ impl<T: Real, const N: usize> Mechanism<T, N> for NLinkPendulum<T, N> {
         })
     }
 
-    /// `T = 1/2 sum_j mu_j (l_j^2 th_j'^2 + 2 l_j th_j' n_j . v_{j-1})`, `O(N)`, with
-    /// `v_{j-1}` the velocity of mass `j - 1` and `n_j = (cos th_j, sin th_j)`.
-    fn kinetic_energy(&self, s: &State<T, N>) -> T {
-        let (sin, cos) = sin_cos(&s.q);
-        let (mut vx, mut vy, mut t) = (T::zero(), T::zero(), T::zero());
-        for j in 0..N {
-            let u = self.lengths[j] * s.qd[j];
-            t += self.mu[j] * u * (u + T::TWO * (cos[j] * vx + sin[j] * vy));
-            vx += u * cos[j];
-            vy += u * sin[j];
-        }
-        T::HALF * t
-    }
-
-    fn potential_energy(&self, s: &State<T, N>) -> T {
-        let mut v = T::zero();
-        for j in 0..N {
-            v -= self.mu[j] * self.lengths[j] * s.q[j].cos();
-        }
-        self.gravity * v
-    }
-
     /// `M^-1 b` by the tension recursion at rest without gravity, `b` realised as the Cartesian
     /// forces `G_j - G_{j+1}`, `G_j = (b_j / l_j) (cos th_j, sin th_j)`.
     fn solve_mass(&self, s: &State<T, N>, b: &SVector<T, N>) -> Result<SVector<T, N>, Error> {
@@ -312,11 +292,19 @@ impl<T: Real, const N: usize> Mechanism<T, N> for NLinkPendulum<T, N> {
         self.tension_solve((sin, cos), &SVector::zeros(), (px, py))
     }
 
-    /// `q''` by the tension recursion under gravity alone (the chain has no generalized forces
-    /// of its own; a wrapper's go through [`Mechanism::solve_mass`]).
-    fn acceleration(&self, s: &State<T, N>) -> Result<SVector<T, N>, Error> {
+    /// The closed form.
+    fn law<F: GeneralizedForce<T, N>>(
+        &self,
+        s: &State<T, N>,
+        extra: &F,
+    ) -> Result<SVector<T, N>, Error> {
         let down = [-self.gravity; N];
-        self.tension_solve(sin_cos(&s.q), &s.qd, ([T::zero(); N], down))
+        let free = self.tension_solve(sin_cos(&s.q), &s.qd, ([T::zero(); N], down))?;
+        Ok(if F::IS_ZERO {
+            free
+        } else {
+            free + self.solve_mass(s, &extra.force(s))?
+        })
     }
 }
 

@@ -1,15 +1,9 @@
 //! [`RollingDisk`]: a vertical disk rolling without slipping on a plane, two nonholonomic
 //! constraints.
 
-use lagrange_core::constraints::{
-    constrained_acceleration, ConstrainedAcceleration, Constraints, PfaffianConstraints,
-    Stabilization,
-};
+use lagrange_core::constraints::{Constraints, PfaffianConstraints};
 use lagrange_core::nalgebra::{Matrix2x4, SMatrix, SVector, Vector2, Vector4};
-use lagrange_core::{
-    acceleration_jacobian_by_differences, validate, Error, Jacobian, Lagrangian, Mechanism, Real,
-    Scalar, State,
-};
+use lagrange_core::{validate, Error, Lagrangian, Mechanism, Real, Scalar, State};
 
 /// A uniform thin disk of mass `m` and radius `R` held upright (no tilt) and rolling without
 /// slipping on a horizontal plane: free to turn about the vertical and to roll, but its
@@ -31,15 +25,18 @@ use lagrange_core::{
 ///
 /// The exact motion: `psi'` and `phi'` constant, the contact point on a circle of radius
 /// `R phi' / psi'` (a straight line when `psi' = 0`), energy constant. No singular
-/// configurations (`A` always has rank 2). [`Mechanism::acceleration`] includes the contact
-/// force; `mass_matrix`, `rhs` and `solve_mass` are those of the free disk. Add a drive or
+/// configurations (`A` always has rank 2).
+///
+/// This type is the two parts of the disk: as a [`Mechanism`] the free disk, as
+/// [`Constraints`] the rolling rows. The rolling disk, whose acceleration includes the contact
+/// force, is [`Constrained::new`](lagrange_core::Constrained::new) of it. Add a drive or
 /// steering torque with [`Mechanism::with_force`]: it acts through the constraints.
 ///
 /// ```
-/// use lagrange_core::{Constraints, Mechanism};
+/// use lagrange_core::prelude::*;
 /// use lagrange_systems::RollingDisk;
-/// let disk = RollingDisk::new(1.0_f64, 0.5)?;
-/// let s = disk.rolling(0.0, [0.0, 0.0, 0.3, 0.0], 1.0, 4.0)?;
+/// let disk = Constrained::new(RollingDisk::new(1.0_f64, 0.5)?);
+/// let s = disk.parts().rolling(0.0, [0.0, 0.0, 0.3, 0.0], 1.0, 4.0)?;
 /// assert!(disk.residual(&s).velocity < 1e-15);
 /// // Turning at a steady rate: the contact force is centripetal, the rates do not change.
 /// let a = disk.acceleration(&s)?;
@@ -51,11 +48,10 @@ use lagrange_core::{
 pub struct RollingDisk<T: Real> {
     mass: T,
     radius: T,
-    stabilization: Stabilization<T>,
 }
 
 impl<T: Real> RollingDisk<T> {
-    /// A disk of `mass` (kg, > 0) and `radius` (m, > 0), without drift control.
+    /// A disk of `mass` (kg, > 0) and `radius` (m, > 0).
     ///
     /// # Errors
     /// [`Error::InvalidParameter`] naming the first parameter out of range or not finite.
@@ -63,18 +59,7 @@ impl<T: Real> RollingDisk<T> {
         Ok(Self {
             mass: validate::positive("mass", mass)?,
             radius: validate::positive("radius", radius)?,
-            stabilization: Stabilization::None,
         })
-    }
-
-    /// The same disk with `stabilization` in its acceleration (Baumgarte acts on the
-    /// velocity residual only: these rows have no position residual).
-    #[must_use]
-    pub fn with_stabilization(self, stabilization: Stabilization<T>) -> Self {
-        Self {
-            stabilization,
-            ..self
-        }
     }
 
     /// Mass, kg.
@@ -112,22 +97,6 @@ impl<T: Real> RollingDisk<T> {
         Ok(State::new(t, q, [v * c, v * s, turn_rate, roll_rate]))
     }
 
-    /// Accelerations and the contact force at `state`.
-    ///
-    /// # Errors
-    /// [`Error::NonFiniteState`].
-    pub fn solve(&self, state: &State<T, 4>) -> Result<ConstrainedAcceleration<T, 4, 2>, Error> {
-        self.solve_with(state, &SVector::zeros())
-    }
-
-    fn solve_with(
-        &self,
-        state: &State<T, 4>,
-        extra: &Vector4<T>,
-    ) -> Result<ConstrainedAcceleration<T, 4, 2>, Error> {
-        constrained_acceleration(self, self, &self.stabilization, state, extra, &[true; 2])
-    }
-
     /// The diagonal of the mass matrix, `[m, m, m R^2/4, m R^2/2]`.
     fn inertias(&self) -> Vector4<T> {
         let mr2 = self.mass * self.radius * self.radius;
@@ -142,26 +111,8 @@ impl<T: Real> Mechanism<T, 4> for RollingDisk<T> {
     fn rhs(&self, _s: &State<T, 4>) -> Vector4<T> {
         Vector4::zeros()
     }
-    fn kinetic_energy(&self, s: &State<T, 4>) -> T {
-        T::HALF * self.inertias().dot(&s.qd.component_mul(&s.qd))
-    }
-    fn potential_energy(&self, _s: &State<T, 4>) -> T {
-        T::zero()
-    }
     fn solve_mass(&self, _s: &State<T, 4>, b: &Vector4<T>) -> Result<Vector4<T>, Error> {
         Ok(b.component_div(&self.inertias()))
-    }
-    fn acceleration(&self, s: &State<T, 4>) -> Result<Vector4<T>, Error> {
-        Ok(self.solve(s)?.acceleration)
-    }
-    fn acceleration_with(&self, s: &State<T, 4>, extra: &Vector4<T>) -> Result<Vector4<T>, Error> {
-        Ok(self.solve_with(s, extra)?.acceleration)
-    }
-    fn acceleration_jacobian(
-        &self,
-        s: &State<T, 4>,
-    ) -> Result<(Vector4<T>, Jacobian<T, 4>), Error> {
-        acceleration_jacobian_by_differences(self, s)
     }
 }
 

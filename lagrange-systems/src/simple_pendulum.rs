@@ -1,7 +1,9 @@
 //! [`SimplePendulum`]: a point mass on a massless rod, with optional viscous damping.
 
 use lagrange_core::nalgebra::{Matrix1, SMatrix, SVector, Vector1};
-use lagrange_core::{validate, Error, Lagrangian, Mechanism, Real, Scalar, State};
+use lagrange_core::{
+    validate, Error, GeneralizedForce, Lagrangian, Mechanism, Real, Scalar, State,
+};
 
 /// A point mass `m` on a massless rod of length `l` about a fixed pivot, in gravity `g`, with
 /// viscous damping `b` at the pivot.
@@ -93,27 +95,21 @@ impl<T: Real> Mechanism<T, 1> for SimplePendulum<T> {
     fn rhs(&self, s: &State<T, 1>) -> SVector<T, 1> {
         Vector1::new(-self.mass * self.gravity * self.length * s.q[0].sin())
     }
-    fn generalized_force(&self, s: &State<T, 1>) -> SVector<T, 1> {
-        Vector1::new(-self.damping * s.qd[0])
-    }
-    fn kinetic_energy(&self, s: &State<T, 1>) -> T {
-        T::HALF * self.inertia() * s.qd[0] * s.qd[0]
-    }
-    fn potential_energy(&self, s: &State<T, 1>) -> T {
-        -self.mass * self.gravity * self.length * s.q[0].cos()
-    }
     fn solve_mass(&self, _s: &State<T, 1>, b: &SVector<T, 1>) -> Result<SVector<T, 1>, Error> {
         Ok(b * self.inv_inertia)
     }
-    fn acceleration(&self, s: &State<T, 1>) -> Result<SVector<T, 1>, Error> {
-        Ok(Vector1::new(-self.w2 * s.q[0].sin() - self.rate * s.qd[0]))
-    }
-    fn acceleration_with(
+    /// The closed form.
+    fn law<F: GeneralizedForce<T, 1>>(
         &self,
         s: &State<T, 1>,
-        extra: &SVector<T, 1>,
+        extra: &F,
     ) -> Result<SVector<T, 1>, Error> {
-        Ok(self.acceleration(s)? + extra * self.inv_inertia)
+        let free = Vector1::new(-self.w2 * s.q[0].sin() - self.rate * s.qd[0]);
+        Ok(if F::IS_ZERO {
+            free
+        } else {
+            free + extra.force(s) * self.inv_inertia
+        })
     }
 }
 
@@ -125,6 +121,6 @@ impl<T: Real> Lagrangian<T, 1> for SimplePendulum<T> {
         -S::from_real(self.mass * self.gravity * self.length) * q[0].cos()
     }
     fn non_conservative_force(&self, s: &State<T, 1>) -> SVector<T, 1> {
-        Mechanism::generalized_force(self, s)
+        Vector1::new(-self.damping * s.qd[0])
     }
 }

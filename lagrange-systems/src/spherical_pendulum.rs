@@ -111,14 +111,6 @@ impl<T: Real> Mechanism<T, 2> for SphericalPendulum<T> {
             -T::TWO * i * sin * cos * thd * phid,
         )
     }
-    fn kinetic_energy(&self, s: &State<T, 2>) -> T {
-        let sin = s.q[0].sin();
-        let (thd, phid) = (s.qd[0], s.qd[1]);
-        T::HALF * self.inertia() * (thd * thd + sin * sin * phid * phid)
-    }
-    fn potential_energy(&self, s: &State<T, 2>) -> T {
-        -self.mass * self.gravity * self.length * s.q[0].cos()
-    }
     fn solve_mass(&self, s: &State<T, 2>, b: &Vector2<T>) -> Result<Vector2<T>, Error> {
         let sin = s.q[0].sin();
         let i = self.inertia();

@@ -70,15 +70,6 @@ impl<T: Real> Mechanism<T, 1> for SpringMassDamper<T> {
     fn rhs(&self, s: &State<T, 1>) -> SVector<T, 1> {
         Vector1::new(-self.stiffness * s.q[0])
     }
-    fn generalized_force(&self, s: &State<T, 1>) -> SVector<T, 1> {
-        Vector1::new(-self.damping * s.qd[0])
-    }
-    fn kinetic_energy(&self, s: &State<T, 1>) -> T {
-        T::HALF * self.mass * s.qd[0] * s.qd[0]
-    }
-    fn potential_energy(&self, s: &State<T, 1>) -> T {
-        T::HALF * self.stiffness * s.q[0] * s.q[0]
-    }
     fn solve_mass(&self, _s: &State<T, 1>, b: &SVector<T, 1>) -> Result<SVector<T, 1>, Error> {
         finite(b / self.mass, Error::NonFiniteState)
     }
@@ -92,6 +83,6 @@ impl<T: Real> Lagrangian<T, 1> for SpringMassDamper<T> {
         S::from_real(T::HALF * self.stiffness) * q[0] * q[0]
     }
     fn non_conservative_force(&self, s: &State<T, 1>) -> SVector<T, 1> {
-        Mechanism::generalized_force(self, s)
+        Vector1::new(-self.damping * s.qd[0])
     }
 }

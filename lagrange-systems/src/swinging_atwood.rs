@@ -107,14 +107,6 @@ impl<T: Real> Mechanism<T, 2> for SwingingAtwood<T> {
             -T::TWO * m * r * rd * thd - m * g * r * sin,
         )
     }
-    fn kinetic_energy(&self, s: &State<T, 2>) -> T {
-        let (r, rd, thd) = (s.q[0], s.qd[0], s.qd[1]);
-        T::HALF
-            * ((self.big_mass + self.small_mass) * rd * rd + self.small_mass * r * r * thd * thd)
-    }
-    fn potential_energy(&self, s: &State<T, 2>) -> T {
-        self.gravity * s.q[0] * (self.big_mass - self.small_mass * s.q[1].cos())
-    }
     fn solve_mass(&self, s: &State<T, 2>, b: &Vector2<T>) -> Result<Vector2<T>, Error> {
         let r = s.q[0];
         positive_radius(s, AT_PULLEY)?;

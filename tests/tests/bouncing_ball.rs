@@ -3,7 +3,7 @@
 
 use lagrange_core::nalgebra::SVector;
 use lagrange_core::State;
-use lagrange_core::{Error, Holonomic, HolonomicConstraints, Mechanism, Projection, Real, Scalar};
+use lagrange_core::{Error, Holonomic, HolonomicConstraints, Lagrangian, Projection, Real, Scalar};
 use lagrange_integrators::{ContactModel, ContactStepper, Rk4};
 use lagrange_systems::FallingParticle;
 use lagrange_tests::{for_f32_and_f64, pick};

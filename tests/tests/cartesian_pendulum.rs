@@ -3,7 +3,7 @@
 //! with projection, with Baumgarte stabilisation, and without drift control.
 
 use lagrange_core::constraints::Stabilization;
-use lagrange_core::{Constraints, Error, Projection, Real, State};
+use lagrange_core::{Constrained, Constraints, Error, Projection, Real, State};
 use lagrange_integrators::{Integrator, Projected, Rk4, VelocityVerlet};
 use lagrange_systems::{CartesianPendulum, SimplePendulum};
 use lagrange_tests::{for_f32_and_f64, pick};
@@ -26,15 +26,17 @@ fn projection<T: Real>() -> Result<Projection<T>, Error> {
 fn tracks_simple_pendulum<T: Real>() -> Result<(), Error> {
     let (one, g, dt) = (T::one(), T::from_f64(G), T::from_f64(DT));
     let simple = SimplePendulum::new(one, one, g, T::zero())?;
-    let cartesian = CartesianPendulum::new(one, one, g)?;
+    let cartesian = Constrained::new(CartesianPendulum::new(one, one, g)?);
     let mut stepper = Projected::new(Rk4, cartesian, projection::<T>()?);
     let mut s = State::at_rest([T::from_f64(TH0)]);
-    let mut c = cartesian.state_from_angle(T::zero(), s.q[0], T::zero());
+    let mut c = cartesian
+        .parts()
+        .state_from_angle(T::zero(), s.q[0], T::zero());
     let mut worst: f64 = 0.0;
     for _ in 0..10_000 {
         s = Rk4.step(&simple, &s, dt)?;
         c = stepper.step(&cartesian, &c, dt)?;
-        let (th, thd) = cartesian.angle(&c);
+        let (th, thd) = cartesian.parts().angle(&c);
         worst = worst.max((th - s.q[0]).abs().to_f64());
         worst = worst.max(((thd - s.qd[0]) * T::from_f64(0.1)).abs().to_f64());
     }
@@ -47,11 +49,11 @@ fn tracks_simple_pendulum<T: Real>() -> Result<(), Error> {
 /// on the circle, to rounding (8 ulps of the largest term).
 fn multiplier_is_rod_tension<T: Real>() -> Result<(), Error> {
     let (m, l, g) = (T::from_f64(2.0), T::from_f64(0.7), T::from_f64(G));
-    let p = CartesianPendulum::new(m, l, g)?;
+    let p = Constrained::new(CartesianPendulum::new(m, l, g)?);
     for i in 0..40 {
         let th = T::from_f64(-3.0 + 0.15 * f64::from(i));
         let thd = T::from_f64(4.0 - 0.2 * f64::from(i));
-        let s = p.state_from_angle(T::zero(), th, thd);
+        let s = p.parts().state_from_angle(T::zero(), th, thd);
         let lambda = p.solve(&s)?.multipliers[0];
         let tension = m * (l * thd * thd + g * th.cos());
         let scale = m * (l * thd * thd + g);
@@ -69,10 +71,10 @@ for_f32_and_f64!(tracks_simple_pendulum, multiplier_is_rod_tension);
 /// rest, and the largest over the first tenth of them.
 fn residual_run<I: Integrator<f64, 2>>(
     mut integrator: I,
-    p: &CartesianPendulum<f64>,
+    p: &Constrained<f64, 1, CartesianPendulum<f64>>,
     steps: u64,
 ) -> Result<(f64, f64), Error> {
-    let start = p.state_from_angle(0.0, 0.5, 0.0);
+    let start = p.parts().state_from_angle(0.0, 0.5, 0.0);
     let (mut early, mut worst) = (0.0f64, 0.0f64);
     let mut n = 0u64;
     integrator.integrate_with(p, &start, DT, steps, |s| {
@@ -100,7 +102,7 @@ fn residual_run<I: Integrator<f64, 2>>(
 /// - Baumgarte, velocity Verlet at `for_step(dt)` (rate dt = 0.3): measured 6.2e-9 against
 ///   1.7e-2 without control; asserted bounded the same way, below 2e-8, and 1000x below none.
 fn residual_figures(steps: u64) -> Result<(), Error> {
-    let free = CartesianPendulum::new(1.0, 1.0, G)?;
+    let free = Constrained::new(CartesianPendulum::new(1.0, 1.0, G)?);
     let projected = Projected::new(Rk4, free, Projection::new(1e-13, 4)?);
     let (_, with_projection) = residual_run(projected, &free, steps)?;
     let (none_early, none) = residual_run(Rk4, &free, steps)?;
@@ -154,7 +156,7 @@ fn residual_over_10_000_steps() -> Result<(), Error> {
 fn implicit_method_on_a_constrained_mechanism() -> Result<(), Error> {
     use lagrange_integrators::GaussLegendre2;
     let simple = SimplePendulum::new(1.0, 1.0, G, 0.0)?;
-    let cartesian = CartesianPendulum::new(1.0, 1.0, G)?;
+    let cartesian = Constrained::new(CartesianPendulum::new(1.0, 1.0, G)?);
     let mut angle_form = GaussLegendre2::<f64>::default();
     let mut stepper = Projected::new(
         GaussLegendre2::<f64>::default(),
@@ -162,14 +164,14 @@ fn implicit_method_on_a_constrained_mechanism() -> Result<(), Error> {
         projection::<f64>()?,
     );
     let mut s = State::at_rest([TH0]);
-    let mut c = cartesian.state_from_angle(0.0, TH0, 0.0);
+    let mut c = cartesian.parts().state_from_angle(0.0, TH0, 0.0);
     let (mut worst, mut iterations, mut angle_iterations): (f64, u32, u32) = (0.0, 0, 0);
     for _ in 0..200 {
         s = angle_form.step(&simple, &s, 1e-2)?;
         c = stepper.step(&cartesian, &c, 1e-2)?;
         iterations = iterations.max(stepper.integrator().last_iterations());
         angle_iterations = angle_iterations.max(angle_form.last_iterations());
-        let (th, _) = cartesian.angle(&c);
+        let (th, _) = cartesian.parts().angle(&c);
         worst = worst.max((th - s.q[0]).abs());
     }
     println!(

@@ -1,7 +1,9 @@
 //! Forces added by wrapping act through the constraints: `with_force` on a constrained
 //! mechanism keeps its multipliers.
 
-use lagrange_core::{Error, Input, Mechanism, Projection, Real, State, ViscousDamping};
+use lagrange_core::{
+    Constrained, Error, Input, Lagrangian, Mechanism, Projection, Real, State, ViscousDamping,
+};
 use lagrange_integrators::{Integrator, Projected, Rk4};
 use lagrange_systems::{CartesianPendulum, RollingDisk, SimplePendulum};
 use lagrange_tests::{for_f32_and_f64, pick};
@@ -18,18 +20,20 @@ fn damping_acts_through_the_rod<T: Real>() -> Result<(), Error> {
         T::from_f64(0.3),
     );
     let simple = SimplePendulum::new(m, l, g, c * l * l)?;
-    let cartesian = CartesianPendulum::new(m, l, g)?;
+    let cartesian = Constrained::new(CartesianPendulum::new(m, l, g)?);
     let damped = cartesian.with_force(ViscousDamping::uniform(c)?);
     let tol = T::from_f64(pick::<T>(1e-5, 1e-13));
     let mut stepper = Projected::new(Rk4, cartesian, Projection::new(tol, 4)?);
     let dt = T::from_f64(1e-3);
     let mut s = State::at_rest([T::one()]);
-    let mut cs = cartesian.state_from_angle(T::zero(), T::one(), T::zero());
+    let mut cs = cartesian
+        .parts()
+        .state_from_angle(T::zero(), T::one(), T::zero());
     let mut worst: f64 = 0.0;
     for _ in 0..5000 {
         s = Rk4.step(&simple, &s, dt)?;
         cs = stepper.step(&damped, &cs, dt)?;
-        worst = worst.max((cartesian.angle(&cs).0 - s.q[0]).abs().to_f64());
+        worst = worst.max((cartesian.parts().angle(&cs).0 - s.q[0]).abs().to_f64());
     }
     println!("damped Cartesian vs damped angle, 5 s: {worst:.2e} rad");
     assert!(worst < pick::<T>(1e-5, 1e-10), "{worst:e}");
@@ -42,9 +46,9 @@ fn damping_acts_through_the_rod<T: Real>() -> Result<(), Error> {
 /// and leaves the heading rate alone; to 8 ulps.
 fn drive_torque_acts_through_the_contact<T: Real>() -> Result<(), Error> {
     let (m, r, tau) = (T::from_f64(2.0), T::from_f64(0.4), T::from_f64(0.6));
-    let disk = RollingDisk::new(m, r)?;
+    let disk = Constrained::new(RollingDisk::new(m, r)?);
     let driven = disk.with_force(Input::new([T::zero(), T::zero(), T::zero(), tau]));
-    let s = disk.rolling(
+    let s = disk.parts().rolling(
         T::zero(),
         [T::zero(); 4],
         T::from_f64(0.5),

@@ -34,9 +34,10 @@ fn tolerance<T: Real>() -> f64 {
     pick::<T>(2e-6, 1e-14)
 }
 
-/// `hand` (a constrained mechanism and its constraints) against `auto_constraints` and
-/// `Constrained::new(EulerLagrange::new(hand), auto_constraints)` at `states`; `scale` is a
-/// natural size of the accelerations and multipliers.
+/// `hand` (the parts of a constrained mechanism: the unconstrained mechanism and its
+/// constraints) against `auto_constraints`, and `Constrained::new(hand)` against
+/// `EulerLagrange::new(hand).held_by(auto_constraints)`, at `states`; `scale` is a natural
+/// size of the accelerations and multipliers.
 fn agree<T, S, A, const N: usize, const C: usize>(
     hand: &S,
     auto_constraints: A,
@@ -48,7 +49,8 @@ where
     S: Mechanism<T, N> + Constraints<T, N, C> + Lagrangian<T, N> + Clone,
     A: Constraints<T, N, C>,
 {
-    let auto = Constrained::new(EulerLagrange::new(hand.clone()), auto_constraints);
+    let constrained = Constrained::<T, C, S>::new(hand.clone());
+    let auto = EulerLagrange::new(hand.clone()).held_by(auto_constraints);
     let tol = tolerance::<T>();
     let mut worst: f64 = 0.0;
     for s in states {
@@ -56,11 +58,11 @@ where
         let pairs: [(SVector<T, C>, SVector<T, C>); 2] = [
             (
                 hand.position_residual(&s.q),
-                auto.constraints().position_residual(&s.q),
+                auto.parts().rows().position_residual(&s.q),
             ),
             (
                 hand.velocity_product(&s.q, &s.qd),
-                auto.constraints().velocity_product(&s.q, &s.qd),
+                auto.parts().rows().velocity_product(&s.q, &s.qd),
             ),
         ];
         for (a, b) in pairs {
@@ -69,14 +71,14 @@ where
             assert!(e < tol, "at {s:?}: hand {a:?} auto {b:?} ({e:e})");
         }
         let (ja, jb): (SMatrix<T, C, N>, SMatrix<T, C, N>) =
-            (hand.jacobian(&s.q), auto.constraints().jacobian(&s.q));
+            (hand.jacobian(&s.q), auto.parts().rows().jacobian(&s.q));
         let e = relative(ja.iter().copied(), jb.iter().copied(), 1.0);
         worst = worst.max(e);
         assert!(
             e < tol,
             "jacobian at {s:?}: hand {ja:?} auto {jb:?} ({e:e})"
         );
-        let a = hand.acceleration(&s)?;
+        let a = constrained.acceleration(&s)?;
         let b = auto.solve(&s)?;
         let e = relative(a.iter().copied(), b.acceleration.iter().copied(), scale);
         worst = worst.max(e);
@@ -103,7 +105,7 @@ fn cartesian_pendulum_agrees<T: Real>() -> Result<(), Error> {
         ))
     });
     let worst = agree(&p, Holonomic::new(p), states, 10.0)?;
-    let multipliers = p.solve(&State::new(
+    let multipliers = Constrained::new(p).solve(&State::new(
         T::zero(),
         [T::one(), T::zero()],
         [T::zero(); 2],

@@ -64,7 +64,11 @@ fn parameters_are_checked<T: Real>() -> Result<(), Error> {
 /// A start state off the constraint (position or velocity) is refused by `Projected` and by
 /// `check_state`, naming the row; a consistent one is accepted.
 fn inconsistent_start_is_refused<T: Real>() -> Result<(), Error> {
-    let p = CartesianPendulum::new(T::one(), T::one(), T::from_f64(9.81))?;
+    let p = Constrained::new(CartesianPendulum::new(
+        T::one(),
+        T::one(),
+        T::from_f64(9.81),
+    )?);
     let dt = T::from_f64(1e-3);
     let tol = T::from_f64(1e-5);
     let mut stepper = Projected::new(Rk4, p, Projection::new(tol, 4)?);
@@ -76,16 +80,18 @@ fn inconsistent_start_is_refused<T: Real>() -> Result<(), Error> {
             Err(Error::ConstraintViolated { row: 0 })
         );
     }
-    let good = p.state_from_angle(T::zero(), T::HALF, T::one());
+    let good = p.parts().state_from_angle(T::zero(), T::HALF, T::one());
     let next = stepper.step(&p, &good, dt)?;
     stepper.step(&p, &next, dt)?;
 
-    let linkage = FourBarLinkage::new(
+    let linkage = Constrained::new(FourBarLinkage::new(
         [T::one(), T::from_f64(0.3), T::one(), T::from_f64(0.8)],
         [T::one(); 3],
         T::from_f64(9.81),
-    )?;
-    let mut s = linkage.assemble(T::zero(), T::HALF, T::one(), Branch::Right)?;
+    )?);
+    let mut s = linkage
+        .parts()
+        .assemble(T::zero(), T::HALF, T::one(), Branch::Right)?;
     s.q[2] += T::from_f64(0.01);
     let mut stepper = Projected::new(Rk4, linkage, Projection::new(tol, 4)?);
     assert!(matches!(
@@ -119,7 +125,7 @@ impl<T: Real> HolonomicConstraints<T, 2, 2> for Twice {
 /// projection and the Schur complement alike.
 fn redundant_and_singular_constraints<T: Real>() -> Result<(), Error> {
     let p = CartesianPendulum::new(T::one(), T::one(), T::from_f64(9.81))?;
-    let twice = Constrained::new(EulerLagrange::new(p), Holonomic::new(Twice));
+    let twice = EulerLagrange::new(p).held_by(Holonomic::new(Twice));
     let s = p.state_from_angle(T::zero(), T::HALF, T::one());
     assert_eq!(
         twice.acceleration(&s),
@@ -131,11 +137,15 @@ fn redundant_and_singular_constraints<T: Real>() -> Result<(), Error> {
     );
     let at_pivot = State::new(T::zero(), [T::zero(); 2], [T::zero(); 2]);
     assert_eq!(
-        p.acceleration(&at_pivot),
+        Constrained::new(p).acceleration(&at_pivot),
         Err(Error::RedundantConstraints { row: 0 })
     );
 
-    let square = FourBarLinkage::new([T::one(); 4], [T::one(); 3], T::from_f64(9.81))?;
+    let square = Constrained::new(FourBarLinkage::new(
+        [T::one(); 4],
+        [T::one(); 3],
+        T::from_f64(9.81),
+    )?);
     let half_pi = T::from_f64(core::f64::consts::FRAC_PI_2);
     let flat = State::new(T::zero(), [half_pi; 3], [T::zero(); 3]);
     assert_eq!(
@@ -220,7 +230,7 @@ for_f32_and_f64!(
 /// Newton that cannot reach the tolerance in its iterations says so.
 #[test]
 fn projection_reports_no_convergence() -> Result<(), Error> {
-    let p = CartesianPendulum::new(1.0, 1.0, 9.81)?;
+    let p = Constrained::new(CartesianPendulum::new(1.0, 1.0, 9.81)?);
     let far = State::new(0.0, [3.0, 0.0], [0.0, 0.0]);
     assert_eq!(
         Projection::new(1e-12, 1)?.project(&p, &p, &far),

@@ -2,8 +2,8 @@
 //! resting and sliding contacts, with no penetration, no NaN and no endless event loop.
 
 use lagrange_core::nalgebra::{SVector, Vector4};
-use lagrange_core::{Constraints, State};
-use lagrange_core::{Error, Holonomic, HolonomicConstraints, Mechanism, Projection, Real, Scalar};
+use lagrange_core::{Constraints, Lagrangian, State};
+use lagrange_core::{Error, Holonomic, HolonomicConstraints, Projection, Real, Scalar};
 use lagrange_integrators::{ContactModel, ContactStepper, Rk4};
 use lagrange_systems::DoublePendulum;
 use lagrange_tests::pick;

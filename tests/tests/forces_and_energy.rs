@@ -2,7 +2,9 @@
 //! damping never adds energy, inputs do work, conserved quantities stay conserved.
 
 use lagrange_core::nalgebra::SVector;
-use lagrange_core::{Error, EulerLagrange, Input, Mechanism, Real, State, ViscousDamping};
+use lagrange_core::{
+    Error, EulerLagrange, Input, Lagrangian, Mechanism, Real, State, ViscousDamping,
+};
 use lagrange_integrators::{Integrator, Rk4};
 use lagrange_systems::{BeadOnRotatingHoop, DoublePendulum, SimplePendulum};
 use lagrange_tests::{for_f32_and_f64, pick};

@@ -4,7 +4,8 @@
 
 use lagrange_core::nalgebra::SVector;
 use lagrange_core::{
-    Constraints, Dual, Error, EulerLagrange, Lagrangian, Mechanism, Projection, Real, Scalar, State,
+    Constrained, Constraints, Dual, Error, EulerLagrange, Lagrangian, Projection, Real, Scalar,
+    State,
 };
 use lagrange_integrators::{Integrator, Projected, Rk4};
 use lagrange_systems::{Branch, FourBarLinkage};
@@ -18,12 +19,12 @@ const G: f64 = 9.81;
 const CRANK_RATE: f64 = 12.0;
 const DT: f64 = 1e-3;
 
-fn linkage<T: Real>() -> Result<FourBarLinkage<T>, Error> {
-    FourBarLinkage::new(
+fn linkage<T: Real>() -> Result<Constrained<T, 2, FourBarLinkage<T>>, Error> {
+    Ok(Constrained::new(FourBarLinkage::new(
         LENGTHS.map(T::from_f64),
         MASSES.map(T::from_f64),
         T::from_f64(G),
-    )
+    )?))
 }
 
 /// The same linkage with the crank angle as its only coordinate. Coupler and rocker follow
@@ -87,7 +88,7 @@ fn reduced_model_closes_the_same_loop() -> Result<(), Error> {
     let l = linkage::<f64>()?;
     for i in 0..64 {
         let th1 = -3.1 + 0.1 * f64::from(i);
-        let s = l.assemble(0.0, th1, 1.0, Branch::Right)?;
+        let s = l.parts().assemble(0.0, th1, 1.0, Branch::Right)?;
         let (th2, th3) = Reduced::closure(th1);
         assert!((s.q[1] - th2).abs() < 1e-13 && (s.q[2] - th3).abs() < 1e-13);
     }
@@ -120,7 +121,7 @@ fn largest_difference(a: &[(f64, f64)], b: &[(f64, f64)]) -> (f64, f64) {
 /// for 5 s.
 fn constrained_run(dt: f64, stride: usize) -> Result<Vec<(f64, f64)>, Error> {
     let l = linkage::<f64>()?;
-    let mut s = l.assemble(0.0, 0.0, CRANK_RATE, Branch::Right)?;
+    let mut s = l.parts().assemble(0.0, 0.0, CRANK_RATE, Branch::Right)?;
     let mut stepper = Projected::new(Rk4, l, Projection::new(1e-13, 4)?);
     let steps = (5.0 / dt).round() as usize;
     let mut out = Vec::new();
@@ -177,7 +178,9 @@ fn crank_matches_reduced_model() -> Result<(), Error> {
 fn residual_and_energy<T: Real>() -> Result<(), Error> {
     let l = linkage::<T>()?;
     let tol = T::from_f64(pick::<T>(5e-6, 1e-13));
-    let start = l.assemble(T::zero(), T::zero(), T::from_f64(CRANK_RATE), Branch::Right)?;
+    let start = l
+        .parts()
+        .assemble(T::zero(), T::zero(), T::from_f64(CRANK_RATE), Branch::Right)?;
     let e0 = l.energy(&start);
     let (mut worst_r, mut worst_e) = (T::zero(), T::zero());
     Projected::new(Rk4, l, Projection::new(tol, 4)?).integrate_with(

@@ -2,9 +2,7 @@
 //! most `mu` times the normal one) and while resting (sliding to a stop).
 
 use lagrange_core::nalgebra::{Matrix1x2, SMatrix, SVector, Vector1, Vector2};
-use lagrange_core::{
-    Constraints, Error, EulerLagrange, Lagrangian, Mechanism, Projection, Scalar, State,
-};
+use lagrange_core::{Constraints, Error, EulerLagrange, Lagrangian, Projection, Scalar, State};
 use lagrange_integrators::{ContactModel, ContactStepper, Contacts, Integrator, Rk4};
 
 const G: f64 = 9.81;

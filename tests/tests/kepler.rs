@@ -1,7 +1,7 @@
 //! The Kepler problem against Kepler's equation: the exact orbit, each integrator's position
 //! error after 10 periods of the e = 0.5 orbit, and the conserved angular momentum.
 
-use lagrange_core::{Error, Mechanism, Real, State};
+use lagrange_core::{Error, Lagrangian, Real, State};
 use lagrange_integrators::{ExplicitEuler, Integrator, Rk4, SemiImplicitEuler, VelocityVerlet};
 use lagrange_systems::exact::{eccentric_anomaly, kepler_orbit};
 use lagrange_systems::Kepler;

@@ -2,7 +2,7 @@
 //! symplectic, symmetric and variational methods keep the relative energy error bounded with
 //! no drift; explicit Euler and RK4 drift. Release-mode runs (`cargo xtask ci` runs them).
 
-use lagrange_core::{Error, EulerLagrange, Mechanism, State};
+use lagrange_core::{Error, EulerLagrange, Lagrangian, Mechanism, State};
 use lagrange_integrators::{
     ExplicitEuler, GaussLegendre2, ImplicitMidpoint, Integrator, LagrangianSystem, Rk4,
     SemiImplicitEuler, StormerVerlet, VariationalMidpoint, VelocityVerlet, Yoshida4,

@@ -2,7 +2,7 @@
 //! without damping or input (10 s here, 100 s in the long run), never increasing with damping,
 //! and changing by exactly the work of an input; the spherical pendulum's cyclic momentum.
 
-use lagrange_core::{Error, Mechanism, Real, State, ViscousDamping};
+use lagrange_core::{Error, Lagrangian, Mechanism, Real, State, ViscousDamping};
 use lagrange_integrators::{Integrator, Rk4};
 use lagrange_systems::{
     Acrobot, CartPole, ElasticPendulum, Kepler, NLinkPendulum, SphericalPendulum, SpringMassDamper,

@@ -4,7 +4,7 @@
 //! Spong's equations as Sutton and Barto implement them; the f32 chain against the f64 one.
 
 use lagrange_core::nalgebra::SVector;
-use lagrange_core::{Error, EulerLagrange, Mechanism, Real, State, ViscousDamping};
+use lagrange_core::{Error, EulerLagrange, Lagrangian, Mechanism, Real, State, ViscousDamping};
 use lagrange_systems::{Acrobot, CartPole, DoublePendulum, NLinkPendulum, SimplePendulum};
 use lagrange_tests::{for_f32_and_f64, pick, random_state, relative, Rng};
 

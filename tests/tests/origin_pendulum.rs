@@ -1,7 +1,7 @@
 //! The origin's pendulum (L = 1 m, g = 9.81 m/s^2, 30 degrees at rest, 10 s) against the exact
 //! Jacobi elliptic solution.
 
-use lagrange_core::{Error, Mechanism, Real, State};
+use lagrange_core::{Error, Lagrangian, Real, State};
 use lagrange_integrators::{Integrator, Rk4};
 use lagrange_systems::exact::{pendulum_from_rest, pendulum_period};
 use lagrange_systems::SimplePendulum;

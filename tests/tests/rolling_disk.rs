@@ -1,7 +1,7 @@
 //! The vertical rolling disk, two nonholonomic (Pfaffian) constraints: steady turning traces
 //! the exact circle, energy is constant, and the velocity residual stays at rounding.
 
-use lagrange_core::{Constraints, Error, Mechanism, Projection, Real};
+use lagrange_core::{Constrained, Constraints, Error, Lagrangian, Projection, Real};
 use lagrange_integrators::{Integrator, Projected, Rk4};
 use lagrange_systems::RollingDisk;
 use lagrange_tests::{for_f32_and_f64, pick};
@@ -28,8 +28,8 @@ const PSI0: f64 = 0.3;
 /// (6e-4 rad of heading at 2 m), 1.6e-5 J, 1.2e-7 m/s (~1 ulp of 2 m/s); bounds 4e-3 m, 5e-5 J,
 /// 5e-7 m/s.
 fn steady_turn_is_the_exact_circle<T: Real>() -> Result<(), Error> {
-    let disk = RollingDisk::new(T::one(), T::from_f64(RADIUS))?;
-    let start = disk.rolling(
+    let disk = Constrained::new(RollingDisk::new(T::one(), T::from_f64(RADIUS))?);
+    let start = disk.parts().rolling(
         T::zero(),
         [T::zero(), T::zero(), T::from_f64(PSI0), T::zero()],
         T::from_f64(TURN),

@@ -1,7 +1,7 @@
 //! The spring-mass-damper against the exact damped oscillator, under-, critically and
 //! over-damped.
 
-use lagrange_core::{Error, Mechanism, Real, State};
+use lagrange_core::{Error, Lagrangian, Real, State};
 use lagrange_integrators::{Integrator, Rk4};
 use lagrange_systems::exact::damped_oscillator;
 use lagrange_systems::SpringMassDamper;

@@ -2,7 +2,7 @@
 //! damp it out, the A-stable symmetric ones keep its energy, and the explicit ones fail with
 //! an error, never a panic or a state holding NaN.
 
-use lagrange_core::{Error, Mechanism, Real, State};
+use lagrange_core::{Error, Lagrangian, Real, State};
 use lagrange_integrators::{
     AdaptiveSettings, BackwardEuler, DormandPrince54, ExplicitEuler, GaussLegendre2,
     ImplicitMidpoint, Integrator, RadauIIA2, Rk4, SemiImplicitEuler, StormerVerlet, VelocityVerlet,

@@ -8,8 +8,8 @@ use crate::demo::{ns_per_step, TIMING_RUNS};
 use crate::svg::{self, Scale, Series};
 use lagrange_core::nalgebra::{SVector, Vector4};
 use lagrange_core::{
-    Constraints, Error, Holonomic, HolonomicConstraints, Mechanism, Projection, Real, Scalar,
-    Stabilization, State,
+    Constrained, Constraints, Error, Holonomic, HolonomicConstraints, Lagrangian, Mechanism,
+    Projection, Real, Scalar, Stabilization, State,
 };
 use lagrange_integrators::{ContactModel, ContactStepper, Integrator, Projected, Rk4};
 use lagrange_systems::{
@@ -84,11 +84,11 @@ fn lines(traces: &[Trace], k: usize) -> Vec<Series> {
 
 /// The Cartesian pendulum three ways and the four-bar linkage with projection.
 fn drift() -> Result<(Vec<Trace>, Trace), Error> {
-    let free = CartesianPendulum::new(1.0, 1.0, G)?;
+    let free = Constrained::new(CartesianPendulum::new(1.0, 1.0, G)?);
     let baumgarte = free.with_stabilization(Stabilization::critical(3.0)?);
-    let start = free.state_from_angle(0.0, TH0, 0.0);
+    let start = free.parts().state_from_angle(0.0, TH0, 0.0);
     // Energy relative to the swing's energy above the rest position.
-    let scale = free.energy(&start) - free.energy(&free.state_from_angle(0.0, 0.0, 0.0));
+    let scale = free.energy(&start) - free.energy(&free.parts().state_from_angle(0.0, 0.0, 0.0));
     let projection = Projection::new(1e-13, 4)?;
     let traces = vec![
         trace("RK4, none", Rk4, &free, &free, &start, LONG, scale)?,
@@ -112,7 +112,7 @@ fn drift() -> Result<(Vec<Trace>, Trace), Error> {
         )?,
     ];
     let linkage = four_bar()?;
-    let s0 = linkage.assemble(0.0, 0.0, 12.0, Branch::Right)?;
+    let s0 = linkage.parts().assemble(0.0, 0.0, 12.0, Branch::Right)?;
     let kinetic = linkage.kinetic_energy(&s0);
     let bar = trace(
         "four-bar, RK4 + projection",
@@ -127,12 +127,12 @@ fn drift() -> Result<(Vec<Trace>, Trace), Error> {
 }
 
 /// The Grashof crank-rocker of the tests: ground 1 m, crank 0.3 m, coupler 1 m, rocker 0.8 m.
-fn four_bar<T: Real>() -> Result<FourBarLinkage<T>, Error> {
-    FourBarLinkage::new(
+fn four_bar<T: Real>() -> Result<Constrained<T, 2, FourBarLinkage<T>>, Error> {
+    Ok(Constrained::new(FourBarLinkage::new(
         [1.0, 0.3, 1.0, 0.8].map(T::from_f64),
         [0.5, 1.0, 0.8].map(T::from_f64),
         T::from_f64(G),
-    )
+    )?))
 }
 
 /// Nanoseconds per step in `T`: `[simple pendulum RK4, Cartesian RK4, Cartesian RK4 +
@@ -143,9 +143,9 @@ fn costs<T: Real>() -> Result<[f64; 7], Error> {
     let th0 = T::from_f64(TH0);
     let steps = 10_000;
     let simple = SimplePendulum::new(one, one, g, T::zero())?;
-    let free = CartesianPendulum::new(one, one, g)?;
+    let free = Constrained::new(CartesianPendulum::new(one, one, g)?);
     let baumgarte = free.with_stabilization(Stabilization::critical(T::from_f64(3.0))?);
-    let start = free.state_from_angle(T::zero(), th0, T::zero());
+    let start = free.parts().state_from_angle(T::zero(), th0, T::zero());
     let tol = T::from_f64(if T::EPSILON.to_f64() > 1e-10 {
         1e-5
     } else {
@@ -154,7 +154,9 @@ fn costs<T: Real>() -> Result<[f64; 7], Error> {
     let projection = Projection::new(tol, 4)?;
     let double = DoublePendulum::new(one, one, one, one, g)?;
     let linkage = four_bar::<T>()?;
-    let s0 = linkage.assemble(T::zero(), T::zero(), T::from_f64(12.0), Branch::Right)?;
+    let s0 = linkage
+        .parts()
+        .assemble(T::zero(), T::zero(), T::from_f64(12.0), Branch::Right)?;
     Ok([
         ns_per_step(Rk4, &simple, &State::at_rest([th0]), dt, steps),
         ns_per_step(Rk4, &free, &start, dt, steps),

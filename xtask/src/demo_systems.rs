@@ -4,7 +4,10 @@
 //! orbit of problem P4 after 10 periods.
 
 use crate::demo::{ns_per_step, TIMING_RUNS};
-use lagrange_core::{solve_spd, Error, Mechanism, Real, State};
+use lagrange_core::nalgebra::SVector;
+use lagrange_core::{
+    solve_spd, Error, GeneralizedForce, Lagrangian, Mechanism, Real, Scalar, State,
+};
 use lagrange_integrators::{ExplicitEuler, Integrator, Rk4, SemiImplicitEuler, VelocityVerlet};
 use lagrange_systems::exact::kepler_orbit;
 use lagrange_systems::{
@@ -197,24 +200,28 @@ fn chain_cost<T: Real, const N: usize>() -> Result<(f64, f64), Error> {
 /// A mechanism whose acceleration is the default: `M` and `f` formed, then Cholesky.
 struct CholeskyPath<M>(M);
 
+impl<T: Real, const N: usize, M: Lagrangian<T, N>> Lagrangian<T, N> for CholeskyPath<M> {
+    fn kinetic<S: Scalar<Real = T>>(&self, t: S, q: &SVector<S, N>, qd: &SVector<S, N>) -> S {
+        self.0.kinetic(t, q, qd)
+    }
+    fn potential<S: Scalar<Real = T>>(&self, t: S, q: &SVector<S, N>) -> S {
+        self.0.potential(t, q)
+    }
+}
+
 impl<T: Real, const N: usize, M: Mechanism<T, N>> Mechanism<T, N> for CholeskyPath<M> {
     fn mass_matrix(&self, s: &State<T, N>) -> lagrange_core::nalgebra::SMatrix<T, N, N> {
         self.0.mass_matrix(s)
     }
-    fn rhs(&self, s: &State<T, N>) -> lagrange_core::nalgebra::SVector<T, N> {
+    fn rhs(&self, s: &State<T, N>) -> SVector<T, N> {
         self.0.rhs(s)
     }
-    fn kinetic_energy(&self, s: &State<T, N>) -> T {
-        self.0.kinetic_energy(s)
-    }
-    fn potential_energy(&self, s: &State<T, N>) -> T {
-        self.0.potential_energy(s)
-    }
-    fn acceleration(
+    fn law<F: GeneralizedForce<T, N>>(
         &self,
         s: &State<T, N>,
-    ) -> Result<lagrange_core::nalgebra::SVector<T, N>, Error> {
-        solve_spd(&self.0.mass_matrix(s), &self.0.rhs(s))
+        extra: &F,
+    ) -> Result<SVector<T, N>, Error> {
+        solve_spd(&self.0.mass_matrix(s), &extra.added_to(s, self.0.rhs(s)))
     }
 }
 

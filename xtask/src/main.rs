@@ -44,7 +44,9 @@ fn main() -> ExitCode {
         "ci" => ci(),
         "trig-fit" => trig_fit::run(),
         _ => {
-            eprintln!("usage: cargo xtask <demo | test | cross | bench | qemu | mutants | trig-fit | ci>");
+            eprintln!(
+                "usage: cargo xtask <demo | test | cross | bench | qemu | mutants | trig-fit | ci>"
+            );
             return ExitCode::from(2);
         }
     };

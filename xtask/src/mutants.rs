@@ -295,7 +295,9 @@ fn options(args: &[String]) -> Result<Options, String> {
     while let Some(a) = it.next() {
         match a.as_str() {
             "--area" => {
-                let names = it.next().ok_or("--area needs names, e.g. --area rk,adaptive")?;
+                let names = it
+                    .next()
+                    .ok_or("--area needs names, e.g. --area rk,adaptive")?;
                 o.areas = names
                     .split(',')
                     .map(|n| {
@@ -439,7 +441,11 @@ fn key_of(root: &Path, listed: &str) -> Option<Key> {
     let (_col, mutation) = rest.split_once(": ")?;
     let number: usize = line.parse().ok()?;
     let source = std::fs::read_to_string(root.join(file)).ok()?;
-    let text = source.lines().nth(number.checked_sub(1)?)?.trim().to_string();
+    let text = source
+        .lines()
+        .nth(number.checked_sub(1)?)?
+        .trim()
+        .to_string();
     Some(Key {
         file: file.into(),
         mutation: mutation.into(),
@@ -505,7 +511,9 @@ fn report(root: &Path, out: &Path, areas: &[&Area]) -> Result<(), String> {
         }
     }
     if !survivors.is_empty() {
-        md.push_str("\n## Surviving mutants (kill them with a test, or record them as equivalent)\n\n");
+        md.push_str(
+            "\n## Surviving mutants (kill them with a test, or record them as equivalent)\n\n",
+        );
         for s in &survivors {
             let _ = writeln!(md, "- {s}");
         }

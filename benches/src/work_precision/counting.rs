@@ -2,12 +2,13 @@
 //! untimed run of each point so that the timed runs pay nothing for it.
 
 use lagrange_core::nalgebra::{SMatrix, SVector};
-use lagrange_core::{Error, Jacobian, Mechanism, Real, State};
+use lagrange_core::{
+    Error, GeneralizedForce, Jacobian, Lagrangian, Mechanism, Real, Scalar, State,
+};
 use std::cell::Cell;
 
-/// `inner`, counting acceleration evaluations (calls to [`Mechanism::acceleration`] and
-/// [`Mechanism::acceleration_with`], and the one inside each
-/// [`Mechanism::acceleration_jacobian`]) and Jacobian evaluations. Every method is forwarded,
+/// `inner`, counting acceleration evaluations (calls of its law, [`Mechanism::law`], and the
+/// one inside each [`Mechanism::law_jacobian`]) and Jacobian evaluations. Every method is forwarded,
 /// so that the inner mechanism's own fast paths and exact Jacobians are kept.
 pub struct Counting<'a, M> {
     inner: &'a M,
@@ -34,6 +35,19 @@ impl<'a, M> Counting<'a, M> {
     }
 }
 
+impl<T: Real, const N: usize, M: Lagrangian<T, N>> Lagrangian<T, N> for Counting<'_, M> {
+    const EXPLICIT_TIME: bool = M::EXPLICIT_TIME;
+    fn kinetic<S: Scalar<Real = T>>(&self, t: S, q: &SVector<S, N>, qd: &SVector<S, N>) -> S {
+        self.inner.kinetic(t, q, qd)
+    }
+    fn potential<S: Scalar<Real = T>>(&self, t: S, q: &SVector<S, N>) -> S {
+        self.inner.potential(t, q)
+    }
+    fn non_conservative_force(&self, s: &State<T, N>) -> SVector<T, N> {
+        self.inner.non_conservative_force(s)
+    }
+}
+
 impl<T: Real, const N: usize, M: Mechanism<T, N>> Mechanism<T, N> for Counting<'_, M> {
     fn mass_matrix(&self, s: &State<T, N>) -> SMatrix<T, N, N> {
         self.inner.mass_matrix(s)
@@ -41,43 +55,31 @@ impl<T: Real, const N: usize, M: Mechanism<T, N>> Mechanism<T, N> for Counting<'
     fn rhs(&self, s: &State<T, N>) -> SVector<T, N> {
         self.inner.rhs(s)
     }
-    fn generalized_force(&self, s: &State<T, N>) -> SVector<T, N> {
-        self.inner.generalized_force(s)
-    }
-    fn kinetic_energy(&self, s: &State<T, N>) -> T {
-        self.inner.kinetic_energy(s)
-    }
-    fn potential_energy(&self, s: &State<T, N>) -> T {
-        self.inner.potential_energy(s)
-    }
-    fn energy(&self, s: &State<T, N>) -> T {
-        self.inner.energy(s)
-    }
     fn solve_mass(&self, s: &State<T, N>, b: &SVector<T, N>) -> Result<SVector<T, N>, Error> {
         self.inner.solve_mass(s, b)
     }
-    fn acceleration(&self, s: &State<T, N>) -> Result<SVector<T, N>, Error> {
-        self.calls.set(self.calls.get() + 1);
-        self.inner.acceleration(s)
-    }
-    fn acceleration_with(
+    fn law<F: GeneralizedForce<T, N>>(
         &self,
         s: &State<T, N>,
-        extra: &SVector<T, N>,
+        extra: &F,
     ) -> Result<SVector<T, N>, Error> {
         self.calls.set(self.calls.get() + 1);
-        self.inner.acceleration_with(s, extra)
+        self.inner.law(s, extra)
     }
-    fn equation_jacobian(&self, s: &State<T, N>, qdd: &SVector<T, N>) -> Jacobian<T, N> {
-        self.jacobians.set(self.jacobians.get() + 1);
-        self.inner.equation_jacobian(s, qdd)
-    }
-    fn acceleration_jacobian(
+    fn law_jacobian<F: GeneralizedForce<T, N>>(
         &self,
         s: &State<T, N>,
+        extra: &F,
     ) -> Result<(SVector<T, N>, Jacobian<T, N>), Error> {
         self.calls.set(self.calls.get() + 1);
         self.jacobians.set(self.jacobians.get() + 1);
-        self.inner.acceleration_jacobian(s)
+        self.inner.law_jacobian(s, extra)
+    }
+    fn law_force<F: GeneralizedForce<T, N>>(
+        &self,
+        s: &State<T, N>,
+        extra: &F,
+    ) -> Result<SVector<T, N>, Error> {
+        self.inner.law_force(s, extra)
     }
 }

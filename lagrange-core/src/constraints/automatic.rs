@@ -87,12 +87,8 @@ where
     fn velocity_product(&self, q: &SVector<T, N>, qd: &SVector<T, N>) -> SVector<T, C> {
         // q + s q' with s seeded in both the outer and the inner direction, so that the
         // inner derivative of the outer derivative is d2/ds2.
-        let line = SVector::<Dual<Dual<T, 1>, 1>, N>::from_fn(|k, _| Dual {
-            re: Dual {
-                re: q[k],
-                eps: [qd[k]],
-            },
-            eps: [Dual::constant(qd[k])],
+        let line = SVector::<Dual<Dual<T, 1>, 1>, N>::from_fn(|k, _| {
+            Dual::new(Dual::new(q[k], [qd[k]]), [Dual::constant(qd[k])])
         });
         self.constraints.phi(&line).map(|r| r.eps[0].eps[0])
     }
@@ -134,10 +130,7 @@ where
     }
 
     fn velocity_product(&self, q: &SVector<T, N>, qd: &SVector<T, N>) -> SVector<T, C> {
-        let line = SVector::<Dual<T, 1>, N>::from_fn(|k, _| Dual {
-            re: q[k],
-            eps: [qd[k]],
-        });
+        let line = SVector::<Dual<T, 1>, N>::from_fn(|k, _| Dual::new(q[k], [qd[k]]));
         let a = self.constraints.matrix(&line);
         SVector::from_fn(|i, _| {
             let mut g = T::zero();

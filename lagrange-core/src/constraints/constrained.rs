@@ -3,7 +3,8 @@
 
 use super::{Constraints, Schur};
 use crate::{
-    acceleration_jacobian_by_differences, validate, Error, Jacobian, Mechanism, Real, State,
+    validate, Error, GeneralizedForce, Jacobian, Lagrangian, Mechanism, NoForce, Real, Scalar,
+    State,
 };
 use nalgebra::{SMatrix, SVector};
 
@@ -138,32 +139,32 @@ pub struct ConstrainedAcceleration<T: Real, const N: usize, const C: usize> {
 /// [ J   0  ] [ -lambda ] = [ -J'q' - 2 alpha J q' - beta^2 phi ]     (Baumgarte terms when chosen)
 /// ```
 ///
-/// by its Schur complement: `a0 = M^-1 (f + Q + extra)`, `S lambda = r - J a0`,
-/// `q'' = a0 + M^-1 J^T lambda`. Cost: `C + 1` calls of [`Mechanism::solve_mass`], one
-/// Jacobian and one velocity-product evaluation (plus `phi` for Baumgarte), a `C x C` Cholesky.
+/// by its Schur complement: `a0 = M^-1 (f + Q + extra)` (the mechanism's own law, so a closed
+/// form is used where it has one), `S lambda = r - J a0`, `q'' = a0 + M^-1 J^T lambda`. Cost:
+/// one law and `C` calls of [`Mechanism::solve_mass`], one Jacobian and one velocity-product
+/// evaluation (plus `phi` for Baumgarte), a `C x C` Cholesky.
 ///
-/// `mechanism` supplies `M` (through `solve_mass`), `f` and `Q`; its own
-/// [`Mechanism::acceleration`] is never called, so a constrained mechanism may pass itself.
-/// It must not hold constraints of its own: put every constraint in one set.
+/// `mechanism` must be unconstrained: its law is `M^-1 (f + Q + extra)`. Put every constraint
+/// in one set.
 ///
 /// # Errors
 /// [`Error::RedundantConstraints`] for dependent or singular active rows;
-/// [`Error::NonFiniteState`]; whatever [`Mechanism::solve_mass`] returns.
-pub fn constrained_acceleration<T, M, K, const N: usize, const C: usize>(
+/// [`Error::NonFiniteState`]; whatever the mechanism's law returns.
+pub fn constrained_acceleration<T, M, K, F, const N: usize, const C: usize>(
     mechanism: &M,
     constraints: &K,
     stabilization: &Stabilization<T>,
     state: &State<T, N>,
-    extra: &SVector<T, N>,
+    extra: &F,
     active: &[bool; C],
 ) -> Result<ConstrainedAcceleration<T, N, C>, Error>
 where
     T: Real,
     M: Mechanism<T, N>,
     K: Constraints<T, N, C>,
+    F: GeneralizedForce<T, N>,
 {
-    let force = mechanism.rhs(state) + mechanism.generalized_force(state) + extra;
-    let a0 = mechanism.solve_mass(state, &force)?;
+    let a0 = mechanism.law(state, extra)?;
     if !active.iter().any(|&on| on) {
         // No row in force (a contact set in free flight): the unconstrained motion.
         return Ok(ConstrainedAcceleration {
@@ -211,39 +212,44 @@ pub fn solve_kkt<T: Real, const N: usize, const C: usize>(
     }
 }
 
-/// A mechanism under `C` constraints: it moves as the KKT system of
-/// [`constrained_acceleration`] says, so every integrator steps it unchanged.
+/// A mechanism under `C` constraints, from one value `P` that is both the unconstrained
+/// mechanism and its constraint rows (a standard constrained mechanism of `lagrange-systems`,
+/// or [`Held`]: any mechanism with rows of your own, made by
+/// [`Mechanism::held_by`]). It moves as the KKT system of [`constrained_acceleration`]
+/// says, so every integrator steps it unchanged.
 ///
-/// `mechanism` must be unconstrained (its acceleration `M^-1 (f + Q)`); mass matrix, `f`, `Q`,
-/// energies and `solve_mass` are its own, and [`Mechanism::acceleration`] adds the constraint
-/// forces. Forces added by [`Mechanism::with_force`], inside or outside this wrapper, act
-/// through the constraints. Drift control: [`Stabilization`] here, or projection after each
-/// step (`Projected` in lagrange-integrators).
+/// Its law ([`Mechanism::law`]) is the constrained one; mass matrix, `f`, `Q`, energies and
+/// `solve_mass` are the unconstrained mechanism's. Forces added by
+/// [`Mechanism::with_force`], inside or outside this wrapper, act through the constraints.
+/// Its Jacobian for implicit methods and the force its law applies (constraint forces
+/// included) derive from the constrained law. Drift control: [`Stabilization`] here, or
+/// projection after each step (`Projected` in lagrange-integrators), which reads the rows from
+/// this mechanism ([`Constraints`]).
 ///
 /// ```
-/// use lagrange_core::constraints::{Constrained, Holonomic, HolonomicConstraints};
-/// use lagrange_core::{EulerLagrange, Lagrangian, Mechanism, Scalar, State};
-/// use nalgebra::{SVector, Vector1};
+/// use lagrange_core::prelude::*;
+/// use lagrange_core::constraints::{Holonomic, HolonomicConstraints};
+/// use lagrange_core::nalgebra::Vector1;
 ///
 /// /// A unit point mass in the plane in gravity 9.81 along -y.
 /// struct Particle;
 /// impl Lagrangian<f64, 2> for Particle {
 ///     fn kinetic<S: Scalar<Real = f64>>(&self, _t: S, _q: &SVector<S, 2>, v: &SVector<S, 2>) -> S {
-///         (v[0] * v[0] + v[1] * v[1]) * S::from_f64(0.5)
+///         (v[0] * v[0] + v[1] * v[1]) * 0.5
 ///     }
 ///     fn potential<S: Scalar<Real = f64>>(&self, _t: S, q: &SVector<S, 2>) -> S {
-///         q[1] * S::from_f64(9.81)
+///         q[1] * 9.81
 ///     }
 /// }
 /// /// On a rod of length 1 from the origin.
 /// struct Rod;
 /// impl HolonomicConstraints<f64, 2, 1> for Rod {
 ///     fn phi<S: Scalar<Real = f64>>(&self, q: &SVector<S, 2>) -> SVector<S, 1> {
-///         Vector1::new((q[0] * q[0] + q[1] * q[1] - S::one()) * S::from_f64(0.5))
+///         Vector1::new((q[0] * q[0] + q[1] * q[1] - 1.0) * 0.5)
 ///     }
 /// }
 ///
-/// let pendulum = Constrained::new(EulerLagrange::new(Particle), Holonomic::new(Rod));
+/// let pendulum = EulerLagrange::new(Particle).held_by(Holonomic::new(Rod));
 /// // Hanging at rest: the rod carries the weight, nothing moves. The force J^T lambda pulls
 /// // the bob up, against grad phi = (0, -1): lambda = -m g, the rod's tension with its sign.
 /// let hanging = State::new(0.0, [0.0, -1.0], [0.0, 0.0]);
@@ -254,18 +260,16 @@ pub fn solve_kkt<T: Real, const N: usize, const C: usize>(
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub struct Constrained<M, K, T, const C: usize> {
-    mechanism: M,
-    constraints: K,
+pub struct Constrained<T, const C: usize, P> {
+    parts: P,
     stabilization: Stabilization<T>,
 }
 
-impl<M, K, T: Real, const C: usize> Constrained<M, K, T, C> {
-    /// `mechanism` held by `constraints`, without drift control.
-    pub fn new(mechanism: M, constraints: K) -> Self {
+impl<T: Real, const C: usize, P> Constrained<T, C, P> {
+    /// The mechanism and rows of `parts` held together, without drift control.
+    pub fn new(parts: P) -> Self {
         Self {
-            mechanism,
-            constraints,
+            parts,
             stabilization: Stabilization::None,
         }
     }
@@ -279,16 +283,10 @@ impl<M, K, T: Real, const C: usize> Constrained<M, K, T, C> {
         }
     }
 
-    /// The unconstrained mechanism.
+    /// The unconstrained mechanism and its rows.
     #[must_use]
-    pub fn mechanism(&self) -> &M {
-        &self.mechanism
-    }
-
-    /// The constraints.
-    #[must_use]
-    pub fn constraints(&self) -> &K {
-        &self.constraints
+    pub fn parts(&self) -> &P {
+        &self.parts
     }
 
     /// The drift control in use.
@@ -306,25 +304,26 @@ impl<M, K, T: Real, const C: usize> Constrained<M, K, T, C> {
         state: &State<T, N>,
     ) -> Result<ConstrainedAcceleration<T, N, C>, Error>
     where
-        M: Mechanism<T, N>,
-        K: Constraints<T, N, C>,
+        P: Mechanism<T, N> + Constraints<T, N, C>,
     {
-        self.solve_with(state, &SVector::zeros())
+        self.solve_with(state, &NoForce)
     }
 
     /// As [`Constrained::solve`] with an extra generalized force.
-    fn solve_with<const N: usize>(
+    ///
+    /// # Errors
+    /// As [`constrained_acceleration`].
+    pub fn solve_with<F: GeneralizedForce<T, N>, const N: usize>(
         &self,
         state: &State<T, N>,
-        extra: &SVector<T, N>,
+        extra: &F,
     ) -> Result<ConstrainedAcceleration<T, N, C>, Error>
     where
-        M: Mechanism<T, N>,
-        K: Constraints<T, N, C>,
+        P: Mechanism<T, N> + Constraints<T, N, C>,
     {
         constrained_acceleration(
-            &self.mechanism,
-            &self.constraints,
+            &self.parts,
+            &self.parts,
             &self.stabilization,
             state,
             extra,
@@ -333,45 +332,159 @@ impl<M, K, T: Real, const C: usize> Constrained<M, K, T, C> {
     }
 }
 
-impl<T, M, K, const N: usize, const C: usize> Mechanism<T, N> for Constrained<M, K, T, C>
+impl<T, P, const N: usize, const C: usize> Lagrangian<T, N> for Constrained<T, C, P>
 where
     T: Real,
-    M: Mechanism<T, N>,
-    K: Constraints<T, N, C>,
+    P: Lagrangian<T, N>,
 {
+    const EXPLICIT_TIME: bool = P::EXPLICIT_TIME;
+    fn kinetic<S: Scalar<Real = T>>(&self, t: S, q: &SVector<S, N>, qd: &SVector<S, N>) -> S {
+        self.parts.kinetic(t, q, qd)
+    }
+    fn potential<S: Scalar<Real = T>>(&self, t: S, q: &SVector<S, N>) -> S {
+        self.parts.potential(t, q)
+    }
+    fn non_conservative_force(&self, state: &State<T, N>) -> SVector<T, N> {
+        self.parts.non_conservative_force(state)
+    }
+}
+
+impl<T, P, const N: usize, const C: usize> Mechanism<T, N> for Constrained<T, C, P>
+where
+    T: Real,
+    P: Mechanism<T, N> + Constraints<T, N, C>,
+{
+    fn mass_matrix(&self, state: &State<T, N>) -> SMatrix<T, N, N> {
+        self.parts.mass_matrix(state)
+    }
+    fn rhs(&self, state: &State<T, N>) -> SVector<T, N> {
+        self.parts.rhs(state)
+    }
+    fn solve_mass(&self, state: &State<T, N>, b: &SVector<T, N>) -> Result<SVector<T, N>, Error> {
+        self.parts.solve_mass(state, b)
+    }
+    fn law<F: GeneralizedForce<T, N>>(
+        &self,
+        state: &State<T, N>,
+        extra: &F,
+    ) -> Result<SVector<T, N>, Error> {
+        Ok(self.solve_with(state, extra)?.acceleration)
+    }
+    /// `Q + extra + J^T lambda`: the free law's force and the constraint forces.
+    fn law_force<F: GeneralizedForce<T, N>>(
+        &self,
+        state: &State<T, N>,
+        extra: &F,
+    ) -> Result<SVector<T, N>, Error> {
+        let lambda = self.solve_with(state, extra)?.multipliers;
+        let rows = self.parts.jacobian(&state.q);
+        Ok(self.parts.law_force(state, extra)? + rows.transpose() * lambda)
+    }
+}
+
+/// The rows of a constrained mechanism are its parts' rows: what a projection reads.
+impl<T, P, const N: usize, const C: usize> Constraints<T, N, C> for Constrained<T, C, P>
+where
+    T: Real,
+    P: Constraints<T, N, C>,
+{
+    fn position_residual(&self, q: &SVector<T, N>) -> SVector<T, C> {
+        self.parts.position_residual(q)
+    }
+    fn jacobian(&self, q: &SVector<T, N>) -> SMatrix<T, C, N> {
+        self.parts.jacobian(q)
+    }
+    fn velocity_product(&self, q: &SVector<T, N>, qd: &SVector<T, N>) -> SVector<T, C> {
+        self.parts.velocity_product(q, qd)
+    }
+}
+
+/// An unconstrained mechanism `M` and constraint rows `K` that hold it, as one value: what
+/// [`Constrained`] is made of when the rows are your own ([`Mechanism::held_by`]). It moves
+/// as `M` alone; the rows act only through [`Constrained`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Held<M, K> {
+    mechanism: M,
+    rows: K,
+}
+
+impl<M, K> Held<M, K> {
+    /// `mechanism` with its `rows`.
+    pub fn new(mechanism: M, rows: K) -> Self {
+        Self { mechanism, rows }
+    }
+    /// The unconstrained mechanism.
+    #[must_use]
+    pub fn mechanism(&self) -> &M {
+        &self.mechanism
+    }
+    /// The constraint rows.
+    #[must_use]
+    pub fn rows(&self) -> &K {
+        &self.rows
+    }
+}
+
+impl<T: Real, const N: usize, M: Lagrangian<T, N>, K> Lagrangian<T, N> for Held<M, K> {
+    const EXPLICIT_TIME: bool = M::EXPLICIT_TIME;
+    fn kinetic<S: Scalar<Real = T>>(&self, t: S, q: &SVector<S, N>, qd: &SVector<S, N>) -> S {
+        self.mechanism.kinetic(t, q, qd)
+    }
+    fn potential<S: Scalar<Real = T>>(&self, t: S, q: &SVector<S, N>) -> S {
+        self.mechanism.potential(t, q)
+    }
+    fn non_conservative_force(&self, state: &State<T, N>) -> SVector<T, N> {
+        self.mechanism.non_conservative_force(state)
+    }
+}
+
+impl<T: Real, const N: usize, M: Mechanism<T, N>, K> Mechanism<T, N> for Held<M, K> {
     fn mass_matrix(&self, state: &State<T, N>) -> SMatrix<T, N, N> {
         self.mechanism.mass_matrix(state)
     }
     fn rhs(&self, state: &State<T, N>) -> SVector<T, N> {
         self.mechanism.rhs(state)
     }
-    fn generalized_force(&self, state: &State<T, N>) -> SVector<T, N> {
-        self.mechanism.generalized_force(state)
-    }
-    fn kinetic_energy(&self, state: &State<T, N>) -> T {
-        self.mechanism.kinetic_energy(state)
-    }
-    fn potential_energy(&self, state: &State<T, N>) -> T {
-        self.mechanism.potential_energy(state)
-    }
     fn solve_mass(&self, state: &State<T, N>, b: &SVector<T, N>) -> Result<SVector<T, N>, Error> {
         self.mechanism.solve_mass(state, b)
     }
-    fn acceleration(&self, state: &State<T, N>) -> Result<SVector<T, N>, Error> {
-        Ok(self.solve(state)?.acceleration)
-    }
-    fn acceleration_with(
+    fn law<F: GeneralizedForce<T, N>>(
         &self,
         state: &State<T, N>,
-        extra: &SVector<T, N>,
+        extra: &F,
     ) -> Result<SVector<T, N>, Error> {
-        Ok(self.solve_with(state, extra)?.acceleration)
+        self.mechanism.law(state, extra)
     }
-    fn acceleration_jacobian(
+    fn law_jacobian<F: GeneralizedForce<T, N>>(
         &self,
         state: &State<T, N>,
+        extra: &F,
     ) -> Result<(SVector<T, N>, Jacobian<T, N>), Error> {
-        acceleration_jacobian_by_differences(self, state)
+        self.mechanism.law_jacobian(state, extra)
+    }
+    fn law_force<F: GeneralizedForce<T, N>>(
+        &self,
+        state: &State<T, N>,
+        extra: &F,
+    ) -> Result<SVector<T, N>, Error> {
+        self.mechanism.law_force(state, extra)
+    }
+}
+
+impl<T, const N: usize, const C: usize, M, K> Constraints<T, N, C> for Held<M, K>
+where
+    T: Real,
+    K: Constraints<T, N, C>,
+{
+    fn position_residual(&self, q: &SVector<T, N>) -> SVector<T, C> {
+        self.rows.position_residual(q)
+    }
+    fn jacobian(&self, q: &SVector<T, N>) -> SMatrix<T, C, N> {
+        self.rows.jacobian(q)
+    }
+    fn velocity_product(&self, q: &SVector<T, N>, qd: &SVector<T, N>) -> SVector<T, C> {
+        self.rows.velocity_product(q, qd)
     }
 }
 

@@ -6,8 +6,9 @@
 //! - [`Schur`]: the factored Schur complement `J M^-1 J^T`, fixed-size, on the stack; the
 //!   shared core of every solve below. Dependent rows give
 //!   [`Error::RedundantConstraints`](crate::Error::RedundantConstraints).
-//! - [`constrained_acceleration`] and the [`Constrained`] wrapper: `q''` and the multipliers
-//!   `lambda` (the constraint forces), so that any integrator steps a constrained mechanism.
+//! - [`constrained_acceleration`] and the [`Constrained`] wrapper (a free mechanism and its rows,
+//!   [`Held`] together or written as one type): `q''` and the multipliers `lambda` (the
+//!   constraint forces), so that any integrator steps a constrained mechanism.
 //! - Drift control: [`Stabilization::Baumgarte`] inside the acceleration, or a
 //!   [`Projection`] back onto `phi = 0` and `J q' = 0` after each step.
 //! - Diagnostics on demand: [`Constraints::residual`] and [`Constraints::check_state`].
@@ -23,7 +24,7 @@ mod set;
 
 pub use automatic::{Holonomic, HolonomicConstraints, Pfaffian, PfaffianConstraints};
 pub use constrained::{
-    constrained_acceleration, solve_kkt, Constrained, ConstrainedAcceleration, Stabilization,
+    constrained_acceleration, solve_kkt, Constrained, ConstrainedAcceleration, Held, Stabilization,
 };
 pub use projection::Projection;
 pub use schur::Schur;

@@ -6,7 +6,9 @@ use lagrange_core::constraints::{
     constrained_acceleration, ConstrainedAcceleration, Schur, Stabilization,
 };
 use lagrange_core::nalgebra::{SMatrix, SVector};
-use lagrange_core::{Error, Mechanism, Real, State};
+use lagrange_core::{
+    Borrowed, Error, GeneralizedForce, Input, Jacobian, Lagrangian, Mechanism, Real, Scalar, State,
+};
 
 /// `mechanism` held by the `active` rows of `contacts`.
 ///
@@ -29,10 +31,10 @@ pub(crate) struct ActiveRows<'a, M, K, T, const C: usize> {
 impl<T: Real, M, K, const C: usize> ActiveRows<'_, M, K, T, C> {
     /// Accelerations and multipliers at `state` with `extra` force, and the rows still in
     /// force after the pulling ones were dropped.
-    pub(crate) fn solve<const N: usize>(
+    pub(crate) fn solve<F: GeneralizedForce<T, N>, const N: usize>(
         &self,
         state: &State<T, N>,
-        extra: &SVector<T, N>,
+        extra: &F,
     ) -> Result<(ConstrainedAcceleration<T, N, C>, [bool; C]), Error>
     where
         M: Mechanism<T, N>,
@@ -52,9 +54,15 @@ impl<T: Real, M, K, const C: usize> ActiveRows<'_, M, K, T, C> {
             };
             if self.friction > T::zero() {
                 if let Some(tangents) = self.contacts.tangent_jacobian(&state.q) {
-                    let force =
-                        self.sliding_friction(state, &tangents, &solved.multipliers, &active);
-                    solved = self.solve_rows(state, &(extra + force), &active)?;
+                    let friction = Input {
+                        value: self.sliding_friction(
+                            state,
+                            &tangents,
+                            &solved.multipliers,
+                            &active,
+                        ),
+                    };
+                    solved = self.solve_rows(state, &(Borrowed(extra), friction), &active)?;
                 }
             }
             let mut dropped = false;
@@ -70,10 +78,10 @@ impl<T: Real, M, K, const C: usize> ActiveRows<'_, M, K, T, C> {
         }
     }
 
-    fn solve_rows<const N: usize>(
+    fn solve_rows<F: GeneralizedForce<T, N>, const N: usize>(
         &self,
         state: &State<T, N>,
-        extra: &SVector<T, N>,
+        extra: &F,
         active: &[bool; C],
     ) -> Result<ConstrainedAcceleration<T, N, C>, Error>
     where
@@ -154,6 +162,23 @@ where
     }
 }
 
+impl<T, M, K, const N: usize, const C: usize> Lagrangian<T, N> for ActiveRows<'_, M, K, T, C>
+where
+    T: Real,
+    M: Lagrangian<T, N>,
+{
+    const EXPLICIT_TIME: bool = M::EXPLICIT_TIME;
+    fn kinetic<S: Scalar<Real = T>>(&self, t: S, q: &SVector<S, N>, qd: &SVector<S, N>) -> S {
+        self.mechanism.kinetic(t, q, qd)
+    }
+    fn potential<S: Scalar<Real = T>>(&self, t: S, q: &SVector<S, N>) -> S {
+        self.mechanism.potential(t, q)
+    }
+    fn non_conservative_force(&self, state: &State<T, N>) -> SVector<T, N> {
+        self.mechanism.non_conservative_force(state)
+    }
+}
+
 impl<T, M, K, const N: usize, const C: usize> Mechanism<T, N> for ActiveRows<'_, M, K, T, C>
 where
     T: Real,
@@ -166,36 +191,33 @@ where
     fn rhs(&self, state: &State<T, N>) -> SVector<T, N> {
         self.mechanism.rhs(state)
     }
-    fn generalized_force(&self, state: &State<T, N>) -> SVector<T, N> {
-        self.mechanism.generalized_force(state)
-    }
-    fn kinetic_energy(&self, state: &State<T, N>) -> T {
-        self.mechanism.kinetic_energy(state)
-    }
-    fn potential_energy(&self, state: &State<T, N>) -> T {
-        self.mechanism.potential_energy(state)
-    }
     fn solve_mass(&self, state: &State<T, N>, b: &SVector<T, N>) -> Result<SVector<T, N>, Error> {
         self.mechanism.solve_mass(state, b)
     }
-    /// In free flight (no row in force) the mechanism's own, possibly closed-form,
-    /// acceleration.
-    fn acceleration(&self, state: &State<T, N>) -> Result<SVector<T, N>, Error> {
-        if self.active.iter().any(|&on| on) {
-            self.acceleration_with(state, &SVector::zeros())
-        } else {
-            self.mechanism.acceleration(state)
-        }
-    }
-    fn acceleration_with(
+    /// The rows in force as constraints; in free flight (no row in force) the mechanism's own,
+    /// possibly closed-form, law.
+    fn law<F: GeneralizedForce<T, N>>(
         &self,
         state: &State<T, N>,
-        extra: &SVector<T, N>,
+        extra: &F,
     ) -> Result<SVector<T, N>, Error> {
         if self.active.iter().any(|&on| on) {
             Ok(self.solve(state, extra)?.0.acceleration)
         } else {
-            self.mechanism.acceleration_with(state, extra)
+            self.mechanism.law(state, extra)
+        }
+    }
+    /// In free flight the mechanism's own Jacobian (exact where it has one); with rows in
+    /// force, central differences of the constrained law.
+    fn law_jacobian<F: GeneralizedForce<T, N>>(
+        &self,
+        state: &State<T, N>,
+        extra: &F,
+    ) -> Result<(SVector<T, N>, Jacobian<T, N>), Error> {
+        if self.active.iter().any(|&on| on) {
+            lagrange_core::jacobian_by_differences(self, state, extra)
+        } else {
+            self.mechanism.law_jacobian(state, extra)
         }
     }
 }

@@ -253,7 +253,7 @@ where
                 &self.bilateral,
                 &self.resting,
             );
-            let (_, still) = rows.solve(&s, &SVector::zeros())?;
+            let (_, still) = rows.solve(&s, &lagrange_core::NoForce)?;
             for (r, kept) in self.resting.iter_mut().zip(still) {
                 *r = *r && kept;
             }

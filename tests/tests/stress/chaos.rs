@@ -6,7 +6,7 @@
 //! f64 only: a start separation of 1e-12 rad is below f32's resolution of angles near pi/2
 //! (1.2e-7), and an f32 pair would measure its own rounding.
 
-use lagrange_core::{Error, EulerLagrange, Mechanism, State};
+use lagrange_core::{Error, EulerLagrange, Lagrangian, State};
 use lagrange_integrators::{Integrator, Rk4, VariationalMidpoint};
 use lagrange_systems::DoublePendulum;
 

@@ -3,7 +3,7 @@
 //! energy error stays within a stated bound and does not drift. A 10^5-step version runs in
 //! the quick debug pass.
 
-use lagrange_core::{Error, Mechanism, Real, State};
+use lagrange_core::{Error, Lagrangian, Real, State};
 use lagrange_integrators::{Integrator, StormerVerlet, VelocityVerlet, Yoshida4};
 use lagrange_systems::SimplePendulum;
 use lagrange_tests::pick;

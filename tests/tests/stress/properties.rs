@@ -3,7 +3,7 @@
 //! conserved to a stated bound over a short run; damping never increases energy. Over random
 //! invalid inputs (NaN, infinities, zero, negative): a specific error, never a panic.
 
-use lagrange_core::{Error, Mechanism, Real, State, ViscousDamping};
+use lagrange_core::{Error, Lagrangian, Mechanism, Real, State, ViscousDamping};
 use lagrange_integrators::{ExplicitEuler, Integrator, Rk4, SemiImplicitEuler, VelocityVerlet};
 use lagrange_systems::{BeadOnRotatingHoop, DoublePendulum, FallingParticle, SimplePendulum};
 use lagrange_tests::pick;

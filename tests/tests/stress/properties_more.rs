@@ -5,7 +5,7 @@
 //! invalid parameters, `InvalidParameter` naming the parameter; at the singular
 //! configurations, `Singularity`, never NaN or a panic.
 
-use lagrange_core::{Error, Mechanism, Real, State};
+use lagrange_core::{Error, Lagrangian, Mechanism, Real, State};
 use lagrange_integrators::{Integrator, Rk4};
 use lagrange_systems::{
     Acrobot, CartPole, ElasticPendulum, Kepler, NLinkPendulum, SphericalPendulum, SpringMassDamper,

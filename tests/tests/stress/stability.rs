@@ -3,7 +3,7 @@
 //! oscillator each method is stable just inside its theoretical limit and blows up (with
 //! `Error::NonFiniteState`) just outside it.
 
-use lagrange_core::{Error, Mechanism, Real, State};
+use lagrange_core::{Error, Lagrangian, Mechanism, Real, State};
 use lagrange_integrators::{ExplicitEuler, Integrator, Rk4, SemiImplicitEuler, VelocityVerlet};
 use lagrange_systems::{DoublePendulum, ElasticPendulum, Kepler, SimplePendulum, SpringMassDamper};
 use lagrange_tests::{for_f32_and_f64, pick};
