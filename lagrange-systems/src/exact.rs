@@ -1,6 +1,7 @@
 //! Exact solutions used as references: the large-amplitude pendulum through Jacobi elliptic
 //! functions, computed by the arithmetic-geometric mean; the damped oscillator
-//! ([`damped_oscillator`]); Kepler orbits through Kepler's equation ([`kepler_orbit`]).
+//! ([`damped_oscillator`]) and the same driven by `F0 cos(w t)` ([`DrivenOscillator`]); Kepler
+//! orbits through Kepler's equation ([`kepler_orbit`]).
 
 use lagrange_core::{validate, Error, Real};
 
@@ -111,7 +112,9 @@ pub fn pendulum_period<T: Real>(theta0: T, omega: T) -> Result<T, Error> {
 }
 
 mod damped_oscillator;
+mod driven_oscillator;
 mod kepler;
 
 pub use damped_oscillator::damped_oscillator;
+pub use driven_oscillator::DrivenOscillator;
 pub use kepler::{eccentric_anomaly, kepler_orbit};

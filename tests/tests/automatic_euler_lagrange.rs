@@ -9,10 +9,10 @@ const STATES: usize = 1000;
 
 /// Relative agreement of accelerations, mass matrices and energies. Both paths compute the same
 /// terms in a different order, so they agree to a few ulps of the largest term, more where the
-/// 2x2 solve cancels. f64: the issue's 1e-12, ~4500 ulps. f32: the largest difference measured
-/// over these states is 6e-7 (~5 ulps); the bound 5e-6 leaves a factor 8.
+/// 2x2 solve cancels. Largest difference measured over these states: f64 9.1e-16 (the double
+/// pendulum; the issue asked for 1e-12), f32 6.3e-7 (~5 ulps); bounds 4.5e-15 and 3e-6.
 fn tolerance<T: Real>() -> f64 {
-    pick::<T>(5e-6, 1e-12)
+    pick::<T>(3e-6, 4.5e-15)
 }
 
 /// Compares `hand` with `EulerLagrange::new(hand)` at `STATES` random states (angles in
@@ -27,10 +27,15 @@ where
         acceleration: scale,
         energy: scale,
     };
-    agrees_with_automatic(hand, scale, tolerance::<T>(), STATES, rng, |r| {
+    let worst = agrees_with_automatic(hand, scale, tolerance::<T>(), STATES, rng, |r| {
         random_state(r, (-3.2, 3.2), (-5.0, 5.0))
-    })
-    .map(|_| ())
+    })?;
+    let name = core::any::type_name::<S>()
+        .rsplit("::")
+        .next()
+        .unwrap_or("");
+    println!("{name}: worst relative difference {worst}");
+    Ok(())
 }
 
 fn double_pendulum<T: Real>() -> Result<(), Error> {

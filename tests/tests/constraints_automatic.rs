@@ -29,9 +29,9 @@ fn relative<T: Real>(
 
 /// Both paths compute the same terms in a different order; the constrained solve then adds a
 /// Schur complement and its Cholesky factor. Measured worst over the three systems: f64
-/// 7.1e-16 (~3 ulps), f32 3.2e-7 (~3 ulps); the bounds 1e-14 and 2e-6 leave a factor ~6-14.
+/// 7.1e-16 (~3 ulps), f32 2.5e-7 (~2 ulps); bounds 3.5e-15 and 1.3e-6.
 fn tolerance<T: Real>() -> f64 {
-    pick::<T>(2e-6, 1e-14)
+    pick::<T>(1.3e-6, 3.5e-15)
 }
 
 /// `hand` (the parts of a constrained mechanism: the unconstrained mechanism and its
