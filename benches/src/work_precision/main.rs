@@ -22,6 +22,7 @@ mod counting;
 mod hand_rk4;
 mod method;
 mod ode_peer;
+mod outcome;
 mod plot;
 mod problem;
 mod problems;
