@@ -23,8 +23,8 @@ mod demo;
 mod demo_constraints;
 mod demo_integrators;
 mod demo_systems;
+mod plots;
 mod qemu;
-mod svg;
 mod trig_fit;
 
 use std::process::ExitCode;
