@@ -23,7 +23,6 @@ mod hand_rk4;
 mod method;
 mod ode_peer;
 mod outcome;
-mod plot;
 mod problem;
 mod problems;
 mod real;

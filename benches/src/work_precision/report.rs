@@ -4,11 +4,11 @@
 use super::budgets::{Rk4Ratio, RK4_BUDGET};
 use super::chain_cost::ChainCost;
 use super::method::{Origin, Tableau};
-use super::plot::{log_log, Line};
 use super::stability::{Limit, STABLE_ENERGY_ERROR};
 use super::sweep::{Row, Sweeps};
 use super::timing::Budget;
 use super::work_precision::{curves, time_at, Reach};
+use lagrange_plot::{Panel, Scale, Series};
 use std::fmt::Write;
 use std::path::Path;
 
@@ -48,7 +48,7 @@ pub fn write(
         Ok(())
     };
     put("bench.csv".into(), csv(&sweeps.rows))?;
-    let plots = plots(&sweeps.rows);
+    let plots = plots(&sweeps.rows).map_err(|e| e.to_string())?;
     let names: Vec<String> = plots.iter().map(|(n, _)| n.clone()).collect();
     for (name, svg) in plots {
         put(name, svg)?;
@@ -100,8 +100,40 @@ fn csv(rows: &[Row]) -> String {
     s
 }
 
-/// One error plot and one energy plot per problem and precision.
-fn plots(rows: &[Row]) -> Vec<(String, String)> {
+/// Size of a work-precision plot, pixels.
+const PLOT_SIZE: (u32, u32) = (900, 540);
+
+/// One kind of work-precision plot: wall time per simulated second against an error.
+struct WorkPlot {
+    /// End of its file names.
+    file: &'static str,
+    /// The error, for its title.
+    what: &'static str,
+    /// Its x axis's label.
+    x_label: &'static str,
+    /// The error of a row.
+    x: fn(&Row) -> f64,
+}
+
+/// The plots drawn per problem and precision.
+const WORK_PLOTS: [WorkPlot; 2] = [
+    WorkPlot {
+        file: "error",
+        what: "final error",
+        x_label: "final error max |y(T) - y_ref(T)|",
+        x: |r| r.final_error,
+    },
+    WorkPlot {
+        file: "energy",
+        what: "energy error",
+        x_label: "max relative energy error max_t |E(t) - E(0)| / |E(0)|",
+        x: |r| r.energy_error,
+    },
+];
+
+/// One error plot and one energy plot per problem and precision: log-log, a line with a dot
+/// per point for each method.
+fn plots(rows: &[Row]) -> Result<Vec<(String, String)>, lagrange_plot::Error> {
     let all = curves(rows);
     let mut keys: Vec<(&str, &str)> = Vec::new();
     for c in &all {
@@ -120,11 +152,11 @@ fn plots(rows: &[Row]) -> Vec<(String, String)> {
                     .is_some_and(|f| f.problem == problem && f.precision == precision)
             })
             .collect();
-        let lines = |x: fn(&Row) -> f64| -> Vec<Line> {
+        let series = |x: fn(&Row) -> f64| -> Vec<Series> {
             mine.iter()
                 .filter_map(|c| {
                     let first = c.first()?;
-                    Some(Line {
+                    Some(Series {
                         name: first.method.to_string(),
                         points: c
                             .iter()
@@ -135,26 +167,20 @@ fn plots(rows: &[Row]) -> Vec<(String, String)> {
                 })
                 .collect()
         };
-        out.push((
-            format!("wp-{problem}-{precision}-error.svg"),
-            log_log(
-                &format!("{problem} ({precision}): work against final error"),
-                "final error max |y(T) - y_ref(T)|",
-                "wall time per simulated second (s)",
-                &lines(|r| r.final_error),
-            ),
-        ));
-        out.push((
-            format!("wp-{problem}-{precision}-energy.svg"),
-            log_log(
-                &format!("{problem} ({precision}): work against energy error"),
-                "max relative energy error max_t |E(t) - E(0)| / |E(0)|",
-                "wall time per simulated second (s)",
-                &lines(|r| r.energy_error),
-            ),
-        ));
+        for plot in WORK_PLOTS {
+            let lines = series(plot.x);
+            let title = format!("{problem} ({precision}): work against {}", plot.what);
+            let panel = Panel::new(&title, &lines)
+                .x_axis(plot.x_label, Scale::Log)
+                .y_axis("wall time per simulated second (s)", Scale::Log)
+                .with_markers();
+            out.push((
+                format!("wp-{problem}-{precision}-{}.svg", plot.file),
+                lagrange_plot::svg(&[panel], PLOT_SIZE.0, PLOT_SIZE.1)?,
+            ));
+        }
     }
-    out
+    Ok(out)
 }
 
 /// A duration, human-readable.
