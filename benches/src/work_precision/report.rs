@@ -389,7 +389,9 @@ fn markdown(
         "Written by `cargo xtask bench{}` in {:.0} s on {cores} cores (1-minute load average {} \
          before, {} after). Each time is the median of {}..{} whole solves over [0, T] (as \
          many as fit about {} s per point), f64 and f32 alike; errors and energies are \
-         computed in f64. The machine may be shared: compare ratios and orders of magnitude, \
+         computed in f64. A point's final error is measured on its timed solves' end state, \
+         and its energy error and evaluation count on an untimed solve that must end at the \
+         same state bit for bit (else the point is reported failed). The machine may be shared: compare ratios and orders of magnitude, \
          not the last digit.\n",
         match (context.quick, context.peers) {
             (true, true) => " --quick --peers",
