@@ -1,10 +1,10 @@
 //! `cargo xtask demo`: the origin's pendulum and a chaotic double pendulum with every
 //! integrator, against exact or reference answers, with an SVG plot.
 
-use crate::cmd::project_root;
-use crate::svg::{self, Scale, Series};
+use crate::plots;
 use lagrange_core::{Error, Mechanism, Real, State};
 use lagrange_integrators::{ExplicitEuler, Integrator, Rk4, SemiImplicitEuler, VelocityVerlet};
+use lagrange_plot::{Scale, Series};
 use lagrange_systems::exact::pendulum_from_rest;
 use lagrange_systems::{DoublePendulum, SimplePendulum};
 use std::hint::black_box;
@@ -270,7 +270,9 @@ pub fn run() -> Result<(), String> {
     });
     let energy = series(&fine, |s| s.1);
     let dp_energy = series(&chaotic, |s| s.1);
-    let doc = svg::panels(
+    println!();
+    plots::write(
+        "pendulum.svg",
         "t (s)",
         &[
             (
@@ -292,12 +294,7 @@ pub fn run() -> Result<(), String> {
                 &dp_energy,
             ),
         ],
-    );
-    let dir = project_root().join("target").join("lagrange-demo");
-    std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
-    let path = dir.join("pendulum.svg");
-    std::fs::write(&path, doc).map_err(|e| e.to_string())?;
-    println!("\nPlot: {}", path.display());
+    )?;
     crate::demo_systems::run()?;
     crate::demo_integrators::run()?;
     crate::demo_constraints::run()

@@ -3,15 +3,15 @@
 //! double pendulum falling onto a floor (heights, energy, gaps), with the cost of a
 //! constrained step against the unconstrained one and SVG plots.
 
-use crate::cmd::project_root;
 use crate::demo::{ns_per_step, TIMING_RUNS};
-use crate::svg::{self, Scale, Series};
+use crate::plots;
 use lagrange_core::nalgebra::{SVector, Vector4};
 use lagrange_core::{
     Constrained, Constraints, Error, Holonomic, HolonomicConstraints, Lagrangian, Mechanism,
     Projection, Real, Scalar, Stabilization, State,
 };
 use lagrange_integrators::{ContactModel, ContactStepper, Integrator, Projected, Rk4};
+use lagrange_plot::{Scale, Series};
 use lagrange_systems::{
     Branch, CartesianPendulum, DoublePendulum, FallingParticle, FourBarLinkage, SimplePendulum,
 };
@@ -323,16 +323,6 @@ fn contact_costs() -> Result<[f64; 4], Error> {
     ])
 }
 
-/// Writes `doc` as `target/lagrange-demo/<name>` and prints where.
-fn write_plot(name: &str, doc: &str) -> Result<(), String> {
-    let dir = project_root().join("target").join("lagrange-demo");
-    std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
-    let path = dir.join(name);
-    std::fs::write(&path, doc).map_err(|e| e.to_string())?;
-    println!("Plot: {}", path.display());
-    Ok(())
-}
-
 /// The constrained scene: tables and `constraints.svg`.
 fn constrained_scene() -> Result<(), String> {
     let (traces, bar) = drift().map_err(|e| e.to_string())?;
@@ -385,7 +375,8 @@ fn constrained_scene() -> Result<(), String> {
             points: bar.samples.iter().map(|s| (s[0], s[1])).collect(),
         },
     ];
-    let doc = svg::panels(
+    plots::write(
+        "constraints.svg",
         "t (s)",
         &[
             (
@@ -407,8 +398,7 @@ fn constrained_scene() -> Result<(), String> {
                 &bar_lines,
             ),
         ],
-    );
-    write_plot("constraints.svg", &doc)
+    )
 }
 
 /// The colliding scene: tables and `impacts.svg`.
@@ -477,7 +467,8 @@ fn colliding_scene() -> Result<(), String> {
             points: dp.iter().map(|r| (r[0], r[3])).collect(),
         },
     ];
-    let doc = svg::panels(
+    plots::write(
+        "impacts.svg",
         "t (s)",
         &[
             (
@@ -499,8 +490,7 @@ fn colliding_scene() -> Result<(), String> {
                 &gaps,
             ),
         ],
-    );
-    write_plot("impacts.svg", &doc)
+    )
 }
 
 /// Runs both scenes.

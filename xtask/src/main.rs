@@ -26,8 +26,8 @@ mod demo_constraints;
 mod demo_integrators;
 mod demo_systems;
 mod mutants;
+mod plots;
 mod qemu;
-mod svg;
 mod trig_fit;
 
 use std::process::ExitCode;

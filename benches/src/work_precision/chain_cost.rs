@@ -133,15 +133,15 @@ fn point<const N: usize>(b: Budget) -> ChainPoint {
     let s = chain_state::<N>();
     // About 1 ms per timed run at any N: fewer steps for longer chains.
     let steps = (100_000 / (N * N) as u64).max(20);
-    let step = median_of_runs(b, || Rk4.integrate(&m, black_box(&s), 1e-3, steps));
+    let (step, _) = median_of_runs(b, || Rk4.integrate(&m, black_box(&s), 1e-3, steps));
     let reps = steps * 4;
-    let assembly = median_of_runs(b, || {
+    let (assembly, _) = median_of_runs(b, || {
         for _ in 0..reps {
             black_box((m.mass_matrix(black_box(&s)), m.rhs(black_box(&s))));
         }
     });
     let (mm, f) = (m.mass_matrix(&s), m.rhs(&s));
-    let solve = median_of_runs(b, || {
+    let (solve, _) = median_of_runs(b, || {
         for _ in 0..reps {
             let _ = black_box(solve_spd(black_box(&mm), black_box(&f)));
         }
@@ -149,7 +149,8 @@ fn point<const N: usize>(b: Budget) -> ChainPoint {
     // The automatic path costs O(N^3) and more per evaluation: fewer steps still.
     let auto = EulerLagrange::new(m);
     let auto_steps = (steps / N as u64).max(4);
-    let automatic = median_of_runs(b, || Rk4.integrate(&auto, black_box(&s), 1e-3, auto_steps));
+    let (automatic, _) =
+        median_of_runs(b, || Rk4.integrate(&auto, black_box(&s), 1e-3, auto_steps));
     ChainPoint {
         n: N,
         ns_per_step: ns(step.median, steps),

@@ -22,7 +22,7 @@ mod counting;
 mod hand_rk4;
 mod method;
 mod ode_peer;
-mod plot;
+mod outcome;
 mod problem;
 mod problems;
 mod real;

@@ -1,7 +1,9 @@
 //! The [`Method`] contract of the bench (a way of solving a problem over `[0, T]` at a step size
-//! or a tolerance) and the methods table.
+//! or a tolerance) and the methods table: the library's integrators, the hand-written RK4 loop
+//! and `ode_solvers`' Dopri5 and Dop853.
 
-use super::ode_peer::{OdeSolvers, Peer};
+use super::ode_peer::Peer;
+use super::outcome::{Observer, Outcome};
 use super::problem::Problem;
 use super::real::BenchReal;
 use lagrange_core::{Error, EulerLagrange, Mechanism, Real, State};
@@ -70,19 +72,22 @@ impl Param {
     }
 }
 
-/// What a solve returns.
-pub struct Outcome<T: Real, const N: usize> {
-    /// The state at the final time.
-    pub end: State<T, N>,
-    /// Steps taken (accepted and rejected, for adaptive methods).
-    pub steps: u64,
-    /// Acceleration evaluations, when the method counts them itself (otherwise the runner
-    /// counts calls to `Mechanism::acceleration`).
-    pub evals: Option<u64>,
+/// The Butcher tableau a method steps with, where solvers of different origins share one:
+/// the report compares such pairs like for like.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Tableau {
+    /// Dormand and Prince's 5(4) pair (the library's `Dopri5Pair`, `ode_solvers`' Dopri5,
+    /// SciPy's RK45).
+    DormandPrince54,
+    /// Hairer's 8(5,3) pair of Dormand and Prince (the library's `Dop853Pair`, `ode_solvers`'
+    /// Dop853, SciPy's DOP853).
+    DormandPrince853,
 }
 
-/// An observer of every state a solve passes through (`None` in timed runs).
-pub type Observer<'a, T, const N: usize> = Option<&'a mut dyn FnMut(&State<T, N>)>;
+impl Tableau {
+    /// Every tableau, in the order of the report's rows.
+    pub const ALL: [Self; 2] = [Self::DormandPrince54, Self::DormandPrince853];
+}
 
 /// A way of solving a problem: an integrator of the library, a hand-written loop, another
 /// crate's solver.
@@ -93,6 +98,10 @@ pub trait Method {
     fn origin(&self) -> Origin;
     /// Fixed step or adaptive.
     fn kind(&self) -> Kind;
+    /// Its Butcher tableau, where solvers of other origins use the same one.
+    fn tableau(&self) -> Option<Tableau> {
+        None
+    }
     /// For an explicit fixed-step method, the largest `h w` for which it is stable on an
     /// undamped linear oscillator of frequency `w` (`0` when no step is: explicit Euler).
     fn linear_stability_limit(&self) -> Option<f64> {
@@ -145,8 +154,10 @@ pub fn for_each(v: &mut impl MethodVisitor) {
     v.visit(&Library(BackwardEulerFamily));
     v.visit(&Library(RadauIIA2Family));
     v.visit(&Variational);
-    v.visit(&Adaptive::<7, 1, Dopri5Pair>(PhantomData));
-    v.visit(&Adaptive::<16, 4, Dop853Pair>(PhantomData));
+    v.visit(&Adaptive::<7, 1, Dopri5Pair>::new(Tableau::DormandPrince54));
+    v.visit(&Adaptive::<16, 4, Dop853Pair>::new(
+        Tableau::DormandPrince853,
+    ));
     v.visit(&HandRk4);
     v.visit(&OdeSolvers(Peer::Dopri5));
     v.visit(&OdeSolvers(Peer::Dop853));
@@ -314,7 +325,20 @@ impl Method for Variational {
 }
 
 /// An adaptive embedded Runge-Kutta pair of the library (`S` stages, `R` dense-output rows).
-pub struct Adaptive<const S: usize, const R: usize, P>(pub PhantomData<P>);
+pub struct Adaptive<const S: usize, const R: usize, P> {
+    tableau: Tableau,
+    pair: PhantomData<P>,
+}
+
+impl<const S: usize, const R: usize, P> Adaptive<S, R, P> {
+    /// The pair `P`, whose coefficients are `tableau`'s.
+    pub fn new(tableau: Tableau) -> Self {
+        Self {
+            tableau,
+            pair: PhantomData,
+        }
+    }
+}
 
 /// Most steps one adaptive solve may take.
 const MAX_ADAPTIVE_STEPS: u64 = 10_000_000;
@@ -328,6 +352,9 @@ impl<const S: usize, const R: usize, Pair: EmbeddedPair<S, R>> Method for Adapti
     }
     fn kind(&self) -> Kind {
         Kind::Adaptive
+    }
+    fn tableau(&self) -> Option<Tableau> {
+        Some(self.tableau)
     }
     fn solve<T, P, M, const N: usize, const N2: usize>(
         &self,
@@ -352,16 +379,15 @@ impl<const S: usize, const R: usize, Pair: EmbeddedPair<S, R>> Method for Adapti
             let mut rk = EmbeddedRungeKutta::<T, N, S, R, Pair>::new(settings, mechanism, start)?;
             let end = match observe {
                 None => rk.integrate_to(mechanism, t_end)?,
-                Some(o) => {
-                    // Accepted steps one by one while they end before t_end, then the last
-                    // one (or few), shortened to land on it.
-                    while rk.state().t + rk.step_size() < t_end {
-                        o(&rk.step(mechanism)?);
-                    }
-                    let end = rk.integrate_to(mechanism, t_end)?;
-                    o(&end);
-                    end
-                }
+                // The steps of `integrate_to` (each told where the end is, so that the last
+                // lands on it), with the observer riding on a guard that never changes sign:
+                // the observed run and the timed runs are the same computation.
+                Some(o) => *rk
+                    .integrate_until_event(mechanism, t_end, |s| {
+                        o(s);
+                        T::one()
+                    })?
+                    .state(),
             };
             let stats = rk.statistics();
             Ok(Outcome {
@@ -427,5 +453,52 @@ impl Method for HandRk4 {
         } else {
             Err(Error::NonFiniteState.to_string())
         })
+    }
+}
+
+/// An `ode_solvers` method, with its own default step-size controller settings.
+pub struct OdeSolvers(pub Peer);
+
+impl Method for OdeSolvers {
+    fn name(&self) -> &'static str {
+        self.0.name()
+    }
+    fn origin(&self) -> Origin {
+        Origin::OdeSolvers
+    }
+    fn kind(&self) -> Kind {
+        Kind::Adaptive
+    }
+    fn tableau(&self) -> Option<Tableau> {
+        Some(match self.0 {
+            Peer::Dopri5 => Tableau::DormandPrince54,
+            Peer::Dop853 => Tableau::DormandPrince853,
+        })
+    }
+    fn solve<T, P, M, const N: usize, const N2: usize>(
+        &self,
+        _problem: &P,
+        mechanism: &M,
+        start: &State<T, N>,
+        t_end: T,
+        param: Param,
+        observe: Observer<'_, T, N>,
+    ) -> Option<Result<Outcome<T, N>, String>>
+    where
+        T: BenchReal,
+        P: Problem<N, N2>,
+        M: Mechanism<T, N>,
+    {
+        let Param::Tolerance(tol) = param else {
+            return None;
+        };
+        Some(T::ode_solve::<M, N, N2>(
+            self.0,
+            mechanism,
+            start,
+            t_end,
+            T::real(tol),
+            observe,
+        ))
     }
 }

@@ -1,11 +1,11 @@
-//! The `ode_solvers` crate's Dopri5 and Dop853 on the bench's problems: the mechanism's
-//! `acceleration` behind its `System` trait, on a static vector of the whole state.
+//! The `ode_solvers` crate's Dopri5 and Dop853 driving a mechanism: its `acceleration` behind
+//! `ode_solvers`' `System` trait, on a static vector of the whole state. The bench's method
+//! for them is [`OdeSolvers`](super::method::OdeSolvers).
 
-use super::method::{Kind, Method, Observer, Origin, Outcome, Param};
-use super::problem::Problem;
-use super::real::BenchReal;
+use super::outcome::{Observer, Outcome};
 use lagrange_core::nalgebra as na;
-use lagrange_core::{Error, Mechanism, State};
+use lagrange_core::{Error, Mechanism, Real, Scalar, State};
+use ode_solvers::dop_shared::FloatNumber;
 use ode_solvers::{Dop853, Dopri5, OutputType, System};
 use std::cell::Cell;
 
@@ -25,11 +25,23 @@ pub enum Peer {
     Dop853,
 }
 
-/// An `ode_solvers` method, with its own default step-size controller settings.
-pub struct OdeSolvers(pub Peer);
+impl Peer {
+    /// Name for tables and legends.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Dopri5 => "ode_solvers Dopri5",
+            Self::Dop853 => "ode_solvers Dop853",
+        }
+    }
+}
+
+/// A precision both the library and `ode_solvers` accept.
+pub trait OdeReal: Real + FloatNumber {}
+
+impl<T: Real + FloatNumber> OdeReal for T {}
 
 /// A mechanism as an `ode_solvers` system.
-struct Sys<'a, 'o, T: BenchReal, M, const N: usize> {
+struct Sys<'a, 'o, T: OdeReal, M, const N: usize> {
     mechanism: &'a M,
     /// The first error `acceleration` returned. The derivative is then NaN, which makes
     /// `ode_solvers`' controller reject the step and retry a smaller one (as a trial stage of
@@ -39,7 +51,7 @@ struct Sys<'a, 'o, T: BenchReal, M, const N: usize> {
 }
 
 /// The state at `t` from the whole-state vector `y`.
-fn state<T: BenchReal, const N: usize, const N2: usize>(t: T, y: &Y<T, N2>) -> State<T, N> {
+fn state<T: OdeReal, const N: usize, const N2: usize>(t: T, y: &Y<T, N2>) -> State<T, N> {
     State {
         t,
         q: na::SVector::from_fn(|i, _| y[i]),
@@ -47,7 +59,7 @@ fn state<T: BenchReal, const N: usize, const N2: usize>(t: T, y: &Y<T, N2>) -> S
     }
 }
 
-impl<T: BenchReal, M: Mechanism<T, N>, const N: usize, const N2: usize> System<T, Y<T, N2>>
+impl<T: OdeReal, M: Mechanism<T, N>, const N: usize, const N2: usize> System<T, Y<T, N2>>
     for Sys<'_, '_, T, M, N>
 {
     fn system(&self, t: T, y: &Y<T, N2>, dy: &mut Y<T, N2>) {
@@ -62,7 +74,7 @@ impl<T: BenchReal, M: Mechanism<T, N>, const N: usize, const N2: usize> System<T
                 if self.failure.get().is_none() {
                     self.failure.set(Some(e));
                 }
-                dy.fill(T::real(f64::NAN));
+                dy.fill(<T as Scalar>::from_f64(f64::NAN));
             }
         }
     }
@@ -72,47 +84,6 @@ impl<T: BenchReal, M: Mechanism<T, N>, const N: usize, const N2: usize> System<T
             observe(&state(t, y));
         }
         false
-    }
-}
-
-impl Method for OdeSolvers {
-    fn name(&self) -> &'static str {
-        match self.0 {
-            Peer::Dopri5 => "ode_solvers Dopri5",
-            Peer::Dop853 => "ode_solvers Dop853",
-        }
-    }
-    fn origin(&self) -> Origin {
-        Origin::OdeSolvers
-    }
-    fn kind(&self) -> Kind {
-        Kind::Adaptive
-    }
-    fn solve<T, P, M, const N: usize, const N2: usize>(
-        &self,
-        _problem: &P,
-        mechanism: &M,
-        start: &State<T, N>,
-        t_end: T,
-        param: Param,
-        observe: Observer<'_, T, N>,
-    ) -> Option<Result<Outcome<T, N>, String>>
-    where
-        T: BenchReal,
-        P: Problem<N, N2>,
-        M: Mechanism<T, N>,
-    {
-        let Param::Tolerance(tol) = param else {
-            return None;
-        };
-        Some(T::ode_solve::<M, N, N2>(
-            self.0,
-            mechanism,
-            start,
-            t_end,
-            T::real(tol),
-            observe,
-        ))
     }
 }
 
@@ -130,7 +101,7 @@ pub fn solve<T, M, const N: usize, const N2: usize>(
     observe: Observer<'_, T, N>,
 ) -> Result<Outcome<T, N>, String>
 where
-    T: BenchReal,
+    T: OdeReal,
     f64: From<T>,
     M: Mechanism<T, N>,
 {
@@ -142,8 +113,8 @@ where
         failure: &failure,
         observe,
     };
-    let (t0, span, zero) = (start.t, t_end - start.t, T::real(0.0));
-    let f = T::real;
+    let f = <T as Scalar>::from_f64;
+    let (t0, span, zero) = (start.t, t_end - start.t, f(0.0));
     // Each method's defaults (safety, beta, fac_min, fac_max) as its `new` sets them, with
     // sparse output (every accepted step stored, no dense interpolation) and MAX_STEPS.
     let solved = match peer {
@@ -208,7 +179,7 @@ where
 }
 
 /// The statistics and last stored point of a finished solve.
-fn finish<T: BenchReal, const N2: usize>(
+fn finish<T: OdeReal, const N2: usize>(
     result: Result<ode_solvers::dop_shared::Stats, ode_solvers::dop_shared::IntegrationError>,
     x: &[T],
     y: &[Y<T, N2>],

@@ -1,13 +1,13 @@
 //! [`BenchReal`]: the two precisions the bench runs in, with what every runner needs of them.
 
 use super::hand_rk4;
-use super::method::{Observer, Outcome};
-use super::ode_peer::{self, Peer};
+use super::ode_peer::{self, OdeReal, Peer};
+use super::outcome::{Observer, Outcome};
 use lagrange_core::{Mechanism, Real, State};
 
 /// `f32` or `f64`: a library scalar that `ode_solvers` also accepts, with the hand-written RK4
 /// loops of its precision.
-pub trait BenchReal: Real + ode_solvers::dop_shared::FloatNumber {
+pub trait BenchReal: OdeReal {
     /// `"f32"` or `"f64"`.
     const LABEL: &'static str;
 
@@ -98,4 +98,18 @@ pub fn narrow<T: Real, const N: usize>(s: &State<f64, N>) -> State<T, N> {
         q: s.q.map(T::from_f64),
         qd: s.qd.map(T::from_f64),
     }
+}
+
+/// True when `a` and `b` hold the same bits in every coordinate and rate, the components that
+/// errors and energies are measured on. The time is left out: a run observed step by step may
+/// sum it in another order than one whole solve (the hand-written loops do).
+pub fn same_bits<T: Real, const N: usize>(a: &State<T, N>, b: &State<T, N>) -> bool {
+    let bits = |s: &State<T, N>| {
+        let w = widen(s);
+        w.q.iter()
+            .chain(w.qd.iter())
+            .map(|x| x.to_bits())
+            .collect::<Vec<u64>>()
+    };
+    bits(a) == bits(b)
 }

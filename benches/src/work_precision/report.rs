@@ -3,12 +3,12 @@
 
 use super::budgets::{Rk4Ratio, RK4_BUDGET};
 use super::chain_cost::ChainCost;
-use super::method::Origin;
-use super::plot::{log_log, Line};
+use super::method::{Origin, Tableau};
 use super::stability::{Limit, STABLE_ENERGY_ERROR};
 use super::sweep::{Row, Sweeps};
 use super::timing::Budget;
 use super::work_precision::{curves, time_at, Reach};
+use lagrange_plot::{Panel, Scale, Series};
 use std::fmt::Write;
 use std::path::Path;
 
@@ -48,7 +48,7 @@ pub fn write(
         Ok(())
     };
     put("bench.csv".into(), csv(&sweeps.rows))?;
-    let plots = plots(&sweeps.rows);
+    let plots = plots(&sweeps.rows).map_err(|e| e.to_string())?;
     let names: Vec<String> = plots.iter().map(|(n, _)| n.clone()).collect();
     for (name, svg) in plots {
         put(name, svg)?;
@@ -100,8 +100,40 @@ fn csv(rows: &[Row]) -> String {
     s
 }
 
-/// One error plot and one energy plot per problem and precision.
-fn plots(rows: &[Row]) -> Vec<(String, String)> {
+/// Size of a work-precision plot, pixels.
+const PLOT_SIZE: (u32, u32) = (900, 540);
+
+/// One kind of work-precision plot: wall time per simulated second against an error.
+struct WorkPlot {
+    /// End of its file names.
+    file: &'static str,
+    /// The error, for its title.
+    what: &'static str,
+    /// Its x axis's label.
+    x_label: &'static str,
+    /// The error of a row.
+    x: fn(&Row) -> f64,
+}
+
+/// The plots drawn per problem and precision.
+const WORK_PLOTS: [WorkPlot; 2] = [
+    WorkPlot {
+        file: "error",
+        what: "final error",
+        x_label: "final error max |y(T) - y_ref(T)|",
+        x: |r| r.final_error,
+    },
+    WorkPlot {
+        file: "energy",
+        what: "energy error",
+        x_label: "max relative energy error max_t |E(t) - E(0)| / |E(0)|",
+        x: |r| r.energy_error,
+    },
+];
+
+/// One error plot and one energy plot per problem and precision: log-log, a line with a dot
+/// per point for each method.
+fn plots(rows: &[Row]) -> Result<Vec<(String, String)>, lagrange_plot::Error> {
     let all = curves(rows);
     let mut keys: Vec<(&str, &str)> = Vec::new();
     for c in &all {
@@ -120,11 +152,11 @@ fn plots(rows: &[Row]) -> Vec<(String, String)> {
                     .is_some_and(|f| f.problem == problem && f.precision == precision)
             })
             .collect();
-        let lines = |x: fn(&Row) -> f64| -> Vec<Line> {
+        let series = |x: fn(&Row) -> f64| -> Vec<Series> {
             mine.iter()
                 .filter_map(|c| {
                     let first = c.first()?;
-                    Some(Line {
+                    Some(Series {
                         name: first.method.to_string(),
                         points: c
                             .iter()
@@ -135,26 +167,20 @@ fn plots(rows: &[Row]) -> Vec<(String, String)> {
                 })
                 .collect()
         };
-        out.push((
-            format!("wp-{problem}-{precision}-error.svg"),
-            log_log(
-                &format!("{problem} ({precision}): work against final error"),
-                "final error max |y(T) - y_ref(T)|",
-                "wall time per simulated second (s)",
-                &lines(|r| r.final_error),
-            ),
-        ));
-        out.push((
-            format!("wp-{problem}-{precision}-energy.svg"),
-            log_log(
-                &format!("{problem} ({precision}): work against energy error"),
-                "max relative energy error max_t |E(t) - E(0)| / |E(0)|",
-                "wall time per simulated second (s)",
-                &lines(|r| r.energy_error),
-            ),
-        ));
+        for plot in WORK_PLOTS {
+            let lines = series(plot.x);
+            let title = format!("{problem} ({precision}): work against {}", plot.what);
+            let panel = Panel::new(&title, &lines)
+                .x_axis(plot.x_label, Scale::Log)
+                .y_axis("wall time per simulated second (s)", Scale::Log)
+                .with_markers();
+            out.push((
+                format!("wp-{problem}-{precision}-{}.svg", plot.file),
+                lagrange_plot::svg(&[panel], PLOT_SIZE.0, PLOT_SIZE.1)?,
+            ));
+        }
     }
-    out
+    Ok(out)
 }
 
 /// A duration, human-readable.
@@ -191,12 +217,12 @@ fn problem_ids(rows: &[Row]) -> Vec<&'static str> {
     ids
 }
 
-/// Method names (with origin) in first-seen order.
-fn method_names(rows: &[Row]) -> Vec<(&'static str, Origin)> {
+/// Method names (with origin and tableau) in first-seen order.
+fn method_names(rows: &[Row]) -> Vec<(&'static str, Origin, Option<Tableau>)> {
     let mut names = Vec::new();
     for r in rows {
-        if !names.iter().any(|(n, _)| *n == r.method) {
-            names.push((r.method, r.origin));
+        if !names.iter().any(|(n, _, _)| *n == r.method) {
+            names.push((r.method, r.origin, r.tableau));
         }
     }
     names
@@ -221,7 +247,7 @@ fn summary_table(s: &mut String, rows: &[Row], precision: &str, level: f64) {
         let _ = write!(s, "---:|");
     }
     s.push('\n');
-    for (method, _) in method_names(rows) {
+    for (method, _, _) in method_names(rows) {
         let mut line = format!("| {method} |");
         let mut any = false;
         for id in &ids {
@@ -240,58 +266,102 @@ fn summary_table(s: &mut String, rows: &[Row], precision: &str, level: f64) {
     }
 }
 
-/// The fastest method of `origin` at `level`: (method, time, reach).
+/// The fastest method of `origin` that reaches `level` on `problem` (f64): (method, reach).
 fn best_of(
     rows: &[Row],
     problem: &str,
     origin: Origin,
     level: f64,
-) -> Option<(&'static str, f64, Reach)> {
+) -> Option<(&'static str, Reach)> {
     method_names(rows)
         .into_iter()
-        .filter(|(_, o)| *o == origin)
-        .filter_map(|(m, _)| {
+        .filter(|(_, o, _)| *o == origin)
+        .filter_map(|(m, _, _)| {
             let reach = time_at(&curve(rows, problem, "f64", m), level);
             reach.time().map(|t| (m, t, reach))
         })
         .min_by(|a, b| a.1.total_cmp(&b.1))
+        .map(|(m, _, reach)| (m, reach))
 }
 
-/// The library's best method against a peer's best at equal final error, per problem and
-/// level.
+/// The method of `origin` with `tableau` that ran on `problem` (f64), and how it reaches
+/// `level`, reached or not.
+fn with_tableau(
+    rows: &[Row],
+    problem: &str,
+    origin: Origin,
+    tableau: Tableau,
+    level: f64,
+) -> Option<(&'static str, Reach)> {
+    method_names(rows)
+        .into_iter()
+        .find(|(m, o, t)| {
+            *o == origin && *t == Some(tableau) && !curve(rows, problem, "f64", m).is_empty()
+        })
+        .map(|(m, _, _)| (m, time_at(&curve(rows, problem, "f64", m), level)))
+}
+
+/// One row of a peer table: the library's side against the peer's at one level.
+fn peer_row(
+    s: &mut String,
+    (problem, level, pairing): (&str, f64, &str),
+    lib: Option<(&str, Reach)>,
+    peer: Option<(&str, Reach)>,
+) {
+    let show = |side: Option<(&str, Reach)>| {
+        side.map_or(("not reached".to_string(), "-".to_string()), |(m, r)| {
+            (m.to_string(), cell(r))
+        })
+    };
+    let ((lm, lt), (pm, pt)) = (show(lib), show(peer));
+    let factor = match (
+        lib.and_then(|(_, r)| r.time()),
+        peer.and_then(|(_, r)| r.time()),
+    ) {
+        (Some(a), Some(b)) => format!("{:.2}x", b / a),
+        _ => "-".into(),
+    };
+    let _ = writeln!(
+        s,
+        "| {problem} | {level:.0e} | {pairing} | {lm} | {lt} | {pm} | {pt} | {factor} |"
+    );
+}
+
+/// The library against a peer at equal final error, per problem and level: the best method of
+/// each side, then each tableau both sides have, like for like.
 fn peer_table(s: &mut String, rows: &[Row], peer: Origin, label: &str) {
     let _ = write!(
         s,
-        "\n### Best library method against {label}'s best at equal final error (f64)\n\n\
-         | problem | final error | best lagrange method | time / sim s | best {label} method | \
-         time / sim s | lagrange faster by |\n|---|---:|---|---:|---|---:|---:|\n"
+        "\n### The library against {label} at equal final error (f64)\n\n\
+         | problem | final error | pairing | lagrange method | time / sim s | {label} method | \
+         time / sim s | lagrange faster by |\n|---|---:|---|---|---:|---|---:|---:|\n"
     );
     for id in problem_ids(rows) {
         if !rows.iter().any(|r| r.problem == id && r.origin == peer) {
             continue;
         }
         for level in F64_LEVELS {
-            let lib = best_of(rows, id, Origin::Library, level);
-            let other = best_of(rows, id, peer, level);
-            let show = |b: Option<(&str, f64, Reach)>| {
-                b.map_or(("not reached".to_string(), "-".to_string()), |(m, _, r)| {
-                    (m.to_string(), cell(r))
-                })
-            };
-            let ((lm, lt), (pm, pt)) = (show(lib), show(other));
-            let factor = match (lib, other) {
-                (Some((_, a, _)), Some((_, b, _))) => format!("{:.2}x", b / a),
-                _ => "-".into(),
-            };
-            let _ = writeln!(
+            peer_row(
                 s,
-                "| {id} | {level:.0e} | {lm} | {lt} | {pm} | {pt} | {factor} |"
+                (id, level, "best against best"),
+                best_of(rows, id, Origin::Library, level),
+                best_of(rows, id, peer, level),
             );
+            for tableau in Tableau::ALL {
+                let lib = with_tableau(rows, id, Origin::Library, tableau, level);
+                let other = with_tableau(rows, id, peer, tableau, level);
+                if lib.is_some() && other.is_some() {
+                    peer_row(s, (id, level, "like for like"), lib, other);
+                }
+            }
         }
     }
     let _ = writeln!(
         s,
-        "\n`lagrange faster by` is {label}'s time over lagrange's: below 1, {label} is faster. {}",
+        "\nBest against best: the fastest of all the library's methods against the fastest of \
+         {label}'s at that error. Like for like: the same Butcher tableau on both sides \
+         (Dormand-Prince 5(4), Dormand-Prince 8(5,3)), each with its own step-size controller. \
+         `lagrange faster by` is {label}'s time over lagrange's: below 1, {label} is faster. {}",
         if peer == Origin::SciPy {
             "SciPy calls a Python right-hand side (the same equations, written in Python) once \
              per evaluation, as the origin's script did."
@@ -319,7 +389,9 @@ fn markdown(
         "Written by `cargo xtask bench{}` in {:.0} s on {cores} cores (1-minute load average {} \
          before, {} after). Each time is the median of {}..{} whole solves over [0, T] (as \
          many as fit about {} s per point), f64 and f32 alike; errors and energies are \
-         computed in f64. The machine may be shared: compare ratios and orders of magnitude, \
+         computed in f64. A point's final error is measured on its timed solves' end state, \
+         and its energy error and evaluation count on an untimed solve that must end at the \
+         same state bit for bit (else the point is reported failed). The machine may be shared: compare ratios and orders of magnitude, \
          not the last digit.\n",
         match (context.quick, context.peers) {
             (true, true) => " --quick --peers",

@@ -6,7 +6,7 @@
 //! origin [`Origin::SciPy`]; the energy error is not measured for them (SciPy's solves are
 //! timed whole, with no observer).
 
-use super::method::{Kind, Origin};
+use super::method::{Kind, Origin, Tableau};
 use super::problem::{state_error, Problem, ProblemVisitor};
 use super::sweep::{Row, Sweeps};
 use super::Options;
@@ -18,11 +18,11 @@ use std::process::{Command, Stdio};
 /// The driver, run by the venv's Python with a job on stdin.
 const SCRIPT: &str = include_str!("scipy_peer.py");
 
-/// The methods the script runs, by the names it prints.
-const METHODS: [&str; 3] = [
-    "SciPy solve_ivp RK45",
-    "SciPy solve_ivp DOP853",
-    "SciPy odeint (LSODA)",
+/// The methods the script runs, by the names it prints, with their tableaux.
+const METHODS: [(&str, Option<Tableau>); 3] = [
+    ("SciPy solve_ivp RK45", Some(Tableau::DormandPrince54)),
+    ("SciPy solve_ivp DOP853", Some(Tableau::DormandPrince853)),
+    ("SciPy odeint (LSODA)", None),
 ];
 
 /// Tolerances (relative = absolute) of each SciPy sweep.
@@ -108,7 +108,8 @@ struct Peers<'a> {
 impl ProblemVisitor for Peers<'_> {
     fn visit<P: Problem<N, N2>, const N: usize, const N2: usize>(&mut self, p: &P) {
         let Some(rhs) = p.python_rhs() else { return };
-        if !self.opts.selected(p.id()) || !METHODS.iter().any(|m| self.opts.method_selected(m)) {
+        if !self.opts.selected(p.id()) || !METHODS.iter().any(|(m, _)| self.opts.method_selected(m))
+        {
             return;
         }
         match self.solve(p, rhs) {
@@ -182,7 +183,7 @@ fn row<P: Problem<N, N2>, const N: usize, const N2: usize>(
     if f.len() != 7 + 2 * N {
         return Err(bad());
     }
-    let method = METHODS.iter().find(|m| **m == f[0]).ok_or_else(bad)?;
+    let (method, tableau) = *METHODS.iter().find(|(m, _)| *m == f[0]).ok_or_else(bad)?;
     let num = |s: &str| s.parse::<f64>().map_err(|_| bad());
     let int = |s: &str| s.parse::<u64>().map_err(|_| bad());
     let y: Vec<f64> = f[7..].iter().map(|s| num(s)).collect::<Result<_, _>>()?;
@@ -198,6 +199,7 @@ fn row<P: Problem<N, N2>, const N: usize, const N2: usize>(
         method,
         origin: Origin::SciPy,
         kind: Kind::Adaptive,
+        tableau,
         param: num(f[1])?,
         t_end: p.t_end(),
         steps: int(f[2])?,

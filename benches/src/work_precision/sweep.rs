@@ -2,12 +2,13 @@
 //! range of step sizes or tolerances; one [`Row`] per point.
 
 use super::counting::Counting;
-use super::method::{self, Kind, Method, MethodVisitor, Origin, Param};
+use super::method::{self, Kind, Method, MethodVisitor, Origin, Param, Tableau};
+use super::outcome::Outcome;
 use super::problem::{energy, state_error, Problem, ProblemVisitor, Reference};
-use super::real::{narrow, widen, BenchReal};
+use super::real::{narrow, same_bits, widen, BenchReal};
 use super::timing::{median_of_runs, Budget};
 use super::Options;
-use lagrange_core::State;
+use lagrange_core::{Real, State};
 use std::hint::black_box;
 
 /// One point of one sweep.
@@ -23,6 +24,8 @@ pub struct Row {
     pub origin: Origin,
     /// Fixed step or adaptive.
     pub kind: Kind,
+    /// Its Butcher tableau, where solvers of other origins share it.
+    pub tableau: Option<Tableau>,
     /// `dt` (s) or tolerance.
     pub param: f64,
     /// Final time of the problem, s.
@@ -292,6 +295,7 @@ impl<P: Problem<N, N2>, const N: usize, const N2: usize> SweepMethods<'_, P, N, 
                 method: m.name(),
                 origin: m.origin(),
                 kind: m.kind(),
+                tableau: m.tableau(),
                 param: param.value(),
                 t_end: p.t_end(),
                 steps: 0,
@@ -303,7 +307,17 @@ impl<P: Problem<N, N2>, const N: usize, const N2: usize> SweepMethods<'_, P, N, 
                 runs: 0,
                 failure: None,
             };
-            match result {
+            // The figures of a point are of one computation: the final error is measured on
+            // the timed runs' end, which must be the observed run's to the bit (that run's
+            // energy error and evaluation count are reported beside it).
+            let measured = result.and_then(|out| {
+                let (timing, timed) = median_of_runs(budget, || {
+                    m.solve(p, &mech, black_box(&start), t_end, param, None)
+                });
+                let end = timed_end(&out.end, timed)?;
+                Ok((out, timing, end))
+            });
+            match measured {
                 Err(why) => {
                     row.failure = Some(why);
                     self.rows.push(row);
@@ -316,14 +330,11 @@ impl<P: Problem<N, N2>, const N: usize, const N2: usize> SweepMethods<'_, P, N, 
                         return;
                     }
                 }
-                Ok(out) => {
+                Ok((out, timing, end)) => {
                     failures = 0;
                     row.steps = out.steps;
                     row.evals = out.evals.unwrap_or(row.evals);
-                    row.final_error = state_error(&widen(&out.end), &self.reference.state);
-                    let timing = median_of_runs(budget, || {
-                        m.solve(p, &mech, black_box(&start), t_end, param, None)
-                    });
+                    row.final_error = state_error(&widen(&end), &self.reference.state);
                     row.seconds = timing.median;
                     row.runs = timing.runs;
                     let (err, secs) = (row.final_error, row.seconds);
@@ -342,6 +353,30 @@ impl<P: Problem<N, N2>, const N: usize, const N2: usize> SweepMethods<'_, P, N, 
             }
         }
     }
+}
+
+/// The final state of a point's timed runs, given the observed run's: every timed run must
+/// have finished, at the observed run's end to the bit.
+///
+/// # Errors
+/// Which timed run failed or ended elsewhere.
+fn timed_end<T: Real, const N: usize>(
+    observed: &State<T, N>,
+    timed: Vec<Option<Result<Outcome<T, N>, String>>>,
+) -> Result<State<T, N>, String> {
+    let mut end = *observed;
+    for (i, run) in timed.into_iter().enumerate() {
+        let out = run
+            .unwrap_or_else(|| Err("the method did not apply".into()))
+            .map_err(|e| format!("timed run {i} failed where the observed run did not: {e}"))?;
+        if !same_bits(&out.end, observed) {
+            return Err(format!(
+                "timed run {i} ended at another state than the observed run"
+            ));
+        }
+        end = out.end;
+    }
+    Ok(end)
 }
 
 /// For `--quick`: the budget of a smoke run.

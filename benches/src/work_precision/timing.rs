@@ -25,26 +25,32 @@ pub struct Timing {
     pub runs: usize,
 }
 
+/// Seconds one call of `f` takes, and what it returned.
+pub fn timed<R>(f: &mut impl FnMut() -> R) -> (f64, R) {
+    let clock = Instant::now();
+    let out = black_box(f());
+    (clock.elapsed().as_secs_f64(), out)
+}
+
 /// Seconds one call of `f` takes.
 pub fn once<R>(f: &mut impl FnMut() -> R) -> f64 {
-    let clock = Instant::now();
-    black_box(f());
-    clock.elapsed().as_secs_f64()
+    timed(f).0
 }
 
 /// The median of an odd number of runs of `f`, as many as fit the budget (the first, a
-/// warm-up, sizes the rest and is not counted).
-pub fn median_of_runs<R>(budget: Budget, mut f: impl FnMut() -> R) -> Timing {
+/// warm-up, sizes the rest and is not counted), and what each timed run returned, in order.
+pub fn median_of_runs<R>(budget: Budget, mut f: impl FnMut() -> R) -> (Timing, Vec<R>) {
     let first = once(&mut f);
     let fit = (budget.seconds / first.max(1e-9)).floor() as usize;
     let runs = (fit.clamp(budget.min_runs, budget.max_runs.max(budget.min_runs))) | 1;
-    let mut times: Vec<f64> = (0..runs).map(|_| once(&mut f)).collect();
+    let (mut times, outputs): (Vec<f64>, Vec<R>) = (0..runs).map(|_| timed(&mut f)).unzip();
     times.sort_by(f64::total_cmp);
-    Timing {
+    let timing = Timing {
         median: times[runs / 2],
         min: times[0],
         runs,
-    }
+    };
+    (timing, outputs)
 }
 
 /// Times `a` and `b` alternately, `pairs` times after one warm-up of each, and returns their
