@@ -95,6 +95,8 @@ pub trait Real:
     const EPSILON: Self;
     /// Positive infinity.
     const INFINITY: Self;
+    /// The largest finite value.
+    const MAX: Self;
     /// The smallest positive normal number (below it, precision is lost to subnormals).
     const MIN_POSITIVE: Self;
     /// `EPSILON^(1/3)`: the relative step of central differences that balances truncation
@@ -215,6 +217,7 @@ macro_rules! impl_real {
             const PI: $t = core::$t::consts::PI;
             const EPSILON: $t = $t::EPSILON;
             const INFINITY: $t = $t::INFINITY;
+            const MAX: $t = $t::MAX;
             const MIN_POSITIVE: $t = $t::MIN_POSITIVE;
             #[allow(clippy::excessive_precision)]
             const CBRT_EPSILON: $t = $cbrt_eps;

@@ -1,9 +1,9 @@
 //! [`ImplicitRungeKutta`]: the one stepper behind implicit midpoint, Gauss-Legendre, backward
 //! Euler and Radau IIA, each given by its Butcher tableau ([`ImplicitTableau`]).
 
-use crate::integrator::{check_step, finish};
+use crate::integrator::{check_signed, check_step, finish, Cost, Work};
 use crate::newton::{self, BlockMatrix, Blocks, NewtonProblem, NewtonSettings, Start};
-use crate::Integrator;
+use crate::{Integrator, MidpointTableau, SymmetricBase};
 use core::marker::PhantomData;
 use lagrange_core::nalgebra::{SMatrix, SVector};
 use lagrange_core::{Error, Jacobian, Mechanism, Real, State};
@@ -41,9 +41,9 @@ pub trait ImplicitTableau<const S: usize> {
 /// the motion.
 ///
 /// Cost per step: one acceleration Jacobian, then `S` accelerations per Newton iteration
-/// ([`ImplicitRungeKutta::last_iterations`] tells how many the last step took; measured on a
-/// double pendulum, the last iteration confirming convergence: 4 to 5 at `h = 1e-2`, 3 to 4
-/// at `h = 1e-3`; 2 for a linear mechanism).
+/// ([`Integrator::last_step`] tells how many the last step took; measured on a double
+/// pendulum, the last iteration confirming convergence: 4 to 5 at `h = 1e-2`, 3 to 4 at
+/// `h = 1e-3`; 2 for a linear mechanism).
 ///
 /// Use the aliases: [`ImplicitMidpoint`](crate::ImplicitMidpoint),
 /// [`GaussLegendre2`](crate::GaussLegendre2), [`BackwardEuler`](crate::BackwardEuler),
@@ -51,7 +51,7 @@ pub trait ImplicitTableau<const S: usize> {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ImplicitRungeKutta<T: Real, const S: usize, M> {
     newton: NewtonSettings<T>,
-    iterations: u32,
+    work: Work,
     method: PhantomData<M>,
 }
 
@@ -61,7 +61,7 @@ impl<T: Real, const S: usize, M> ImplicitRungeKutta<T, S, M> {
     pub fn new(newton: NewtonSettings<T>) -> Self {
         Self {
             newton,
-            iterations: 0,
+            work: Work::default(),
             method: PhantomData,
         }
     }
@@ -70,12 +70,6 @@ impl<T: Real, const S: usize, M> ImplicitRungeKutta<T, S, M> {
     #[must_use]
     pub fn newton(&self) -> &NewtonSettings<T> {
         &self.newton
-    }
-
-    /// Newton iterations of the last successful step (0 before any).
-    #[must_use]
-    pub fn last_iterations(&self) -> u32 {
-        self.iterations
     }
 }
 
@@ -112,9 +106,13 @@ struct Stages<'a, T: Real, Mech, const N: usize, const S: usize> {
     start_jacobian: Option<Jacobian<T, N>>,
     /// `|q'0| / |h|`: the velocities in units of acceleration, added to `|K|` as the scale.
     velocity_scale: SVector<T, N>,
+    /// Jacobians evaluated on refreshes (beyond the start's).
+    refreshed: u32,
 }
 
-impl<T: Real, Mech: Mechanism<T, N>, const N: usize, const S: usize> Stages<'_, T, Mech, N, S> {
+impl<T: Real, Mech: Mechanism<T, N>, const N: usize, const S: usize>
+    Stages<'_, T, Mech, N, S>
+{
     /// The stage velocities `V_i` for stage accelerations `k`.
     fn velocities(&self, k: &Blocks<T, N, S>) -> Blocks<T, N, S> {
         core::array::from_fn(|i| {
@@ -163,6 +161,7 @@ where
             Some(j) => [j; S],
             None => {
                 let states = self.stage_states(k);
+                self.refreshed += S as u32;
                 let mut js = [Jacobian::zeros(); S];
                 for (j, s) in js.iter_mut().zip(states.iter()) {
                     *j = self.mechanism.acceleration_jacobian(s)?.1;
@@ -188,24 +187,15 @@ where
     }
 }
 
-impl<T, M, const N: usize, const S: usize> Integrator<T, N> for ImplicitRungeKutta<T, S, M>
-where
-    T: Real,
-    M: ImplicitTableau<S>,
-{
-    const NAME: &'static str = M::NAME;
-    const ORDER: u32 = M::ORDER;
-    /// Per Newton iteration; each step also evaluates one acceleration Jacobian.
-    const EVALS_PER_STEP: u32 = S as u32;
-
-    fn step<Mech: Mechanism<T, N>>(
+impl<T: Real, const S: usize, Tab: ImplicitTableau<S>> ImplicitRungeKutta<T, S, Tab> {
+    /// One step of `h` (either sign) from `s`, unchecked but for the result.
+    fn advance<Mech: Mechanism<T, N>, const N: usize>(
         &mut self,
         m: &Mech,
         s: &State<T, N>,
-        dt: T,
+        h: T,
     ) -> Result<State<T, N>, Error> {
-        let h = check_step(s, dt)?;
-        let a: [[T; S]; S] = M::A.map(|row| row.map(real));
+        let a: [[T; S]; S] = Tab::A.map(|row| row.map(real));
         let a2 = core::array::from_fn(|i| {
             core::array::from_fn(|j| (0..S).fold(T::zero(), |acc, l| acc + a[i][l] * a[l][j]))
         });
@@ -216,21 +206,68 @@ where
             h,
             a,
             a2,
-            c: M::C.map(real),
+            c: Tab::C.map(real),
             start_jacobian: Some(jacobian),
             velocity_scale: s.qd.map(|v| v.abs() / h.abs()),
+            refreshed: 0,
         };
         let mut k = [qdd; S];
-        self.iterations = newton::solve(&mut problem, &mut k, &self.newton, Start::Newton)?;
+        let iterations = newton::solve(&mut problem, &mut k, &self.newton, Start::Newton)?;
+        self.work = Work {
+            evaluations: S as u32 * iterations,
+            jacobians: 1 + problem.refreshed,
+            iterations,
+            steps: 1,
+            rejected: 0,
+        };
 
         let v = problem.velocities(&k);
         let mut q = s.q;
         let mut qd = s.qd;
-        for ((b, kj), vj) in M::B.iter().zip(k.iter()).zip(v.iter()) {
+        for ((b, kj), vj) in Tab::B.iter().zip(k.iter()).zip(v.iter()) {
             let hb = h * real::<T>(*b);
             qd += kj * hb;
             q += vj * hb;
         }
         finish(State { t: s.t + h, q, qd })
+    }
+}
+
+impl<T, Tab, Mech, const N: usize, const S: usize> Integrator<T, N, Mech>
+    for ImplicitRungeKutta<T, S, Tab>
+where
+    T: Real,
+    Tab: ImplicitTableau<S>,
+    Mech: Mechanism<T, N>,
+{
+    const NAME: &'static str = Tab::NAME;
+    const ORDER: u32 = Tab::ORDER;
+    /// `S` accelerations per Newton iteration and one Jacobian (its accelerations are not
+    /// counted apart: the first iteration starts from them).
+    const COST: Cost = Cost {
+        fixed: 0,
+        per_iteration: S as u32,
+        jacobians: 1,
+    };
+
+    fn step(&mut self, m: &Mech, s: &State<T, N>, dt: T) -> Result<State<T, N>, Error> {
+        let h = check_step(s, dt)?;
+        self.advance(m, s, h)
+    }
+
+    fn last_step(&self) -> Work {
+        self.work
+    }
+}
+
+/// The implicit midpoint rule is symmetric and of order 2: a base for [`Yoshida4`](crate::Yoshida4).
+impl<T, Mech, const N: usize> SymmetricBase<T, N, Mech> for ImplicitRungeKutta<T, 1, MidpointTableau>
+where
+    T: Real,
+    Mech: Mechanism<T, N>,
+{
+    fn signed_step(&mut self, m: &Mech, s: &State<T, N>, h: T) -> Result<State<T, N>, Error> {
+        let h = check_signed(s, h)?;
+        self.advance(m, s, h)
     }
 }

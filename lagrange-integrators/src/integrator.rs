@@ -1,96 +1,287 @@
-//! The [`Integrator`] trait every fixed-step method implements, and the checks they share.
+//! The [`Integrator`] trait every method implements (one way to step), what a step costs
+//! ([`Cost`], [`Work`]), what a failed run reports ([`Failure`]), and the checks they share.
 
+use core::fmt;
 use lagrange_core::{Error, Mechanism, Real, State};
 
-/// A one-step method that advances a [`Mechanism`]'s state by `dt`.
+/// What a step of a method costs, in evaluations of the mechanism's acceleration law, for
+/// every method alike: `fixed + per_iteration * iterations` accelerations and `jacobians`
+/// Jacobians per step, where `iterations` is the number of iterations of the step's implicit
+/// equations (Newton, or a fixed point), which [`Integrator::last_step`] reports.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Cost {
+    /// Accelerations every step takes, whatever its iterations.
+    pub fixed: u32,
+    /// Accelerations per iteration of the step's implicit equations.
+    pub per_iteration: u32,
+    /// Acceleration Jacobians per step (at least; Newton may refresh them).
+    pub jacobians: u32,
+}
+
+impl Cost {
+    /// An explicit method: `evaluations` accelerations per step.
+    #[must_use]
+    pub const fn explicit(evaluations: u32) -> Self {
+        Self {
+            fixed: evaluations,
+            per_iteration: 0,
+            jacobians: 0,
+        }
+    }
+}
+
+/// The work the last step did (or, for an adaptive method, the last call of
+/// [`Integrator::step`], with all its internal steps).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Work {
+    /// Acceleration evaluations.
+    pub evaluations: u32,
+    /// Acceleration Jacobian evaluations.
+    pub jacobians: u32,
+    /// Iterations of the implicit equations (Newton or fixed point); 0 for an explicit step.
+    pub iterations: u32,
+    /// Internal steps taken (1 for a fixed-step method).
+    pub steps: u32,
+    /// Internal steps rejected by an adaptive method's error control.
+    pub rejected: u32,
+}
+
+impl Work {
+    /// One step of a method whose work is fixed by its [`Cost`], with `iterations` iterations.
+    #[must_use]
+    pub const fn of(cost: Cost, iterations: u32) -> Self {
+        Self {
+            evaluations: cost.fixed + cost.per_iteration * iterations,
+            jacobians: cost.jacobians,
+            iterations,
+            steps: 1,
+            rejected: 0,
+        }
+    }
+}
+
+/// Why a run of [`Integrator::integrate`] stopped early, and where: the error, the step that
+/// failed (counted from 0) and the last good state, which the caller may keep.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Failure<T: Real, const N: usize> {
+    /// What went wrong.
+    pub error: Error,
+    /// The step that failed: `step` steps were taken successfully before it.
+    pub step: u64,
+    /// The state after the last successful step (the start state when the first one failed);
+    /// its time is when the failed step began.
+    pub last: State<T, N>,
+}
+
+impl<T: Real, const N: usize> fmt::Display for Failure<T, N> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "step {} (from t = {}) failed: {}",
+            self.step, self.last.t, self.error
+        )
+    }
+}
+
+impl<T: Real, const N: usize> core::error::Error for Failure<T, N> {}
+
+/// A failed run converts to its [`Error`], so that `?` works in a function returning one.
+impl<T: Real, const N: usize> From<Failure<T, N>> for Error {
+    fn from(f: Failure<T, N>) -> Self {
+        f.error
+    }
+}
+
+#[cfg(feature = "defmt")]
+impl<T: Real, const N: usize> defmt::Format for Failure<T, N> {
+    fn format(&self, f: defmt::Formatter<'_>) {
+        defmt::write!(
+            f,
+            "Failure {{ error: {}, step: {}, last: {} }}",
+            self.error,
+            self.step,
+            self.last
+        );
+    }
+}
+
+/// A method that advances a [`Mechanism`]'s state by a time `dt`: the one way to step that
+/// every method of the library offers (fixed-step, symmetric, implicit, variational, adaptive)
+/// and every driver uses ([`FixedTimestep`](crate::FixedTimestep), [`Projected`](crate::Projected),
+/// [`ContactStepper`](crate::ContactStepper), scenes).
 ///
 /// A step returns a new state and leaves the old one untouched, so that on an error the caller
-/// still holds the last good state.
-pub trait Integrator<T: Real, const N: usize> {
+/// still holds the last good state. A method may keep what it learnt from its last step (a
+/// first guess, a step size, momenta): it uses it only when the next step starts from the
+/// state it returned, and starts afresh from any other state.
+///
+/// `dt` is positive everywhere: every driver runs forward in time, and stepping backward
+/// through dissipation or an impact is not defined. (To run a conservative mechanism
+/// backward, negate its velocities; a composition's negative substeps go through
+/// [`SymmetricBase::signed_step`](crate::SymmetricBase::signed_step).)
+pub trait Integrator<T: Real, const N: usize, M: Mechanism<T, N>> {
     /// Short name for tables and logs.
     const NAME: &'static str;
     /// Order of the global error: halving `dt` divides the error by `2^ORDER`.
     const ORDER: u32;
-    /// Acceleration evaluations per step (for an implicit method: per Newton iteration, and
-    /// each step also evaluates one acceleration Jacobian).
-    const EVALS_PER_STEP: u32;
+    /// The acceleration evaluations of a step ([`Cost`]).
+    const COST: Cost;
 
-    /// Advances `state` by `dt` (which may be negative, to integrate backwards).
+    /// Advances `state` by `dt` (positive), landing on `state.t + dt` exactly.
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] `dt` when `dt` is zero or not finite;
-    /// [`Error::NonFiniteState`] when `state` is not finite, or the new state is not (a step past
-    /// the stability limit); whatever [`Mechanism::acceleration`] returns.
-    fn step<M: Mechanism<T, N>>(
-        &mut self,
-        mechanism: &M,
-        state: &State<T, N>,
-        dt: T,
-    ) -> Result<State<T, N>, Error>;
+    /// [`Error::InvalidParameter`] `dt` when `dt` is not positive and finite;
+    /// [`Error::StepSizeUnderflow`] when `state.t + dt` rounds to `state.t`;
+    /// [`Error::NonFiniteState`] when `state` is not finite, or the new state is not (a step
+    /// past the stability limit); whatever the mechanism's law returns.
+    fn step(&mut self, mechanism: &M, state: &State<T, N>, dt: T) -> Result<State<T, N>, Error>;
 
-    /// Takes `steps` steps of `dt` from `state` and returns the last state.
+    /// The work of the last step ([`Work`]); by default that of [`Integrator::COST`] with no
+    /// iterations.
+    fn last_step(&self) -> Work {
+        Work::of(Self::COST, 0)
+    }
+
+    /// Takes `steps` steps of `dt` from `state` and returns the last state. The time of the
+    /// `k`-th state is `state.t + k dt` summed without rounding drift (a compensated sum), so
+    /// that a long run keeps its clock.
     ///
     /// # Errors
-    /// The first error of any step.
-    fn integrate<M: Mechanism<T, N>>(
+    /// The first error of any step, with the step and the last good state ([`Failure`]);
+    /// `dt` and `state` are checked even when `steps` is zero.
+    fn integrate(
         &mut self,
         mechanism: &M,
         state: &State<T, N>,
         dt: T,
         steps: u64,
-    ) -> Result<State<T, N>, Error> {
+    ) -> Result<State<T, N>, Failure<T, N>> {
         self.integrate_with(mechanism, state, dt, steps, |_| {})
     }
 
     /// As [`Integrator::integrate`], calling `observe` with every new state.
     ///
     /// # Errors
-    /// The first error of any step.
-    fn integrate_with<M: Mechanism<T, N>, F: FnMut(&State<T, N>)>(
+    /// As [`Integrator::integrate`].
+    fn integrate_with<F: FnMut(&State<T, N>)>(
         &mut self,
         mechanism: &M,
         state: &State<T, N>,
         dt: T,
         steps: u64,
         observe: F,
-    ) -> Result<State<T, N>, Error> {
-        step_loop(state, steps, |s| self.step(mechanism, s, dt), observe)
+    ) -> Result<State<T, N>, Failure<T, N>> {
+        step_loop(state, dt, steps, |s| self.step(mechanism, s, dt), observe)
     }
 }
 
-/// `steps` applications of `advance` from `state`, calling `observe` with each new state: the
-/// loop of [`Integrator::integrate_with`], shared with the methods that override it to inline
-/// their stages.
+/// Time advanced by a sum compensated for rounding: `t0 + k dt` to within an ulp however many
+/// steps `k`, where adding `dt` to `t` each step would drift by `k` roundings.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Clock<T> {
+    /// The rounded sum.
+    hi: T,
+    /// The rounding errors of the sum so far.
+    lo: T,
+}
+
+impl<T: Real> Clock<T> {
+    /// A clock at `t`.
+    #[must_use]
+    pub fn new(t: T) -> Self {
+        Self { hi: t, lo: T::zero() }
+    }
+
+    /// Advances by `dt` (Knuth's two-sum keeps the rounding error exactly).
+    pub fn tick(&mut self, dt: T) {
+        let s = self.hi + dt;
+        let b = s - self.hi;
+        let error = (self.hi - (s - b)) + (dt - b);
+        self.hi = s;
+        self.lo += error;
+    }
+
+    /// The time now.
+    #[must_use]
+    pub fn time(&self) -> T {
+        self.hi + self.lo
+    }
+}
+
+/// `steps` applications of `advance` from `state`, calling `observe` with each new state, the
+/// time of each from a compensated [`Clock`]: the loop of [`Integrator::integrate_with`],
+/// shared with the methods that override it to inline their stages.
+///
+/// # Errors
+/// `dt` or `state` refused ([`check_step`]), or the first error of `advance`, as a
+/// [`Failure`].
 #[inline(always)]
 pub(crate) fn step_loop<T: Real, const N: usize>(
     state: &State<T, N>,
+    dt: T,
     steps: u64,
     mut advance: impl FnMut(&State<T, N>) -> Result<State<T, N>, Error>,
     mut observe: impl FnMut(&State<T, N>),
-) -> Result<State<T, N>, Error> {
+) -> Result<State<T, N>, Failure<T, N>> {
+    let fail = |error, step, last: &State<T, N>| Failure {
+        error,
+        step,
+        last: *last,
+    };
+    check_step(state, dt).map_err(|e| fail(e, 0, state))?;
     let mut s = *state;
-    for _ in 0..steps {
-        s = advance(&s)?;
+    let mut clock = Clock::new(state.t);
+    for k in 0..steps {
+        let mut next = advance(&s).map_err(|e| fail(e, k, &s))?;
+        clock.tick(dt);
+        next.t = clock.time();
+        s = next;
         observe(&s);
     }
     Ok(s)
 }
 
-/// `dt` when it is finite and not zero and the state it is to step from is finite.
+/// `dt` when it is positive and finite and advances the time of `s`, which must be finite.
 pub(crate) fn check_step<T: Real, const N: usize>(s: &State<T, N>, dt: T) -> Result<T, Error> {
     let dt = check_dt(dt)?;
-    s.check_finite().map(|()| dt)
+    s.check_finite()?;
+    advances(s.t, dt).map(|()| dt)
 }
 
-/// `dt` when it is finite and not zero.
+/// `h` when it is finite and moves the time of `s` (either way), which must be finite: the
+/// check of a composition's signed substep.
+pub(crate) fn check_signed<T: Real, const N: usize>(s: &State<T, N>, h: T) -> Result<T, Error> {
+    if !h.is_finite() {
+        return Err(Error::InvalidParameter {
+            name: "dt",
+            reason: "must be finite",
+        });
+    }
+    s.check_finite()?;
+    advances(s.t, h).map(|()| h)
+}
+
+/// `dt` when it is positive and finite.
 pub(crate) fn check_dt<T: Real>(dt: T) -> Result<T, Error> {
-    if dt.is_finite() && dt != T::zero() {
+    if dt.is_finite() && dt > T::zero() {
         Ok(dt)
     } else {
         Err(Error::InvalidParameter {
             name: "dt",
-            reason: "must be finite and not zero",
+            reason: "must be positive and finite",
         })
+    }
+}
+
+/// `Ok` when `t + dt` differs from `t`: a step that cannot move the clock is an error, not a
+/// silent no-op.
+pub(crate) fn advances<T: Real>(t: T, dt: T) -> Result<(), Error> {
+    if t + dt == t {
+        Err(Error::StepSizeUnderflow)
+    } else {
+        Ok(())
     }
 }
 

@@ -1,6 +1,6 @@
 //! The classical fourth-order Runge-Kutta method.
 
-use crate::integrator::{check_step, finish, step_loop};
+use crate::integrator::{check_step, finish, step_loop, Cost, Failure};
 use crate::Integrator;
 use lagrange_core::{Error, Mechanism, Real, State};
 
@@ -23,17 +23,12 @@ use lagrange_core::{Error, Mechanism, Real, State};
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Rk4;
 
-impl<T: Real, const N: usize> Integrator<T, N> for Rk4 {
+impl<T: Real, const N: usize, M: Mechanism<T, N>> Integrator<T, N, M> for Rk4 {
     const NAME: &'static str = "RK4";
     const ORDER: u32 = 4;
-    const EVALS_PER_STEP: u32 = 4;
+    const COST: Cost = Cost::explicit(4);
 
-    fn step<M: Mechanism<T, N>>(
-        &mut self,
-        m: &M,
-        s: &State<T, N>,
-        dt: T,
-    ) -> Result<State<T, N>, Error> {
+    fn step(&mut self, m: &M, s: &State<T, N>, dt: T) -> Result<State<T, N>, Error> {
         let h = check_step(s, dt)?;
         finish(stages(m, s, h)?)
     }
@@ -41,16 +36,15 @@ impl<T: Real, const N: usize> Integrator<T, N> for Rk4 {
     /// As the default, with `dt` and the start checked once (each step's end is checked, so
     /// the next step's start is known finite) and the stages inlined into the loop: a call per
     /// step cost a quarter of a pendulum's RK4 step.
-    fn integrate_with<M: Mechanism<T, N>, F: FnMut(&State<T, N>)>(
+    fn integrate_with<F: FnMut(&State<T, N>)>(
         &mut self,
         m: &M,
         state: &State<T, N>,
         dt: T,
         steps: u64,
         observe: F,
-    ) -> Result<State<T, N>, Error> {
-        let h = check_step(state, dt)?;
-        step_loop(state, steps, |s| finish(stages(m, s, h)?), observe)
+    ) -> Result<State<T, N>, Failure<T, N>> {
+        step_loop(state, dt, steps, |s| finish(stages(m, s, dt)?), observe)
     }
 }
 

@@ -1,6 +1,6 @@
 //! Semi-implicit (symplectic) Euler.
 
-use crate::integrator::{check_step, finish};
+use crate::integrator::{check_step, finish, Cost};
 use crate::Integrator;
 use lagrange_core::{Error, Mechanism, Real, State};
 
@@ -15,17 +15,12 @@ use lagrange_core::{Error, Mechanism, Real, State};
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct SemiImplicitEuler;
 
-impl<T: Real, const N: usize> Integrator<T, N> for SemiImplicitEuler {
+impl<T: Real, const N: usize, M: Mechanism<T, N>> Integrator<T, N, M> for SemiImplicitEuler {
     const NAME: &'static str = "semi-implicit Euler";
     const ORDER: u32 = 1;
-    const EVALS_PER_STEP: u32 = 1;
+    const COST: Cost = Cost::explicit(1);
 
-    fn step<M: Mechanism<T, N>>(
-        &mut self,
-        m: &M,
-        s: &State<T, N>,
-        dt: T,
-    ) -> Result<State<T, N>, Error> {
+    fn step(&mut self, m: &M, s: &State<T, N>, dt: T) -> Result<State<T, N>, Error> {
         let h = check_step(s, dt)?;
         let qd = s.qd + m.acceleration(s)? * h;
         finish(State {

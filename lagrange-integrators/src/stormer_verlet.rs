@@ -1,9 +1,9 @@
 //! Symmetric Stormer-Verlet: velocity Verlet made time-reversible for accelerations that
 //! depend on the velocities, the base of the order-4 compositions.
 
-use crate::integrator::{check_step, finish};
+use crate::integrator::{check_signed, check_step, finish, Cost, Work};
 use crate::newton::{self, BlockMatrix, Blocks, NewtonProblem, NewtonSettings, Start};
-use crate::Integrator;
+use crate::{Integrator, SymmetricBase};
 use lagrange_core::nalgebra::{SMatrix, SVector};
 use lagrange_core::{Error, Mechanism, Real, State};
 
@@ -35,7 +35,7 @@ pub struct StormerVerlet<T: Real, const N: usize> {
     newton: NewtonSettings<T>,
     /// `(q1, q''(t1, q1, v))` of the last step: the next step's first guess.
     last: Option<(SVector<T, N>, SVector<T, N>)>,
-    iterations: u32,
+    work: Work,
 }
 
 impl<T: Real, const N: usize> StormerVerlet<T, N> {
@@ -45,14 +45,8 @@ impl<T: Real, const N: usize> StormerVerlet<T, N> {
         Self {
             newton,
             last: None,
-            iterations: 0,
+            work: Work::default(),
         }
-    }
-
-    /// Iterations of the implicit kick in the last step.
-    #[must_use]
-    pub fn last_iterations(&self) -> u32 {
-        self.iterations
     }
 }
 
@@ -77,6 +71,8 @@ struct HalfKick<'a, T: Real, M, const N: usize> {
     half: T,
     /// `|h/2 q''|` of the guess: added to `|v|` as the convergence scale.
     kick: SVector<T, N>,
+    /// Jacobians evaluated (where the fixed point gave way to Newton).
+    jacobians: u32,
 }
 
 impl<T: Real, M: Mechanism<T, N>, const N: usize> HalfKick<'_, T, M, N> {
@@ -89,13 +85,16 @@ impl<T: Real, M: Mechanism<T, N>, const N: usize> HalfKick<'_, T, M, N> {
     }
 }
 
-impl<T: Real, M: Mechanism<T, N>, const N: usize> NewtonProblem<T, N, 1> for HalfKick<'_, T, M, N> {
+impl<T: Real, M: Mechanism<T, N>, const N: usize> NewtonProblem<T, N, 1>
+    for HalfKick<'_, T, M, N>
+{
     fn residual(&mut self, v: &Blocks<T, N, 1>) -> Result<Blocks<T, N, 1>, Error> {
         let kicked = self.start.qd + self.mechanism.acceleration(&self.at(&v[0]))? * self.half;
         Ok([v[0] - kicked])
     }
 
     fn newton_matrix(&mut self, v: &Blocks<T, N, 1>) -> Result<BlockMatrix<T, N, 1>, Error> {
+        self.jacobians += 1;
         let j = self.mechanism.acceleration_jacobian(&self.at(&v[0]))?.1;
         Ok(BlockMatrix([[SMatrix::identity() - j.wrt_qd * self.half]]))
     }
@@ -105,42 +104,82 @@ impl<T: Real, M: Mechanism<T, N>, const N: usize> NewtonProblem<T, N, 1> for Hal
     }
 }
 
-impl<T: Real, const N: usize> Integrator<T, N> for StormerVerlet<T, N> {
-    const NAME: &'static str = "Stormer-Verlet";
-    const ORDER: u32 = 2;
-    /// In a run of steps where the acceleration does not depend on `q'`; see the type's doc.
-    const EVALS_PER_STEP: u32 = 2;
-
-    fn step<M: Mechanism<T, N>>(
+impl<T: Real, const N: usize> StormerVerlet<T, N> {
+    /// One step of `h` (either sign) from `s`, unchecked but for the result.
+    fn advance<M: Mechanism<T, N>>(
         &mut self,
         m: &M,
         s: &State<T, N>,
-        dt: T,
+        h: T,
     ) -> Result<State<T, N>, Error> {
-        let h = check_step(s, dt)?;
         let half = h * T::HALF;
+        let mut evaluations = 0;
         let guess = match self.last.take() {
             // Only a guess: a time-dependent mechanism's is a little off, and converges.
             Some((q, a)) if q == s.q => a,
-            _ => m.acceleration(s)?,
+            _ => {
+                evaluations += 1;
+                m.acceleration(s)?
+            }
         };
         let mut kick = HalfKick {
             mechanism: m,
             start: s,
             half,
             kick: (guess * half).map(|x| x.abs()),
+            jacobians: 0,
         };
         let mut v = [s.qd + guess * half];
-        self.iterations = newton::solve(&mut kick, &mut v, &self.newton, Start::FixedPoint)?;
+        let iterations = newton::solve(&mut kick, &mut v, &self.newton, Start::FixedPoint)?;
         let [v] = v;
         let t = s.t + h;
         let q = s.q + v * h;
         let a = m.acceleration(&State { t, q, qd: v })?;
         self.last = Some((q, a));
+        self.work = Work {
+            evaluations: evaluations + iterations + 1,
+            jacobians: kick.jacobians,
+            iterations,
+            steps: 1,
+            rejected: 0,
+        };
         finish(State {
             t,
             q,
             qd: v + a * half,
         })
+    }
+}
+
+impl<T: Real, const N: usize, M: Mechanism<T, N>> Integrator<T, N, M>
+    for StormerVerlet<T, N>
+{
+    const NAME: &'static str = "Stormer-Verlet";
+    const ORDER: u32 = 2;
+    /// One acceleration per iteration of the implicit kick and one for the explicit kick (2
+    /// per step where the acceleration does not depend on `q'`, in a run of steps; see the
+    /// type's doc).
+    const COST: Cost = Cost {
+        fixed: 1,
+        per_iteration: 1,
+        jacobians: 0,
+    };
+
+    fn step(&mut self, m: &M, s: &State<T, N>, dt: T) -> Result<State<T, N>, Error> {
+        let h = check_step(s, dt)?;
+        self.advance(m, s, h)
+    }
+
+    fn last_step(&self) -> Work {
+        self.work
+    }
+}
+
+impl<T: Real, const N: usize, M: Mechanism<T, N>> SymmetricBase<T, N, M>
+    for StormerVerlet<T, N>
+{
+    fn signed_step(&mut self, m: &M, s: &State<T, N>, h: T) -> Result<State<T, N>, Error> {
+        let h = check_signed(s, h)?;
+        self.advance(m, s, h)
     }
 }

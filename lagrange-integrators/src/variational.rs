@@ -1,11 +1,14 @@
 //! [`VariationalMidpoint`]: the discrete Euler-Lagrange equations of the midpoint discrete
 //! Lagrangian, with discrete forces (Lagrange-d'Alembert), in position-momentum form.
 
-use crate::integrator::check_dt;
+use crate::integrator::{check_signed, check_step, Clock, Cost, Failure, Work};
 use crate::newton::{self, BlockMatrix, Blocks, NewtonProblem, NewtonSettings, Start};
-use crate::LagrangianSystem;
+use crate::{Integrator, SymmetricBase};
 use lagrange_core::nalgebra::{SMatrix, SVector};
-use lagrange_core::{Dual, Error, Real, State};
+use lagrange_core::{
+    central_difference_jacobian, Dual, Error, Jacobian, Lagrangian, Mechanism, NoForce, Real,
+    Scalar, State,
+};
 
 /// A state in position-momentum form: time, coordinates and the discrete momenta `p`
 /// conjugate to them, which is what the variational integrator steps.
@@ -44,9 +47,10 @@ impl<T: Real, const N: usize> defmt::Format for PhaseState<T, N> {
     }
 }
 
-/// The variational integrator of the midpoint discrete Lagrangian, for any
-/// [`LagrangianSystem`] (any [`Lagrangian`](lagrange_core::Lagrangian) through
-/// [`EulerLagrange`](lagrange_core::EulerLagrange), with forces added by `with_force`):
+/// The variational integrator of the midpoint discrete Lagrangian, for any mechanism (its
+/// [`Lagrangian`] is the discrete Lagrangian's; the forces its law applies besides `f`,
+/// [`Mechanism::law_force`], are the discrete forces: damping, inputs, drives, and the
+/// constraint forces of a constrained mechanism):
 ///
 /// ```text
 /// L_d(q0, q1, h) = h L(t0 + h/2, (q0 + q1)/2, (q1 - q0)/h)
@@ -75,14 +79,23 @@ impl<T: Real, const N: usize> defmt::Format for PhaseState<T, N> {
 /// momentum map of any symmetry of `L`, there to the Newton tolerance.) With damping the
 /// discrete forces remove energy at the rate the continuous ones do, to `O(h^2)`.
 ///
-/// [`PhaseState`] carries the discrete momenta between steps; [`VariationalMidpoint::step`] and
-/// [`VariationalMidpoint::integrate`] take and return ordinary [`State`]s, converting with the
-/// Legendre transform `p = dL/dq'` at the ends (by Newton on `dL/dq'(q, v) = p` for the
-/// velocities, exact in one iteration for a kinetic energy quadratic in `q'`).
+/// [`PhaseState`] carries the discrete momenta between steps; [`Integrator::step`] takes and
+/// returns ordinary [`State`]s, converting with the Legendre transform `p = dL/dq'` (by
+/// Newton on `dL/dq'(q, v) = p` for the velocities, exact in one iteration for a kinetic
+/// energy quadratic in `q'`). A step from the state the last one returned continues from its
+/// momenta, so a run of steps carries them exactly; [`Integrator::integrate`] stays in
+/// position-momentum form throughout and converts only at the end. A constrained mechanism's
+/// constraint forces enter as discrete forces (Lagrange-d'Alembert): the constraints then drift
+/// by `O(h^2)`, which [`Projected`](crate::Projected) removes.
+///
+/// Cost per step, in evaluations of the Lagrangian in dual numbers counted as accelerations:
+/// one first-order evaluation per Newton iteration, one second-order one per Newton matrix,
+/// one more first-order one for `p1`, and the conversion to velocities (one iteration of the
+/// same kind).
 ///
 /// ```
 /// use lagrange_core::prelude::*;
-/// use lagrange_integrators::VariationalMidpoint;
+/// use lagrange_integrators::{Integrator, VariationalMidpoint};
 /// use lagrange_systems::DoublePendulum;
 /// let dp = EulerLagrange::new(DoublePendulum::new(1.0_f64, 1.0, 1.0, 1.0, 9.81)?);
 /// let start = State::new(0.0, [0.6, -0.4], [0.5, 1.0]);
@@ -93,9 +106,12 @@ impl<T: Real, const N: usize> defmt::Format for PhaseState<T, N> {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct VariationalMidpoint<T: Real, const N: usize> {
     newton: NewtonSettings<T>,
-    /// `(q1, q1 - q0, h)` of the last step: the next step's first guess.
-    last: Option<(SVector<T, N>, SVector<T, N>, T)>,
-    iterations: u32,
+    /// The state the last step returned and its position-momentum form: a step from it
+    /// continues from those momenta.
+    last: Option<(State<T, N>, PhaseState<T, N>)>,
+    /// `(q1 - q0, h)` of the last step: the next step's first guess.
+    motion: Option<(SVector<T, N>, T)>,
+    work: Work,
 }
 
 impl<T: Real, const N: usize> Default for VariationalMidpoint<T, N> {
@@ -112,9 +128,42 @@ impl<T: Real + defmt::Format, const N: usize> defmt::Format for VariationalMidpo
     }
 }
 
+/// `L = T - V` of `sys` at `(t, q, q')` in any scalar.
+fn lagrangian<T, S, Sys, const N: usize>(sys: &Sys, t: S, q: &SVector<S, N>, qd: &SVector<S, N>) -> S
+where
+    T: Real,
+    S: Scalar<Real = T>,
+    Sys: Lagrangian<T, N>,
+{
+    sys.kinetic(t, q, qd) - sys.potential(t, q)
+}
+
+/// The discrete forces' generalized force at `state`: what the law applies besides `f`.
+fn force<T: Real, M: Mechanism<T, N>, const N: usize>(
+    m: &M,
+    state: &State<T, N>,
+) -> Result<SVector<T, N>, Error> {
+    m.law_force(state, &NoForce)
+}
+
+/// `(dQ/dq, dQ/dq')` of [`force`] by central differences.
+fn force_jacobian<T: Real, M: Mechanism<T, N>, const N: usize>(
+    m: &M,
+    state: &State<T, N>,
+) -> Result<Jacobian<T, N>, Error> {
+    let mut failure = None;
+    let j = central_difference_jacobian(state, |s| {
+        force(m, s).unwrap_or_else(|e| {
+            failure = Some(e);
+            SVector::zeros()
+        })
+    });
+    failure.map_or(Ok(j), Err)
+}
+
 /// First derivatives of `L` at `(t, q, q')` along the `N` directions `(sq e_i, e_i)` in
 /// `(q, q')`: `dL/dq'_i + sq dL/dq_i`.
-fn directional<T: Real, Sys: LagrangianSystem<T, N>, const N: usize>(
+fn directional<T: Real, Sys: Lagrangian<T, N>, const N: usize>(
     sys: &Sys,
     t: T,
     q: &SVector<T, N>,
@@ -129,11 +178,11 @@ fn directional<T: Real, Sys: LagrangianSystem<T, N>, const N: usize>(
         d
     });
     let qd = SVector::<Dual<T, N>, N>::from_fn(|k, _| Dual::variable(qd[k], k));
-    SVector::from(sys.lagrangian(Dual::constant(t), &q, &qd).eps)
+    SVector::from(lagrangian(sys, Dual::constant(t), &q, &qd).eps)
 }
 
 /// `dL/dq` at `(t, q, q')`.
-fn coordinate_gradient<T: Real, Sys: LagrangianSystem<T, N>, const N: usize>(
+fn coordinate_gradient<T: Real, Sys: Lagrangian<T, N>, const N: usize>(
     sys: &Sys,
     t: T,
     q: &SVector<T, N>,
@@ -141,13 +190,13 @@ fn coordinate_gradient<T: Real, Sys: LagrangianSystem<T, N>, const N: usize>(
 ) -> SVector<T, N> {
     let q = SVector::<Dual<T, N>, N>::from_fn(|k, _| Dual::variable(q[k], k));
     let qd = qd.map(Dual::constant);
-    SVector::from(sys.lagrangian(Dual::constant(t), &q, &qd).eps)
+    SVector::from(lagrangian(sys, Dual::constant(t), &q, &qd).eps)
 }
 
 /// The derivative of [`directional`] along `(oq e_j, ov e_j)` in `(q, q')`, column `j`: one
 /// evaluation of `L` in second-order duals.
 #[allow(clippy::too_many_arguments)] // the point and the two seeds
-fn directional_jacobian<T: Real, Sys: LagrangianSystem<T, N>, const N: usize>(
+fn directional_jacobian<T: Real, Sys: Lagrangian<T, N>, const N: usize>(
     sys: &Sys,
     t: T,
     q: &SVector<T, N>,
@@ -169,7 +218,7 @@ fn directional_jacobian<T: Real, Sys: LagrangianSystem<T, N>, const N: usize>(
     };
     let qs = SVector::<Dual<Dual<T, N>, N>, N>::from_fn(|k, _| seed(q[k], sq, oq, k));
     let qds = SVector::<Dual<Dual<T, N>, N>, N>::from_fn(|k, _| seed(qd[k], T::one(), ov, k));
-    let l = sys.lagrangian(Dual::constant(Dual::constant(t)), &qs, &qds);
+    let l = lagrangian(sys, Dual::constant(Dual::constant(t)), &qs, &qds);
     SMatrix::from_fn(|i, j| l.eps[j].eps[i])
 }
 
@@ -178,9 +227,11 @@ struct DiscreteEulerLagrange<'a, T: Real, Sys, const N: usize> {
     sys: &'a Sys,
     start: &'a PhaseState<T, N>,
     h: T,
+    /// Newton matrices evaluated.
+    matrices: u32,
 }
 
-impl<T: Real, Sys: LagrangianSystem<T, N>, const N: usize> DiscreteEulerLagrange<'_, T, Sys, N> {
+impl<T: Real, Sys: Mechanism<T, N>, const N: usize> DiscreteEulerLagrange<'_, T, Sys, N> {
     /// The midpoint state of the step to `q1`.
     fn midpoint(&self, q1: &SVector<T, N>) -> State<T, N> {
         State {
@@ -194,12 +245,12 @@ impl<T: Real, Sys: LagrangianSystem<T, N>, const N: usize> DiscreteEulerLagrange
 impl<T, Sys, const N: usize> NewtonProblem<T, N, 1> for DiscreteEulerLagrange<'_, T, Sys, N>
 where
     T: Real,
-    Sys: LagrangianSystem<T, N>,
+    Sys: Mechanism<T, N>,
 {
     fn residual(&mut self, q1: &Blocks<T, N, 1>) -> Result<Blocks<T, N, 1>, Error> {
         let m = self.midpoint(&q1[0]);
         let half = self.h * T::HALF;
-        let p = directional(self.sys, m.t, &m.q, &m.qd, -half) - self.sys.force(&m) * half;
+        let p = directional(self.sys, m.t, &m.q, &m.qd, -half) - force(self.sys, &m)? * half;
         Ok([p - self.start.p])
     }
 
@@ -207,7 +258,8 @@ where
         let m = self.midpoint(&q1[0]);
         let half = self.h * T::HALF;
         let dl = directional_jacobian(self.sys, m.t, &m.q, &m.qd, -half, T::HALF, self.h.recip());
-        let dq = self.sys.force_jacobian(&m);
+        self.matrices += 1;
+        let dq = force_jacobian(self.sys, &m)?;
         // d/dq1 of h/2 Q(midpoint): h/2 (dQ/dq / 2 + dQ/dq' / h).
         let force = dq.wrt_q * (half * T::HALF) + dq.wrt_qd * T::HALF;
         Ok(BlockMatrix([[dl - force]]))
@@ -227,7 +279,7 @@ struct Legendre<'a, T: Real, Sys, const N: usize> {
 impl<T, Sys, const N: usize> NewtonProblem<T, N, 1> for Legendre<'_, T, Sys, N>
 where
     T: Real,
-    Sys: LagrangianSystem<T, N>,
+    Sys: Lagrangian<T, N>,
 {
     fn residual(&mut self, v: &Blocks<T, N, 1>) -> Result<Blocks<T, N, 1>, Error> {
         let z = self.phase;
@@ -256,18 +308,13 @@ impl<T: Real, const N: usize> VariationalMidpoint<T, N> {
         Self {
             newton,
             last: None,
-            iterations: 0,
+            motion: None,
+            work: Work::default(),
         }
     }
 
-    /// Newton iterations of the last step's discrete Euler-Lagrange equation.
-    #[must_use]
-    pub fn last_iterations(&self) -> u32 {
-        self.iterations
-    }
-
     /// The momenta `p = dL/dq'` at `state` (the continuous Legendre transform).
-    pub fn momentum<Sys: LagrangianSystem<T, N>>(
+    pub fn momentum<Sys: Lagrangian<T, N>>(
         &self,
         sys: &Sys,
         state: &State<T, N>,
@@ -276,7 +323,7 @@ impl<T: Real, const N: usize> VariationalMidpoint<T, N> {
     }
 
     /// `state` in position-momentum form.
-    pub fn phase_state<Sys: LagrangianSystem<T, N>>(
+    pub fn phase_state<Sys: Lagrangian<T, N>>(
         &self,
         sys: &Sys,
         state: &State<T, N>,
@@ -294,7 +341,7 @@ impl<T: Real, const N: usize> VariationalMidpoint<T, N> {
     /// # Errors
     /// [`Error::NonFiniteState`] for a non-finite `phase`; [`Error::SingularJacobian`] where
     /// the mass matrix is singular; [`Error::NoConvergence`].
-    pub fn velocity_state<Sys: LagrangianSystem<T, N>>(
+    pub fn velocity_state<Sys: Lagrangian<T, N>>(
         &self,
         sys: &Sys,
         phase: &PhaseState<T, N>,
@@ -318,47 +365,54 @@ impl<T: Real, const N: usize> VariationalMidpoint<T, N> {
         })
     }
 
-    /// One step of `dt` in position-momentum form: `(q0, p0) -> (q1, p1)`.
+    /// One step of `dt` (positive) in position-momentum form: `(q0, p0) -> (q1, p1)`.
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] `dt` when zero or not finite; [`Error::NonFiniteState`] for
-    /// a non-finite start or result; [`Error::NoConvergence`] or [`Error::SingularJacobian`]
-    /// from Newton on the discrete Euler-Lagrange equation.
-    pub fn step_phase<Sys: LagrangianSystem<T, N>>(
+    /// [`Error::InvalidParameter`] `dt` when not positive and finite;
+    /// [`Error::NonFiniteState`] for a non-finite start or result; [`Error::NoConvergence`] or
+    /// [`Error::SingularJacobian`] from Newton on the discrete Euler-Lagrange equation.
+    pub fn step_phase<M: Mechanism<T, N>>(
         &mut self,
-        sys: &Sys,
+        m: &M,
         phase: &PhaseState<T, N>,
         dt: T,
     ) -> Result<PhaseState<T, N>, Error> {
-        let guess = match self.last.take() {
-            Some((q, dq, h)) if q == phase.q => phase.q + dq * (dt / h),
-            _ => phase.q,
-        };
-        self.step_from(sys, phase, dt, guess)
+        let dt = crate::integrator::check_dt(dt)?;
+        let guess = self.guess(&phase.q, dt);
+        self.step_from(m, phase, dt, guess)
     }
 
-    /// [`VariationalMidpoint::step_phase`] from the guess `q1`.
-    fn step_from<Sys: LagrangianSystem<T, N>>(
+    /// The first guess of `q1` for a step of `h` from `q0`: the last step's motion, scaled.
+    fn guess(&self, q0: &SVector<T, N>, h: T) -> SVector<T, N> {
+        match self.motion {
+            Some((dq, h_last)) => q0 + dq * (h / h_last),
+            None => *q0,
+        }
+    }
+
+    /// A step of `h` (either sign) from `phase` with the guess `q1`.
+    fn step_from<M: Mechanism<T, N>>(
         &mut self,
-        sys: &Sys,
+        m: &M,
         phase: &PhaseState<T, N>,
-        dt: T,
+        h: T,
         q1: SVector<T, N>,
     ) -> Result<PhaseState<T, N>, Error> {
         if !phase.is_finite() {
             return Err(Error::NonFiniteState);
         }
-        let h = check_dt(dt)?;
+        crate::integrator::advances(phase.t, h)?;
         let mut problem = DiscreteEulerLagrange {
-            sys,
+            sys: m,
             start: phase,
             h,
+            matrices: 0,
         };
         let mut x = [q1];
-        self.iterations = newton::solve(&mut problem, &mut x, &self.newton, Start::Newton)?;
+        let iterations = newton::solve(&mut problem, &mut x, &self.newton, Start::Newton)?;
         let [q1] = x;
-        let m = problem.midpoint(&q1);
-        let p1 = phase.p + (coordinate_gradient(sys, m.t, &m.q, &m.qd) + sys.force(&m)) * h;
+        let mid = problem.midpoint(&q1);
+        let p1 = phase.p + (coordinate_gradient(m, mid.t, &mid.q, &mid.qd) + force(m, &mid)?) * h;
         let next = PhaseState {
             t: phase.t + h,
             q: q1,
@@ -367,95 +421,116 @@ impl<T: Real, const N: usize> VariationalMidpoint<T, N> {
         if !next.is_finite() {
             return Err(Error::NonFiniteState);
         }
-        self.last = Some((q1, q1 - phase.q, h));
+        self.motion = Some((q1 - phase.q, h));
+        self.work = Work {
+            evaluations: iterations + 1,
+            jacobians: problem.matrices,
+            iterations,
+            steps: 1,
+            rejected: 0,
+        };
         Ok(next)
     }
 
-    /// One step of `dt` from a [`State`], converting to and from momenta.
-    ///
-    /// # Errors
-    /// As [`VariationalMidpoint::step_phase`] and [`VariationalMidpoint::velocity_state`].
-    pub fn step<Sys: LagrangianSystem<T, N>>(
+    /// One step of `h` (either sign) from a [`State`]: from the momenta kept by the last step
+    /// when `state` is what it returned, converting otherwise; then back to velocities.
+    fn advance<M: Mechanism<T, N>>(
         &mut self,
-        sys: &Sys,
+        m: &M,
         state: &State<T, N>,
-        dt: T,
+        h: T,
     ) -> Result<State<T, N>, Error> {
-        state.check_finite()?;
-        let z = self.phase_state(sys, state);
-        let next = self.step_from(sys, &z, dt, state.q + state.qd * dt)?;
-        self.velocity_state(sys, &next, &((next.q - z.q) / dt))
+        let (z, guess) = match self.last.take() {
+            Some((out, z)) if out == *state => (z, self.guess(&state.q, h)),
+            _ => (self.phase_state(m, state), state.q + state.qd * h),
+        };
+        let next = self.step_from(m, &z, h, guess)?;
+        let out = self.velocity_state(m, &next, &((next.q - z.q) / h))?;
+        self.work.evaluations += 1;
+        self.last = Some((out, next));
+        Ok(out)
+    }
+}
+
+impl<T: Real, const N: usize, M: Mechanism<T, N>> Integrator<T, N, M>
+    for VariationalMidpoint<T, N>
+{
+    const NAME: &'static str = "variational midpoint";
+    const ORDER: u32 = 2;
+    /// Lagrangian evaluations in dual numbers, counted as accelerations: one first-order per
+    /// Newton iteration, one for `p1` and one for the velocities; one second-order per Newton
+    /// matrix.
+    const COST: Cost = Cost {
+        fixed: 2,
+        per_iteration: 1,
+        jacobians: 1,
+    };
+
+    fn step(&mut self, m: &M, s: &State<T, N>, dt: T) -> Result<State<T, N>, Error> {
+        let h = check_step(s, dt)?;
+        self.advance(m, s, h)
     }
 
-    /// `steps` steps of `dt` from `state`, in position-momentum form throughout, converting
-    /// only at the ends.
-    ///
-    /// # Errors
-    /// The first error of any step.
-    pub fn integrate<Sys: LagrangianSystem<T, N>>(
+    fn last_step(&self) -> Work {
+        self.work
+    }
+
+    /// In position-momentum form throughout, converting to velocities only at the end (the
+    /// default would convert after every step).
+    fn integrate(
         &mut self,
-        sys: &Sys,
+        m: &M,
         state: &State<T, N>,
         dt: T,
         steps: u64,
-    ) -> Result<State<T, N>, Error> {
-        self.integrate_phase(sys, state, dt, steps, |_| Ok(()))
-    }
-
-    /// As [`VariationalMidpoint::integrate`], calling `observe` with every new state (which
-    /// costs a conversion to velocities per step) and its position-momentum form.
-    ///
-    /// # Errors
-    /// The first error of any step or conversion.
-    pub fn integrate_with<Sys, F>(
-        &mut self,
-        sys: &Sys,
-        state: &State<T, N>,
-        dt: T,
-        steps: u64,
-        mut observe: F,
-    ) -> Result<State<T, N>, Error>
-    where
-        Sys: LagrangianSystem<T, N>,
-        F: FnMut(&State<T, N>, &PhaseState<T, N>),
-    {
-        let newton = self.newton;
-        let mut previous = state.q;
-        self.integrate_phase(sys, state, dt, steps, |z| {
-            let s = Self::new(newton).velocity_state(sys, z, &((z.q - previous) / dt))?;
-            previous = z.q;
-            observe(&s, z);
-            Ok(())
-        })
-    }
-
-    /// The stepping loop of [`VariationalMidpoint::integrate`] and
-    /// [`VariationalMidpoint::integrate_with`].
-    fn integrate_phase<Sys, F>(
-        &mut self,
-        sys: &Sys,
-        state: &State<T, N>,
-        dt: T,
-        steps: u64,
-        mut each: F,
-    ) -> Result<State<T, N>, Error>
-    where
-        Sys: LagrangianSystem<T, N>,
-        F: FnMut(&PhaseState<T, N>) -> Result<(), Error>,
-    {
-        state.check_finite()?;
-        let mut z = self.phase_state(sys, state);
-        let mut guess = state.q + state.qd * dt;
-        let mut before = z.q;
-        for _ in 0..steps {
-            before = z.q;
-            z = self.step_from(sys, &z, dt, guess)?;
-            guess = z.q + (z.q - before);
-            each(&z)?;
-        }
+    ) -> Result<State<T, N>, Failure<T, N>> {
+        let fail = |error, step, last: &State<T, N>| Failure {
+            error,
+            step,
+            last: *last,
+        };
+        let dt = check_step(state, dt).map_err(|e| fail(e, 0, state))?;
         if steps == 0 {
             return Ok(*state);
         }
-        self.velocity_state(sys, &z, &((z.q - before) / dt))
+        let mut z = match self.last.take() {
+            Some((out, z)) if out == *state => z,
+            _ => self.phase_state(m, state),
+        };
+        let mut guess = match self.motion {
+            Some(_) => self.guess(&state.q, dt),
+            None => state.q + state.qd * dt,
+        };
+        let mut clock = Clock::new(state.t);
+        let mut before = z;
+        for k in 0..steps {
+            before = z;
+            z = self.step_from(m, &z, dt, guess).map_err(|e| {
+                // The last good state in velocities, when it can be had.
+                let last = self
+                    .velocity_state(m, &before, &state.qd)
+                    .unwrap_or(*state);
+                fail(e, k, &last)
+            })?;
+            clock.tick(dt);
+            z.t = clock.time();
+            guess = z.q + (z.q - before.q);
+        }
+        let out = self
+            .velocity_state(m, &z, &((z.q - before.q) / dt))
+            .map_err(|e| fail(e, steps, state))?;
+        self.last = Some((out, z));
+        Ok(out)
+    }
+}
+
+/// The variational midpoint rule is symmetric and of order 2: a base for
+/// [`Yoshida4`](crate::Yoshida4), which makes an order-4 method symplectic for any Lagrangian.
+impl<T: Real, const N: usize, M: Mechanism<T, N>> SymmetricBase<T, N, M>
+    for VariationalMidpoint<T, N>
+{
+    fn signed_step(&mut self, m: &M, s: &State<T, N>, h: T) -> Result<State<T, N>, Error> {
+        let h = check_signed(s, h)?;
+        self.advance(m, s, h)
     }
 }

@@ -1,6 +1,6 @@
 //! Velocity Verlet (Stormer-Verlet, kick-drift-kick).
 
-use crate::integrator::{check_step, finish};
+use crate::integrator::{check_step, finish, Cost};
 use crate::Integrator;
 use lagrange_core::{Error, Mechanism, Real, State};
 
@@ -25,17 +25,12 @@ use lagrange_core::{Error, Mechanism, Real, State};
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct VelocityVerlet;
 
-impl<T: Real, const N: usize> Integrator<T, N> for VelocityVerlet {
+impl<T: Real, const N: usize, M: Mechanism<T, N>> Integrator<T, N, M> for VelocityVerlet {
     const NAME: &'static str = "velocity Verlet";
     const ORDER: u32 = 2;
-    const EVALS_PER_STEP: u32 = 2;
+    const COST: Cost = Cost::explicit(2);
 
-    fn step<M: Mechanism<T, N>>(
-        &mut self,
-        m: &M,
-        s: &State<T, N>,
-        dt: T,
-    ) -> Result<State<T, N>, Error> {
+    fn step(&mut self, m: &M, s: &State<T, N>, dt: T) -> Result<State<T, N>, Error> {
         let h = check_step(s, dt)?;
         let half = h * T::HALF;
         let a0 = m.acceleration(s)?;

@@ -1,15 +1,26 @@
 //! Yoshida's order-4 composition (the triple jump; Forest-Ruth in kick-drift form) of a
 //! symmetric second-order method.
 
-use crate::{ImplicitMidpoint, Integrator, StormerVerlet};
+use crate::integrator::{check_step, Cost, Work};
+use crate::Integrator;
 use lagrange_core::{Error, Mechanism, Real, State};
 
 /// A symmetric (time-reversible) one-step method of order 2: what [`Yoshida4`] can raise to
-/// order 4. (Composing a non-symmetric method with these weights gives only order 3.)
-pub trait SymmetricSecondOrder {}
-
-impl<T: Real, const N: usize> SymmetricSecondOrder for StormerVerlet<T, N> {}
-impl<T: Real> SymmetricSecondOrder for ImplicitMidpoint<T> {}
+/// order 4 (composing a non-symmetric method with these weights gives only order 3).
+/// [`StormerVerlet`](crate::StormerVerlet), [`ImplicitMidpoint`](crate::ImplicitMidpoint) and
+/// [`VariationalMidpoint`](crate::VariationalMidpoint) are.
+pub trait SymmetricBase<T: Real, const N: usize, M: Mechanism<T, N>>:
+    Integrator<T, N, M>
+{
+    /// A step of `h`, which may be negative: a composition steps back in its middle substep.
+    ///
+    /// # Errors
+    /// [`Error::NonFiniteState`] for a non-finite `state` or result;
+    /// [`Error::StepSizeUnderflow`] when `state.t + h` rounds to `state.t` (`h = 0` too); as
+    /// [`Integrator::step`] otherwise.
+    fn signed_step(&mut self, mechanism: &M, state: &State<T, N>, h: T)
+        -> Result<State<T, N>, Error>;
+}
 
 /// The weights of the triple jump, `w1, w0, w1`:
 ///
@@ -49,12 +60,16 @@ pub const YOSHIDA4_WEIGHTS: [f64; 3] = [
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct Yoshida4<B> {
     base: B,
+    work: Work,
 }
 
 impl<B> Yoshida4<B> {
     /// The composition of `base`.
     pub fn new(base: B) -> Self {
-        Self { base }
+        Self {
+            base,
+            work: Work::default(),
+        }
     }
 
     /// The base method.
@@ -71,27 +86,40 @@ impl<B: defmt::Format> defmt::Format for Yoshida4<B> {
     }
 }
 
-impl<T, B, const N: usize> Integrator<T, N> for Yoshida4<B>
+impl<T, B, M, const N: usize> Integrator<T, N, M> for Yoshida4<B>
 where
     T: Real,
-    B: Integrator<T, N> + SymmetricSecondOrder,
+    M: Mechanism<T, N>,
+    B: SymmetricBase<T, N, M>,
 {
     const NAME: &'static str = "Yoshida 4";
     const ORDER: u32 = 4;
-    const EVALS_PER_STEP: u32 = 3 * B::EVALS_PER_STEP;
+    const COST: Cost = Cost {
+        fixed: 3 * B::COST.fixed,
+        per_iteration: B::COST.per_iteration,
+        jacobians: 3 * B::COST.jacobians,
+    };
 
-    fn step<M: Mechanism<T, N>>(
-        &mut self,
-        m: &M,
-        s: &State<T, N>,
-        dt: T,
-    ) -> Result<State<T, N>, Error> {
+    fn step(&mut self, m: &M, s: &State<T, N>, dt: T) -> Result<State<T, N>, Error> {
+        let dt = check_step(s, dt)?;
         let mut next = *s;
+        let mut work = Work::default();
         for w in YOSHIDA4_WEIGHTS {
-            next = self.base.step(m, &next, dt * T::from_f64(w))?;
+            next = self.base.signed_step(m, &next, dt * T::from_f64(w))?;
+            let done = self.base.last_step();
+            work.evaluations += done.evaluations;
+            work.jacobians += done.jacobians;
+            work.iterations += done.iterations;
         }
+        work.steps = 1;
+        self.work = work;
         // The substeps' times add up to dt only to rounding: land exactly.
         next.t = s.t + dt;
         Ok(next)
+    }
+
+    /// The three substeps together (iterations summed over them).
+    fn last_step(&self) -> Work {
+        self.work
     }
 }

@@ -336,6 +336,8 @@ pub fn run(args: &[String]) -> Result<(), String> {
     }
     if !o.report_only {
         for area in &o.areas {
+            let dir = out.join(area.name);
+            std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
             let start = Instant::now();
             // A surviving mutant is a finding, not a failure of the command: the report says.
             let status = cmd::run(&mut mutants_command(area, &out, &o, false));

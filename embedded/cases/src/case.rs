@@ -3,7 +3,7 @@
 use core::hint::black_box;
 
 use lagrange_core::{Error, Real, State};
-use lagrange_integrators::{Integrator, LagrangianSystem, VariationalMidpoint};
+use lagrange_integrators::{Integrator, VariationalMidpoint};
 
 use crate::Setup;
 
@@ -83,7 +83,7 @@ impl Case {
     where
         T: Precision,
         S: Setup<T, N>,
-        I: Integrator<T, N> + Default,
+        I: Integrator<T, N, S::Mechanism> + Default,
     {
         Self {
             system: S::NAME,
@@ -94,14 +94,13 @@ impl Case {
         }
     }
 
-    /// The case of setup `S` stepped by the variational midpoint integrator (which works on
-    /// the Lagrangian, so `S` must build a [`LagrangianSystem`]) in `T`.
+    /// The case of setup `S` stepped by the variational midpoint integrator in
+    /// position-momentum form throughout (its `integrate`), in `T`.
     #[must_use]
     pub const fn variational<T, const N: usize, S>() -> Self
     where
         T: Precision,
         S: Setup<T, N>,
-        S::Mechanism: LagrangianSystem<T, N>,
     {
         Self {
             system: S::NAME,
@@ -128,7 +127,7 @@ fn run<T, const N: usize, S, I>(steps: u32) -> Result<Outcome, Error>
 where
     T: Precision,
     S: Setup<T, N>,
-    I: Integrator<T, N> + Default,
+    I: Integrator<T, N, S::Mechanism> + Default,
 {
     let (mechanism, start) = S::build()?;
     let mechanism = black_box(mechanism);
@@ -146,7 +145,6 @@ fn run_variational<T, const N: usize, S>(steps: u32) -> Result<Outcome, Error>
 where
     T: Precision,
     S: Setup<T, N>,
-    S::Mechanism: LagrangianSystem<T, N>,
 {
     let (mechanism, start) = S::build()?;
     let mechanism = black_box(mechanism);

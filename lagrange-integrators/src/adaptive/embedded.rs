@@ -3,6 +3,8 @@
 
 use super::controller::PiController;
 use super::AdaptiveSettings;
+use crate::integrator::{check_step, Cost, Failure, Work};
+use crate::Integrator;
 use core::marker::PhantomData;
 use lagrange_core::nalgebra::SVector;
 use lagrange_core::{Error, Mechanism, Real, State};
@@ -39,7 +41,7 @@ pub trait EmbeddedPair<const S: usize, const R: usize> {
     const DENSE: [[f64; S]; R];
 }
 
-/// Work counts since the last (re)start.
+/// Work counts since the integrator was made or restarted.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Statistics {
@@ -58,9 +60,7 @@ pub(super) type Hermite<T, const N: usize> = [SVector<T, N>; 3];
 /// [`DormandPrince54`](crate::DormandPrince54) and
 /// [`DormandPrince853`](crate::DormandPrince853).
 ///
-/// It holds its current state (given to [`EmbeddedRungeKutta::new`] or
-/// [`EmbeddedRungeKutta::restart`]) and advances it by steps whose size a PI controller
-/// chooses from the embedded error estimate:
+/// It advances by steps whose size a PI controller chooses from the embedded error estimate:
 ///
 /// ```text
 /// err      = RMS_i( est_i / (atol + rtol max(|y0_i|, |y1_i|)) )   over y = (q, q')
@@ -69,19 +69,37 @@ pub(super) type Hermite<T, const N: usize> = [SVector<T, N>; 3];
 /// rejected:  h <- h max(0.2, 0.9 err^(-1/k)), no growth on the next accepted step
 /// ```
 ///
-/// The mechanism is passed to every call and not stored. The derivative at the current state
-/// is reused by the next step (first same as last); after changing the mechanism between
-/// steps (an [`Input`](lagrange_core::Input), say) call [`EmbeddedRungeKutta::refresh`].
+/// It is made from its settings alone; the mechanism and the state are given to each call,
+/// which starts from that state:
+///
+/// - [`Integrator::step`] lands exactly on `state.t + dt` through the continuous extension
+///   (dense output), so a frame loop ([`FixedTimestep`](crate::FixedTimestep), a scene) can
+///   drive it with its own steps taken at the size the error control allows, not the frame's;
+/// - [`EmbeddedRungeKutta::integrate_to`] steps to an end time, its last step shortened to
+///   land there;
+/// - [`EmbeddedRungeKutta::next_step`] takes one step of the controller's choosing, and
+///   [`EmbeddedRungeKutta::dense_output`] samples inside it;
+/// - [`EmbeddedRungeKutta::integrate_until_event`] stops where a guard changes sign.
+///
+/// A call that starts from the state the last call returned continues the run: the derivative
+/// at its end is reused by the next step (first same as last), the controller keeps its
+/// history, and the steps a frame loop's landings interpolated between go on. A call from any
+/// other state starts afresh there, trying first the step size the controller last proposed.
+/// After changing the mechanism (an [`Input`](lagrange_core::Input), say), call
+/// [`EmbeddedRungeKutta::restart`] so that the next call starts afresh from its state.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct EmbeddedRungeKutta<T: Real, const N: usize, const S: usize, const R: usize, P> {
     pub(super) settings: AdaptiveSettings<T>,
+    /// Where the integration is: the end of the last accepted step (or the event that cut it).
     pub(super) state: State<T, N>,
+    /// The state the last call returned: a call from it continues the run.
+    pub(super) output: Option<State<T, N>>,
     /// The derivative `(q', q'')` at `state`, when known.
     pub(super) derivative: Option<(SVector<T, N>, SVector<T, N>)>,
     /// Stage derivatives of the last step: `kq_i = V_i`, `kv_i = q''(stage i)`.
     pub(super) kq: [SVector<T, N>; S],
     pub(super) kv: [SVector<T, N>; S],
-    /// The next step size to try.
+    /// The next step size to try (zero before any).
     pub(super) h: T,
     pub(super) controller: PiController,
     /// The start of the last accepted step and its size (zero before any).
@@ -95,6 +113,8 @@ pub struct EmbeddedRungeKutta<T: Real, const N: usize, const S: usize, const R: 
     pub(super) rows_q: [SVector<T, N>; R],
     pub(super) rows_v: [SVector<T, N>; R],
     pub(super) stats: Statistics,
+    /// The work of the last call.
+    pub(super) work: Work,
     pub(super) pair: PhantomData<P>,
 }
 
@@ -141,79 +161,44 @@ where
     T: Real,
     P: EmbeddedPair<S, R>,
 {
-    /// The integrator with `settings`, started at `state`: evaluates the derivative there
-    /// and chooses the first step (Hairer's estimate, one more evaluation, unless
-    /// [`AdaptiveSettings::with_initial_step`] gave it).
-    ///
-    /// # Errors
-    /// [`Error::NonFiniteState`] for a non-finite `state`; whatever
-    /// [`Mechanism::acceleration`] returns.
-    pub fn new<M: Mechanism<T, N>>(
-        settings: AdaptiveSettings<T>,
-        mechanism: &M,
-        state: &State<T, N>,
-    ) -> Result<Self, Error> {
-        let mut s = Self {
+    /// The integrator with `settings`; the first call starts where it is told.
+    #[must_use]
+    pub fn new(settings: AdaptiveSettings<T>) -> Self {
+        let nowhere = State {
+            t: T::zero(),
+            q: SVector::zeros(),
+            qd: SVector::zeros(),
+        };
+        Self {
             settings,
-            state: *state,
+            state: nowhere,
+            output: None,
             derivative: None,
             kq: [SVector::zeros(); S],
             kv: [SVector::zeros(); S],
             h: T::zero(),
             controller: PiController::new(P::ERROR_EXPONENT),
-            previous: *state,
+            previous: nowhere,
             h_last: T::zero(),
-            dense_end: state.t,
+            dense_end: T::zero(),
             hermite: None,
             rows_q: [SVector::zeros(); R],
             rows_v: [SVector::zeros(); R],
             stats: Statistics::default(),
+            work: Work::default(),
             pair: PhantomData,
-        };
-        s.restart(mechanism, state)?;
-        Ok(s)
-    }
-
-    /// Starts again from `state`, as [`EmbeddedRungeKutta::new`] does, keeping the settings.
-    ///
-    /// # Errors
-    /// As [`EmbeddedRungeKutta::new`].
-    pub fn restart<M: Mechanism<T, N>>(
-        &mut self,
-        mechanism: &M,
-        state: &State<T, N>,
-    ) -> Result<(), Error> {
-        state.check_finite()?;
-        self.state = *state;
-        self.stats = Statistics::default();
-        self.controller.reset();
-        self.h_last = T::zero();
-        self.hermite = None;
-        self.previous = *state;
-        self.dense_end = state.t;
-        self.derivative = None;
-        let (q, v) = self.derivative_at_state(mechanism)?;
-        self.h = match self.settings.h_initial() {
-            Some(h) => h,
-            None => self.initial_step(mechanism, &q, &v)?,
         }
-        .min(self.settings.h_max());
-        Ok(())
     }
 
-    /// Drops the derivative kept from the last step, so that the next step evaluates it anew:
-    /// call after changing the mechanism between steps.
-    pub fn refresh(&mut self) {
-        self.derivative = None;
+    /// Forgets the run, so that the next call starts afresh from its state (after the
+    /// mechanism changed between calls): the derivative kept for the next step, the
+    /// controller's history and the dense output go; the proposed step size stays as the first
+    /// step to try.
+    pub fn restart(&mut self) {
+        self.output = None;
     }
 
-    /// The current state.
-    #[must_use]
-    pub fn state(&self) -> &State<T, N> {
-        &self.state
-    }
-
-    /// The step size the next step will try.
+    /// The step size the next step will try (zero before any).
     #[must_use]
     pub fn step_size(&self) -> T {
         self.h
@@ -225,10 +210,41 @@ where
         &self.settings
     }
 
-    /// Work done since the last (re)start.
+    /// Work done since the integrator was made or the run started afresh.
     #[must_use]
     pub fn statistics(&self) -> Statistics {
         self.stats
+    }
+
+    /// Continues the run when `state` is what the last call returned; otherwise starts afresh
+    /// there: the derivative, and the first step (the controller's last proposal, else
+    /// Hairer's estimate).
+    pub(super) fn begin<M: Mechanism<T, N>>(
+        &mut self,
+        m: &M,
+        state: &State<T, N>,
+    ) -> Result<(), Error> {
+        state.check_finite()?;
+        if self.output.as_ref() == Some(state) {
+            return Ok(());
+        }
+        self.state = *state;
+        self.output = Some(*state);
+        self.stats = Statistics::default();
+        self.controller.reset();
+        self.h_last = T::zero();
+        self.hermite = None;
+        self.previous = *state;
+        self.dense_end = state.t;
+        self.derivative = None;
+        let (q, v) = self.derivative_at_state(m)?;
+        if let Some(h) = self.settings.h_initial() {
+            self.h = h;
+        } else if !(self.h > T::zero()) {
+            self.h = self.initial_step(m, &q, &v)?;
+        }
+        self.h = self.h.min(self.settings.h_max());
+        Ok(())
     }
 
     /// One evaluation of the acceleration, counted.
@@ -255,7 +271,9 @@ where
         Ok(d)
     }
 
-    /// Hairer's initial step estimate (`hinit` of DOPRI5 and DOP853), one evaluation.
+    /// Hairer's initial step estimate (`hinit` of DOPRI5 and DOP853), one evaluation. A
+    /// non-finite intermediate (a state so large that its scale overflows) falls back to a
+    /// small first step, which the controller then grows.
     fn initial_step<M: Mechanism<T, N>>(
         &mut self,
         m: &M,
@@ -272,20 +290,26 @@ where
             }
             (sum / T::from_f64(2.0 * N as f64)).sqrt()
         };
-        let d0 = rms(&s.q, &s.qd);
-        let d1 = rms(fq, fv);
+        let fallback = real::<T>(1e-6);
+        let (d0, d1) = (rms(&s.q, &s.qd), rms(fq, fv));
         let small = real::<T>(1e-5);
-        let mut h0 = if d0 < small || d1 < small {
-            real(1e-6)
+        let mut h0 = if !(d0 >= small && d1 >= small) {
+            fallback
         } else {
             real::<T>(0.01) * d0 / d1
         };
+        if !(h0.is_finite() && h0 > T::zero()) {
+            h0 = fallback;
+        }
         h0 = h0.min(self.settings.h_max());
         let explicit_euler = State {
             t: s.t + h0,
             q: s.q + fq * h0,
             qd: s.qd + fv * h0,
         };
+        if !explicit_euler.is_finite() {
+            return Ok(fallback.min(self.settings.h_max()));
+        }
         let a1 = self.eval(m, &explicit_euler)?;
         let d2 = rms(&(explicit_euler.qd - fq), &(a1 - fv)) / h0;
         let d = d1.max(d2);
@@ -295,11 +319,11 @@ where
             (real::<T>(0.01) / d).powf(real::<T>(1.0) / T::from_f64(f64::from(P::ORDER)))
         };
         let h = (h0 * real(100.0)).min(h1).min(self.settings.h_max());
-        if h.is_finite() && h > T::zero() {
-            Ok(h)
+        Ok(if h.is_finite() && h > T::zero() {
+            h
         } else {
-            Err(Error::NonFiniteState)
-        }
+            fallback.min(self.settings.h_max())
+        })
     }
 
     /// The error norm of a step of `h` from `y0 = self.state` to `y1`, from the stages.
@@ -360,36 +384,44 @@ where
         }
     }
 
-    /// One accepted step from the current state, at most to `t_end`: tries, rejects and
-    /// shrinks until the error estimate passes.
+    /// One accepted step from the current state, at most to `t_end` (landing on it when the
+    /// step reaches it): tries, rejects and shrinks until the error estimate passes.
+    ///
+    /// The last step to `t_end` is stretched by up to 1% rather than leave a sliver, but never
+    /// after a rejection: a rejected last step shrinks like any other, so that a step which
+    /// cannot move the clock fails with [`Error::StepSizeUnderflow`] instead of retrying the
+    /// same stretched step for ever. A step whose new state is not finite counts as rejected.
     pub(super) fn advance<M: Mechanism<T, N>>(
         &mut self,
         m: &M,
-        t_end: Option<T>,
+        t_end: T,
     ) -> Result<(), Error> {
         let (fq, fv) = self.derivative_at_state(m)?;
         self.kq[0] = fq;
         self.kv[0] = fv;
         let y0 = self.state;
         let mut h = self.h.min(self.settings.h_max());
+        let mut stretch = real::<T>(1.01);
         loop {
-            let mut last = false;
-            if let Some(te) = t_end {
-                // Stretch by up to 1% rather than leave a sliver of a step.
-                if y0.t + h * real(1.01) >= te {
-                    h = te - y0.t;
-                    last = true;
-                }
+            let remaining = t_end - y0.t;
+            let last = h * stretch >= remaining;
+            if last {
+                h = remaining;
             }
-            if !last && (h < self.settings.h_min() || y0.t + h == y0.t) {
+            if y0.t + h == y0.t || (!last && h < self.settings.h_min()) {
                 return Err(Error::StepSizeUnderflow);
             }
             let mut y1 = y0;
             run_stages!(self, m, y0, h, y1; 1 2 3 4 5 6 7 8 9 10 11 12);
-            if let (true, Some(te)) = (last, t_end) {
-                y1.t = te;
+            if last {
+                y1.t = t_end;
             }
-            let err = self.error_norm(h, &y1);
+            // A blown-up stage makes the estimate NaN or the state infinite: rejected.
+            let err = if y1.is_finite() {
+                self.error_norm(h, &y1)
+            } else {
+                T::INFINITY
+            };
             if err <= T::one() {
                 let rejected_last = self.controller.rejected_last();
                 let proposal = h * T::from_f32(self.controller.accept(err.to_f32()));
@@ -407,57 +439,191 @@ where
                 self.state = y1;
                 self.derivative = Some((self.kq[P::FSAL], self.kv[P::FSAL]));
                 self.stats.accepted += 1;
+                self.work.steps += 1;
                 return Ok(());
             }
-            // Rejected (a NaN error estimate from a blown-up stage counts as rejected).
             h *= T::from_f32(self.controller.reject(err.to_f32()));
+            stretch = T::one();
             self.stats.rejected += 1;
+            self.work.rejected += 1;
         }
     }
 
-    /// One accepted step, of whatever size the controller chooses; returns the new state.
+    /// Starts the work count of a call.
+    fn begin_work(&mut self) {
+        self.work = Work::default();
+    }
+
+    /// Ends the work count of a call: evaluations since `evaluations`.
+    fn end_work(&mut self, evaluations: u64) {
+        let done = self.stats.evaluations.saturating_sub(evaluations);
+        self.work.evaluations = u32::try_from(done).unwrap_or(u32::MAX);
+    }
+
+    /// One accepted step from `state`, of the size the controller chooses but not past
+    /// `t_end`; returns the new state. Its dense output is prepared, so that
+    /// [`EmbeddedRungeKutta::dense_output`] can sample inside it (3 more evaluations for
+    /// DOP853's order-7 extension; none for Dormand-Prince 5(4)).
     ///
     /// # Errors
+    /// [`Error::InvalidParameter`] `t_end` when not after `state.t` or not finite;
     /// [`Error::StepSizeUnderflow`] when the error test needs a step below the minimum (or
-    /// below the resolution of `t`); whatever [`Mechanism::acceleration`] returns.
-    pub fn step<M: Mechanism<T, N>>(&mut self, mechanism: &M) -> Result<State<T, N>, Error> {
-        self.advance(mechanism, None)?;
+    /// below the resolution of `t`); [`Error::NonFiniteState`] for a non-finite `state`;
+    /// whatever the mechanism's law returns.
+    pub fn next_step<M: Mechanism<T, N>>(
+        &mut self,
+        mechanism: &M,
+        state: &State<T, N>,
+        t_end: T,
+    ) -> Result<State<T, N>, Error> {
+        let t_end = check_end(state, t_end)?;
+        self.begin_work();
+        let evaluations = self.stats.evaluations;
+        let result = self.next_step_from(mechanism, state, t_end);
+        self.end_work(evaluations);
+        result
+    }
+
+    fn next_step_from<M: Mechanism<T, N>>(
+        &mut self,
+        mechanism: &M,
+        state: &State<T, N>,
+        t_end: T,
+    ) -> Result<State<T, N>, Error> {
+        self.begin(mechanism, state)?;
+        if self.state.t >= t_end {
+            // Continuing from a landing that the last step already passed: the end is
+            // inside that step.
+            let s = self.interpolate(mechanism, t_end)?;
+            self.output = Some(s);
+            return Ok(s);
+        }
+        self.advance(mechanism, t_end)?;
+        self.prepare_dense(mechanism)?;
+        self.output = Some(self.state);
         Ok(self.state)
     }
 
-    /// `t_end` when it is finite and not before the current time.
-    pub(super) fn check_end(&self, t_end: T) -> Result<T, Error> {
-        if t_end.is_finite() && t_end >= self.state.t {
-            Ok(t_end)
-        } else {
-            Err(Error::InvalidParameter {
-                name: "t_end",
-                reason: "must be finite and not before the current time",
-            })
+    /// The state at `t` inside the last accepted step, by the continuous extension.
+    pub(super) fn interpolate<M: Mechanism<T, N>>(
+        &mut self,
+        m: &M,
+        t: T,
+    ) -> Result<State<T, N>, Error> {
+        if t == self.state.t {
+            return Ok(self.state);
         }
+        self.prepare_dense(m)?;
+        let s = self.evaluate_dense(t);
+        s.check_finite().map(|()| s)
     }
 
-    /// Steps until the current time is `t_end` exactly (the last step is shortened to land
-    /// on it); returns the state there.
+    /// Steps from `state` until the time is `t_end` exactly (the last step is shortened to
+    /// land on it); returns the state there.
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] `t_end` before the current time or not finite;
+    /// [`Error::InvalidParameter`] `t_end` before `state.t` or not finite;
     /// [`Error::TooManySteps`] after [`AdaptiveSettings::max_steps`] steps; as
-    /// [`EmbeddedRungeKutta::step`].
+    /// [`EmbeddedRungeKutta::next_step`]; each with the steps taken and the last good state
+    /// ([`Failure`]).
     pub fn integrate_to<M: Mechanism<T, N>>(
         &mut self,
         mechanism: &M,
+        state: &State<T, N>,
         t_end: T,
-    ) -> Result<State<T, N>, Error> {
-        let t_end = self.check_end(t_end)?;
+    ) -> Result<State<T, N>, Failure<T, N>> {
+        self.begin_work();
+        let evaluations = self.stats.evaluations;
+        let result = self.run_to(mechanism, state, t_end, true);
+        self.end_work(evaluations);
+        result
+    }
+
+    /// The steps of [`EmbeddedRungeKutta::integrate_to`]; with `exact_end` false the end is
+    /// reached by the continuous extension when a step passes it (the landing of
+    /// [`Integrator::step`]), else by a last step shortened to it.
+    fn run_to<M: Mechanism<T, N>>(
+        &mut self,
+        mechanism: &M,
+        state: &State<T, N>,
+        t_end: T,
+        exact_end: bool,
+    ) -> Result<State<T, N>, Failure<T, N>> {
+        let fail = |error, step, last: &State<T, N>| Failure {
+            error,
+            step,
+            last: *last,
+        };
+        let t_end = check_end(state, t_end).map_err(|e| fail(e, 0, state))?;
+        self.begin(mechanism, state)
+            .map_err(|e| fail(e, 0, state))?;
         let mut steps = 0;
         while self.state.t < t_end {
             if steps == self.settings.max_steps() {
-                return Err(Error::TooManySteps { steps });
+                return Err(fail(Error::TooManySteps { steps }, steps, &self.state));
             }
-            self.advance(mechanism, Some(t_end))?;
+            let horizon = if exact_end { t_end } else { T::INFINITY };
+            let from = self.state;
+            self.advance(mechanism, horizon)
+                .map_err(|e| fail(e, steps, &from))?;
             steps += 1;
         }
-        Ok(self.state)
+        let out = if self.state.t == t_end {
+            self.state
+        } else {
+            self.interpolate(mechanism, t_end)
+                .map_err(|e| fail(e, steps, &self.previous))?
+        };
+        self.output = Some(out);
+        Ok(out)
+    }
+}
+
+/// `t_end` when it is finite and not before `state.t`.
+pub(super) fn check_end<T: Real, const N: usize>(state: &State<T, N>, t_end: T) -> Result<T, Error> {
+    if t_end.is_finite() && t_end >= state.t {
+        Ok(t_end)
+    } else {
+        Err(Error::InvalidParameter {
+            name: "t_end",
+            reason: "must be finite and not before the state's time",
+        })
+    }
+}
+
+impl<T, M, P, const N: usize, const S: usize, const R: usize> Integrator<T, N, M>
+    for EmbeddedRungeKutta<T, N, S, R, P>
+where
+    T: Real,
+    M: Mechanism<T, N>,
+    P: EmbeddedPair<S, R>,
+{
+    const NAME: &'static str = P::NAME;
+    const ORDER: u32 = P::ORDER;
+    /// Per internal step accepted (`fixed`, with the first stage of the next step reused), and
+    /// per rejected attempt (`per_iteration`: a rejection is an iteration of the step-size
+    /// search); [`Integrator::last_step`] reports both counts of a call.
+    const COST: Cost = Cost {
+        fixed: P::FSAL as u32,
+        per_iteration: P::FSAL as u32,
+        jacobians: 0,
+    };
+
+    /// Lands on `state.t + dt` through the continuous extension, the internal steps as long
+    /// as the tolerance allows (they run ahead of the landing; the next call from this one's
+    /// result continues from them).
+    fn step(&mut self, m: &M, state: &State<T, N>, dt: T) -> Result<State<T, N>, Error> {
+        let dt = check_step(state, dt)?;
+        self.begin_work();
+        let evaluations = self.stats.evaluations;
+        let result = self
+            .run_to(m, state, state.t + dt, false)
+            .map_err(|f| f.error);
+        self.end_work(evaluations);
+        result
+    }
+
+    fn last_step(&self) -> Work {
+        self.work
     }
 }

@@ -1,7 +1,8 @@
 //! Dense output of the adaptive integrators (the continuous extension between the last two
 //! accepted points) and event location by root finding on it.
 
-use super::embedded::{combine, real, EmbeddedPair, EmbeddedRungeKutta};
+use super::embedded::{check_end, combine, real, EmbeddedPair, EmbeddedRungeKutta};
+use crate::Failure;
 use lagrange_core::nalgebra::SVector;
 use lagrange_core::{Error, Mechanism, Real, State};
 
@@ -60,7 +61,10 @@ where
     P: EmbeddedPair<S, R>,
 {
     /// Computes the dense coefficients of the last step, evaluating its extra stages.
-    fn prepare_dense<M: Mechanism<T, N>>(&mut self, m: &M) -> Result<(), Error> {
+    pub(super) fn prepare_dense<M: Mechanism<T, N>>(
+        &mut self,
+        m: &M,
+    ) -> Result<(), Error> {
         if self.hermite.is_some() {
             return Ok(());
         }
@@ -93,7 +97,7 @@ where
     /// ```text
     /// y(t0 + s h) = y0 + s (d1 + (1-s) (d2 + s (d3 + (1-s) (d4 + s (d5 + ...)))))
     /// ```
-    fn evaluate_dense(&self, t: T) -> State<T, N> {
+    pub(super) fn evaluate_dense(&self, t: T) -> State<T, N> {
         let (y0, h) = (self.previous, self.h_last);
         let s = (t - y0.t) / h;
         let s1 = T::one() - s;
@@ -119,42 +123,42 @@ where
     }
 
     /// The interval `[t0, t1]` that [`EmbeddedRungeKutta::dense_output`] can sample: the
-    /// last accepted step (up to an event that cut it short), `None` before any step.
+    /// last accepted step (up to an event that cut it short), when its continuous extension
+    /// is prepared ([`EmbeddedRungeKutta::next_step`] prepares it); `None` otherwise.
     #[must_use]
     pub fn dense_interval(&self) -> Option<(T, T)> {
-        (self.h_last > T::zero()).then_some((self.previous.t, self.dense_end))
+        (self.h_last > T::zero() && self.hermite.is_some())
+            .then_some((self.previous.t, self.dense_end))
     }
 
-    /// The state at time `t` between the last two accepted points (from the start of the
-    /// last step to the current time), by the method's continuous extension (order 4 for
-    /// Dormand-Prince 5(4), 7 for DOP853, which evaluates 3 more stages once per step for it).
+    /// The state at time `t` inside the last step taken by
+    /// [`EmbeddedRungeKutta::next_step`] (from its start to its end), by the method's
+    /// continuous extension (order 4 for Dormand-Prince 5(4), 7 for DOP853).
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] `t` when outside that interval or before any step;
-    /// whatever [`Mechanism::acceleration`] returns.
-    pub fn dense_output<M: Mechanism<T, N>>(
-        &mut self,
-        mechanism: &M,
-        t: T,
-    ) -> Result<State<T, N>, Error> {
-        if !(self.h_last > T::zero() && t >= self.previous.t && t <= self.dense_end) {
-            return Err(Error::InvalidParameter {
+    /// [`Error::InvalidParameter`] `t` when outside [`EmbeddedRungeKutta::dense_interval`]
+    /// (or there is none); [`Error::NonFiniteState`].
+    pub fn dense_output(&self, t: T) -> Result<State<T, N>, Error> {
+        match self.dense_interval() {
+            Some((t0, t1)) if t >= t0 && t <= t1 => {
+                let s = if t == t1 {
+                    self.state
+                } else {
+                    self.evaluate_dense(t)
+                };
+                s.check_finite().map(|()| s)
+            }
+            _ => Err(Error::InvalidParameter {
                 name: "t",
-                reason: "must lie within the last accepted step",
-            });
+                reason: "must lie within the last step taken by next_step",
+            }),
         }
-        if t == self.dense_end {
-            return Ok(self.state);
-        }
-        self.prepare_dense(mechanism)?;
-        Ok(self.evaluate_dense(t))
     }
 
-    /// Steps towards `t_end` until `guard(state)` changes sign, locates the time of the
-    /// change on the dense output (the Illinois variant of regula falsi, to
+    /// Steps from `state` towards `t_end` until `guard(state)` changes sign, locates the time
+    /// of the change on the dense output (the Illinois variant of regula falsi, to
     /// [`AdaptiveSettings::event_tolerance`](super::AdaptiveSettings::event_tolerance) or to
-    /// rounding), and stops there: the integrator's state becomes the one at the event, and
-    /// the next call continues from it.
+    /// rounding), and stops there; a call from the state it returns continues the run.
     ///
     /// The guard is a function `g(t, q, q')` of the state. A sign change is a step from a
     /// non-zero value to zero or to the opposite sign; the located time is the first one known
@@ -169,46 +173,88 @@ where
     pub fn integrate_until_event<M, G>(
         &mut self,
         mechanism: &M,
+        state: &State<T, N>,
         t_end: T,
         mut guard: G,
+    ) -> Result<Stop<T, N>, Failure<T, N>>
+    where
+        M: Mechanism<T, N>,
+        G: FnMut(&State<T, N>) -> T,
+    {
+        let fail = |error, step, last: &State<T, N>| Failure {
+            error,
+            step,
+            last: *last,
+        };
+        let t_end = check_end(state, t_end).map_err(|e| fail(e, 0, state))?;
+        self.begin(mechanism, state)
+            .map_err(|e| fail(e, 0, state))?;
+        let mut g0 = checked_guard(guard(state)).map_err(|e| fail(e, 0, state))?;
+        // Continuing from a landing that the last step passed: that step's rest first.
+        if self.state.t > state.t {
+            let g1 = checked_guard(guard(&self.state)).map_err(|e| fail(e, 0, state))?;
+            if crossed(g0, g1) {
+                return self
+                    .stop_at_event(mechanism, &mut guard, (state.t, g0), g1)
+                    .map_err(|e| fail(e, 0, state));
+            }
+            g0 = g1;
+        }
+        let mut steps = 0;
+        while self.state.t < t_end {
+            if steps == self.settings.max_steps() {
+                return Err(fail(Error::TooManySteps { steps }, steps, &self.state));
+            }
+            let from = self.state;
+            self.advance(mechanism, t_end)
+                .map_err(|e| fail(e, steps, &from))?;
+            steps += 1;
+            let g1 = checked_guard(guard(&self.state)).map_err(|e| fail(e, steps, &from))?;
+            if crossed(g0, g1) {
+                let start = (self.previous.t, g0);
+                return self
+                    .stop_at_event(mechanism, &mut guard, start, g1)
+                    .map_err(|e| fail(e, steps, &from));
+            }
+            g0 = g1;
+        }
+        self.output = Some(self.state);
+        Ok(Stop::End(self.state))
+    }
+
+    /// The event inside the last step, where the guard went from `start = (t, g)` to `g1`
+    /// at the step's end: the state there becomes the run's current one.
+    fn stop_at_event<M, G>(
+        &mut self,
+        m: &M,
+        guard: &mut G,
+        start: (T, T),
+        g1: T,
     ) -> Result<Stop<T, N>, Error>
     where
         M: Mechanism<T, N>,
         G: FnMut(&State<T, N>) -> T,
     {
-        let t_end = self.check_end(t_end)?;
-        let mut g0 = checked_guard(guard(&self.state))?;
-        let mut steps = 0;
-        while self.state.t < t_end {
-            if steps == self.settings.max_steps() {
-                return Err(Error::TooManySteps { steps });
-            }
-            self.advance(mechanism, Some(t_end))?;
-            steps += 1;
-            let g1 = checked_guard(guard(&self.state))?;
-            if crossed(g0, g1) {
-                if g1 != T::zero() {
-                    let t = self.locate(mechanism, &mut guard, g0, g1)?;
-                    self.state = self.evaluate_dense(t);
-                    self.dense_end = t;
-                    self.derivative = None;
-                }
-                return Ok(Stop::Event(self.state));
-            }
-            g0 = g1;
+        if g1 != T::zero() {
+            let t = self.locate(m, guard, start, g1)?;
+            self.state = self.evaluate_dense(t);
+            self.state.check_finite()?;
+            self.dense_end = t;
+            self.derivative = None;
         }
-        Ok(Stop::End(self.state))
+        self.output = Some(self.state);
+        Ok(Stop::Event(self.state))
     }
 
-    /// The time of the sign change of `guard` within the last step, given its values at
-    /// both ends.
-    fn locate<M, G>(&mut self, m: &M, guard: &mut G, g0: T, g1: T) -> Result<T, Error>
+    /// The time of the sign change of `guard` within the last step, between `(a, g(a))` and
+    /// the step's end where it is `g1`.
+    fn locate<M, G>(&mut self, m: &M, guard: &mut G, from: (T, T), g1: T) -> Result<T, Error>
     where
         M: Mechanism<T, N>,
         G: FnMut(&State<T, N>) -> T,
     {
         self.prepare_dense(m)?;
-        let (mut a, mut ga) = (self.previous.t, g0);
+        let (mut a, mut ga) = from;
         let (mut b, mut gb) = (self.state.t, g1);
         let tolerance = self
             .settings

@@ -1,5 +1,6 @@
 //! [`ActiveRows`]: a mechanism under the rows of a contact set that are in force (bilateral
-//! rows and resting contacts), which is what the integrator steps between events.
+//! rows and resting contacts), which is what a [`ContactStepper`](super::ContactStepper)'s
+//! integrator steps between events.
 
 use super::Contacts;
 use lagrange_core::constraints::{
@@ -10,7 +11,9 @@ use lagrange_core::{
     Borrowed, Error, GeneralizedForce, Input, Jacobian, Lagrangian, Mechanism, Real, Scalar, State,
 };
 
-/// `mechanism` held by the `active` rows of `contacts`.
+/// A mechanism held by the rows of its contact set that are in force: the law that a
+/// [`ContactStepper`](super::ContactStepper)'s inner integrator steps between events (made by
+/// the stepper, not by hand).
 ///
 /// Inside every solve, a unilateral row whose multiplier comes out negative (its contact
 /// would pull) is dropped and the rest solved again, so a resting contact lets go as soon as
@@ -19,7 +22,7 @@ use lagrange_core::{
 /// force from the frictionless solve, then one more solve with the friction forces applied
 /// (exact when tangent and normal are decoupled in the mass metric, as for a point on flat
 /// ground; one fixed-point pass otherwise).
-pub(crate) struct ActiveRows<'a, M, K, T, const C: usize> {
+pub struct ActiveRows<'a, M, K, T, const C: usize> {
     pub(crate) mechanism: &'a M,
     pub(crate) contacts: &'a K,
     pub(crate) active: [bool; C],

@@ -15,6 +15,7 @@ mod impulse;
 mod model;
 mod stepper;
 
+pub use active_rows::ActiveRows;
 pub use contacts::Contacts;
 pub use impulse::Impact;
 pub use model::ContactModel;

@@ -2,12 +2,14 @@
 //! time, and resting contacts held as constraints.
 
 use super::active_rows::{independent, ActiveRows};
+
 use super::impulse::Rows;
 use super::{ContactModel, Contacts, Impact};
-use crate::Integrator;
+use crate::integrator::check_step;
+use crate::{Cost, Integrator};
 use lagrange_core::constraints::Projection;
 use lagrange_core::nalgebra::SVector;
-use lagrange_core::{validate, Error, Mechanism, Real, State};
+use lagrange_core::{Error, Mechanism, Real, State};
 
 /// Any integrator, stepping a mechanism with unilateral contacts `g(q) >= 0` (and optional
 /// bilateral rows) at a fixed step:
@@ -62,7 +64,7 @@ use lagrange_core::{validate, Error, Mechanism, Real, State};
 /// # Ok::<(), lagrange_core::Error>(())
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ContactStepper<I, K, T: Real, const N: usize, const C: usize> {
+pub struct ContactStepper<T: Real, const N: usize, const C: usize, I, K> {
     integrator: I,
     contacts: K,
     model: ContactModel<T>,
@@ -73,7 +75,7 @@ pub struct ContactStepper<I, K, T: Real, const N: usize, const C: usize> {
     last: Option<State<T, N>>,
 }
 
-impl<I, K, T: Real, const N: usize, const C: usize> ContactStepper<I, K, T, N, C> {
+impl<T: Real, const N: usize, const C: usize, I, K> ContactStepper<T, N, C, I, K> {
     /// `integrator` stepping with the unilateral `contacts` under `model`, with `projection`
     /// for the rows held as constraints.
     pub fn new(
@@ -159,10 +161,9 @@ fn active<'a, M, K, T: Real, const C: usize>(
     }
 }
 
-impl<I, K, T, const N: usize, const C: usize> ContactStepper<I, K, T, N, C>
+impl<T, I, K, const N: usize, const C: usize> ContactStepper<T, N, C, I, K>
 where
     T: Real,
-    I: Integrator<T, N>,
     K: Contacts<T, N, C>,
 {
     /// As [`Integrator::step`], calling `observe` with every impact inside the step.
@@ -181,10 +182,10 @@ where
     ) -> Result<State<T, N>, Error>
     where
         M: Mechanism<T, N>,
+        I: for<'a> Integrator<T, N, ActiveRows<'a, M, K, T, C>>,
         F: FnMut(&Impact<T, N, C>),
     {
-        let dt = validate::positive("dt", dt)?;
-        state.check_finite()?;
+        let dt = check_step(state, dt)?;
         if self.last.as_ref() != Some(state) {
             self.start(state)?;
         }
@@ -291,14 +292,18 @@ where
     /// Bisection on the step length from `s` for the first crossing: the length `lo` at the
     /// early end of the final bracket, the state there, and the contacts crossed at its late
     /// end.
-    fn locate<M: Mechanism<T, N>>(
+    fn locate<M>(
         &mut self,
         mechanism: &M,
         s: &State<T, N>,
         start_gaps: &SVector<T, C>,
         remaining: T,
         crossed: [bool; C],
-    ) -> Result<(T, State<T, N>, [bool; C]), Error> {
+    ) -> Result<(T, State<T, N>, [bool; C]), Error>
+    where
+        M: Mechanism<T, N>,
+        I: for<'a> Integrator<T, N, ActiveRows<'a, M, K, T, C>>,
+    {
         let (mut lo, mut hi, mut at, mut struck) = (T::zero(), remaining, *s, crossed);
         while hi - lo > self.model.time_tolerance() {
             let mid = lo + (hi - lo) * T::HALF;
@@ -329,26 +334,24 @@ where
     }
 }
 
-impl<I, K, T, const N: usize, const C: usize> Integrator<T, N> for ContactStepper<I, K, T, N, C>
+impl<T, M, I, K, const N: usize, const C: usize> Integrator<T, N, M> for ContactStepper<T, N, C, I, K>
 where
     T: Real,
-    I: Integrator<T, N>,
+    M: Mechanism<T, N>,
+    I: for<'a> Integrator<T, N, ActiveRows<'a, M, K, T, C>>,
     K: Contacts<T, N, C>,
 {
     const NAME: &'static str = I::NAME;
     const ORDER: u32 = I::ORDER;
-    const EVALS_PER_STEP: u32 = I::EVALS_PER_STEP;
+    /// The inner integrator's per step between events; each event adds about
+    /// `log2(dt / time_tolerance)` steps of it.
+    const COST: Cost = I::COST;
 
     /// One step with contacts; see [`ContactStepper::step_observed`].
     ///
     /// # Errors
     /// As [`ContactStepper::step_observed`].
-    fn step<M: Mechanism<T, N>>(
-        &mut self,
-        mechanism: &M,
-        state: &State<T, N>,
-        dt: T,
-    ) -> Result<State<T, N>, Error> {
+    fn step(&mut self, mechanism: &M, state: &State<T, N>, dt: T) -> Result<State<T, N>, Error> {
         self.step_observed(mechanism, state, dt, |_| {})
     }
 }

@@ -1,0 +1,10 @@
+//! The names a program that steps mechanisms needs: `use lagrange_integrators::prelude::*;`.
+//!
+//! Everything of [`lagrange_core::prelude`], the [`Integrator`] trait and the integrators and
+//! drivers most programs use.
+
+pub use crate::{
+    AdaptiveSettings, DormandPrince54, DormandPrince853, FixedTimestep, GaussLegendre2,
+    Integrator, Projected, Rk4, StormerVerlet, VariationalMidpoint, Yoshida4,
+};
+pub use lagrange_core::prelude::*;
