@@ -1,7 +1,7 @@
 //! Explicit (forward) Euler.
 
 use crate::integrator::{check_step, finish, Cost};
-use crate::Integrator;
+use crate::{Integrator, Method};
 use lagrange_core::{Error, Mechanism, Real, State};
 
 /// Forward Euler: `q1 = q0 + h q'0`, `q'1 = q'0 + h q''0`.
@@ -13,11 +13,13 @@ use lagrange_core::{Error, Mechanism, Real, State};
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct ExplicitEuler;
 
-impl<T: Real, const N: usize, M: Mechanism<T, N>> Integrator<T, N, M> for ExplicitEuler {
+impl Method for ExplicitEuler {
     const NAME: &'static str = "explicit Euler";
     const ORDER: u32 = 1;
     const COST: Cost = Cost::explicit(1);
+}
 
+impl<T: Real, const N: usize, M: Mechanism<T, N>> Integrator<T, N, M> for ExplicitEuler {
     fn step(&mut self, m: &M, s: &State<T, N>, dt: T) -> Result<State<T, N>, Error> {
         let h = check_step(s, dt)?;
         let a = m.acceleration(s)?;

@@ -138,7 +138,12 @@ impl<T: Real, const N: usize, I> FixedTimestep<T, N, I> {
             } else {
                 T::zero()
             };
-            let kept = kept.max(T::zero()).min(self.dt);
+            // A remainder that is a whole step but for rounding is one: dropped too.
+            let kept = if kept >= self.dt * (T::one() - T::from_f64(STEP_SLACK_EPS) * T::EPSILON) {
+                T::zero()
+            } else {
+                kept.max(T::zero())
+            };
             dropped = self.accumulator - kept;
             self.accumulator = kept;
         }

@@ -3,7 +3,7 @@
 
 use crate::integrator::{check_signed, check_step, finish, Cost, Work};
 use crate::newton::{self, BlockMatrix, Blocks, NewtonProblem, NewtonSettings, Start};
-use crate::{Integrator, MidpointTableau, SymmetricBase};
+use crate::{Integrator, Method, MidpointTableau, SymmetricBase};
 use core::marker::PhantomData;
 use lagrange_core::nalgebra::{SMatrix, SVector};
 use lagrange_core::{Error, Jacobian, Mechanism, Real, State};
@@ -110,9 +110,7 @@ struct Stages<'a, T: Real, Mech, const N: usize, const S: usize> {
     refreshed: u32,
 }
 
-impl<T: Real, Mech: Mechanism<T, N>, const N: usize, const S: usize>
-    Stages<'_, T, Mech, N, S>
-{
+impl<T: Real, Mech: Mechanism<T, N>, const N: usize, const S: usize> Stages<'_, T, Mech, N, S> {
     /// The stage velocities `V_i` for stage accelerations `k`.
     fn velocities(&self, k: &Blocks<T, N, S>) -> Blocks<T, N, S> {
         core::array::from_fn(|i| {
@@ -233,14 +231,9 @@ impl<T: Real, const S: usize, Tab: ImplicitTableau<S>> ImplicitRungeKutta<T, S, 
     }
 }
 
-impl<T, Tab, Mech, const N: usize, const S: usize> Integrator<T, N, Mech>
-    for ImplicitRungeKutta<T, S, Tab>
-where
-    T: Real,
-    Tab: ImplicitTableau<S>,
-    Mech: Mechanism<T, N>,
-{
+impl<T: Real, Tab: ImplicitTableau<S>, const S: usize> Method for ImplicitRungeKutta<T, S, Tab> {
     const NAME: &'static str = Tab::NAME;
+    const YOSHIDA4_NAME: &'static str = "Yoshida 4 (midpoint)";
     const ORDER: u32 = Tab::ORDER;
     /// `S` accelerations per Newton iteration and one Jacobian (its accelerations are not
     /// counted apart: the first iteration starts from them).
@@ -250,18 +243,27 @@ where
         jacobians: 1,
     };
 
-    fn step(&mut self, m: &Mech, s: &State<T, N>, dt: T) -> Result<State<T, N>, Error> {
-        let h = check_step(s, dt)?;
-        self.advance(m, s, h)
-    }
-
     fn last_step(&self) -> Work {
         self.work
     }
 }
 
+impl<T, Tab, Mech, const N: usize, const S: usize> Integrator<T, N, Mech>
+    for ImplicitRungeKutta<T, S, Tab>
+where
+    T: Real,
+    Tab: ImplicitTableau<S>,
+    Mech: Mechanism<T, N>,
+{
+    fn step(&mut self, m: &Mech, s: &State<T, N>, dt: T) -> Result<State<T, N>, Error> {
+        let h = check_step(s, dt)?;
+        self.advance(m, s, h)
+    }
+}
+
 /// The implicit midpoint rule is symmetric and of order 2: a base for [`Yoshida4`](crate::Yoshida4).
-impl<T, Mech, const N: usize> SymmetricBase<T, N, Mech> for ImplicitRungeKutta<T, 1, MidpointTableau>
+impl<T, Mech, const N: usize> SymmetricBase<T, N, Mech>
+    for ImplicitRungeKutta<T, 1, MidpointTableau>
 where
     T: Real,
     Mech: Mechanism<T, N>,

@@ -32,7 +32,7 @@ impl Cost {
 }
 
 /// The work the last step did (or, for an adaptive method, the last call of
-/// [`Integrator::step`], with all its internal steps).
+/// [`Integrator::step`], with all its internal steps): [`Method::last_step`].
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Work {
@@ -107,6 +107,26 @@ impl<T: Real, const N: usize> defmt::Format for Failure<T, N> {
     }
 }
 
+/// What a method is, whatever it steps: its name, order and cost, and the work of its last
+/// step. Every [`Integrator`] is one.
+pub trait Method {
+    /// Short name for tables and logs.
+    const NAME: &'static str;
+    /// Order of the global error: halving `dt` divides the error by `2^ORDER`.
+    const ORDER: u32;
+    /// The acceleration evaluations of a step ([`Cost`]).
+    const COST: Cost;
+    /// The name of its order-4 composition ([`Yoshida4`](crate::Yoshida4)) when it is a
+    /// symmetric base.
+    const YOSHIDA4_NAME: &'static str = "Yoshida 4";
+
+    /// The work of the last step ([`Work`]); by default that of [`Method::COST`] with no
+    /// iterations.
+    fn last_step(&self) -> Work {
+        Work::of(Self::COST, 0)
+    }
+}
+
 /// A method that advances a [`Mechanism`]'s state by a time `dt`: the one way to step that
 /// every method of the library offers (fixed-step, symmetric, implicit, variational, adaptive)
 /// and every driver uses ([`FixedTimestep`](crate::FixedTimestep), [`Projected`](crate::Projected),
@@ -121,14 +141,7 @@ impl<T: Real, const N: usize> defmt::Format for Failure<T, N> {
 /// through dissipation or an impact is not defined. (To run a conservative mechanism
 /// backward, negate its velocities; a composition's negative substeps go through
 /// [`SymmetricBase::signed_step`](crate::SymmetricBase::signed_step).)
-pub trait Integrator<T: Real, const N: usize, M: Mechanism<T, N>> {
-    /// Short name for tables and logs.
-    const NAME: &'static str;
-    /// Order of the global error: halving `dt` divides the error by `2^ORDER`.
-    const ORDER: u32;
-    /// The acceleration evaluations of a step ([`Cost`]).
-    const COST: Cost;
-
+pub trait Integrator<T: Real, const N: usize, M: Mechanism<T, N>>: Method {
     /// Advances `state` by `dt` (positive), landing on `state.t + dt` exactly.
     ///
     /// # Errors
@@ -137,12 +150,6 @@ pub trait Integrator<T: Real, const N: usize, M: Mechanism<T, N>> {
     /// [`Error::NonFiniteState`] when `state` is not finite, or the new state is not (a step
     /// past the stability limit); whatever the mechanism's law returns.
     fn step(&mut self, mechanism: &M, state: &State<T, N>, dt: T) -> Result<State<T, N>, Error>;
-
-    /// The work of the last step ([`Work`]); by default that of [`Integrator::COST`] with no
-    /// iterations.
-    fn last_step(&self) -> Work {
-        Work::of(Self::COST, 0)
-    }
 
     /// Takes `steps` steps of `dt` from `state` and returns the last state. The time of the
     /// `k`-th state is `state.t + k dt` summed without rounding drift (a compensated sum), so
@@ -191,7 +198,10 @@ impl<T: Real> Clock<T> {
     /// A clock at `t`.
     #[must_use]
     pub fn new(t: T) -> Self {
-        Self { hi: t, lo: T::zero() }
+        Self {
+            hi: t,
+            lo: T::zero(),
+        }
     }
 
     /// Advances by `dt` (Knuth's two-sum keeps the rounding error exactly).
@@ -284,6 +294,19 @@ pub(crate) fn advances<T: Real>(t: T, dt: T) -> Result<(), Error> {
         Ok(())
     }
 }
+
+/// True when `given` is `last`, the state a method returned, as a driver hands it back: the
+/// same coordinates and velocities bit for bit, and the same time but for the rounding of a
+/// clock that sums its steps exactly ([`Clock`]) where the method added one step to the time.
+/// A method continues its run (momenta, controller, resting contacts) only from such a state.
+pub(crate) fn continues<T: Real, const N: usize>(last: &State<T, N>, given: &State<T, N>) -> bool {
+    let slack = T::from_f64(CLOCK_SLACK_EPS) * T::EPSILON * last.t.abs().max(given.t.abs());
+    last.q == given.q && last.qd == given.qd && (last.t - given.t).abs() <= slack
+}
+
+/// The time of a state handed back by a driver may differ from the one a method returned by
+/// the rounding of one addition and the clock's own (an ulp or two): this many epsilons.
+const CLOCK_SLACK_EPS: f64 = 8.0;
 
 /// The state a step produced, or [`Error::NonFiniteState`] when it blew up.
 pub(crate) fn finish<T: Real, const N: usize>(s: State<T, N>) -> Result<State<T, N>, Error> {

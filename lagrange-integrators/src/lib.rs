@@ -83,7 +83,7 @@ pub use gauss_legendre::{GaussLegendre2, GaussLegendre2Tableau};
 pub use impacts::{ContactModel, ContactStepper, Contacts, Impact};
 pub use implicit_midpoint::{ImplicitMidpoint, MidpointTableau};
 pub use implicit_rk::{ImplicitRungeKutta, ImplicitTableau};
-pub use integrator::{Clock, Cost, Failure, Integrator, Work};
+pub use integrator::{Clock, Cost, Failure, Integrator, Method, Work};
 pub use newton::NewtonSettings;
 pub use projected::Projected;
 pub use radau_iia::{RadauIIA2, RadauIIA2Tableau};

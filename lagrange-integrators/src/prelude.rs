@@ -4,7 +4,7 @@
 //! drivers most programs use.
 
 pub use crate::{
-    AdaptiveSettings, DormandPrince54, DormandPrince853, FixedTimestep, GaussLegendre2,
-    Integrator, Projected, Rk4, StormerVerlet, VariationalMidpoint, Yoshida4,
+    AdaptiveSettings, DormandPrince54, DormandPrince853, FixedTimestep, GaussLegendre2, Integrator,
+    Method, Projected, Rk4, StormerVerlet, VariationalMidpoint, Yoshida4,
 };
 pub use lagrange_core::prelude::*;

@@ -1,7 +1,7 @@
 //! [`Projected`]: any integrator followed by a projection onto the constraints after each step.
 
-use crate::integrator::Work;
-use crate::{Cost, Integrator};
+use crate::integrator::{continues, Work};
+use crate::{Cost, Integrator, Method};
 use lagrange_core::constraints::{Constraints, Projection};
 use lagrange_core::{Error, Mechanism, Real, State};
 
@@ -60,18 +60,24 @@ impl<T: Real, const N: usize, const C: usize, I> Projected<T, N, C, I> {
     }
 }
 
-impl<T, M, I, const N: usize, const C: usize> Integrator<T, N, M> for Projected<T, N, C, I>
-where
-    T: Real,
-    M: Mechanism<T, N> + Constraints<T, N, C>,
-    I: Integrator<T, N, M>,
-{
+impl<T: Real, I: Method, const N: usize, const C: usize> Method for Projected<T, N, C, I> {
     const NAME: &'static str = I::NAME;
     const ORDER: u32 = I::ORDER;
     /// The inner integrator's (the projection solves with the mass matrix, evaluating no
     /// accelerations).
     const COST: Cost = I::COST;
 
+    fn last_step(&self) -> Work {
+        self.integrator.last_step()
+    }
+}
+
+impl<T, M, I, const N: usize, const C: usize> Integrator<T, N, M> for Projected<T, N, C, I>
+where
+    T: Real,
+    M: Mechanism<T, N> + Constraints<T, N, C>,
+    I: Integrator<T, N, M>,
+{
     /// One step of the inner integrator, then the projection.
     ///
     /// # Errors
@@ -79,16 +85,12 @@ where
     /// constraints beyond the projection's tolerance; the inner integrator's errors;
     /// [`Projection::project`]'s errors.
     fn step(&mut self, mechanism: &M, state: &State<T, N>, dt: T) -> Result<State<T, N>, Error> {
-        if self.last.as_ref() != Some(state) {
+        if !self.last.is_some_and(|last| continues(&last, state)) {
             mechanism.check_state(state, self.projection.tolerance())?;
         }
         let next = self.integrator.step(mechanism, state, dt)?;
         let projected = self.projection.project(mechanism, mechanism, &next)?;
         self.last = Some(projected);
         Ok(projected)
-    }
-
-    fn last_step(&self) -> Work {
-        self.integrator.last_step()
     }
 }

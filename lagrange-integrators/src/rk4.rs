@@ -1,7 +1,7 @@
 //! The classical fourth-order Runge-Kutta method.
 
 use crate::integrator::{check_step, finish, step_loop, Cost, Failure};
-use crate::Integrator;
+use crate::{Integrator, Method};
 use lagrange_core::{Error, Mechanism, Real, State};
 
 /// Classical Runge-Kutta on `y = (q, q')`, `y' = (q', q'')`:
@@ -23,11 +23,13 @@ use lagrange_core::{Error, Mechanism, Real, State};
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Rk4;
 
-impl<T: Real, const N: usize, M: Mechanism<T, N>> Integrator<T, N, M> for Rk4 {
+impl Method for Rk4 {
     const NAME: &'static str = "RK4";
     const ORDER: u32 = 4;
     const COST: Cost = Cost::explicit(4);
+}
 
+impl<T: Real, const N: usize, M: Mechanism<T, N>> Integrator<T, N, M> for Rk4 {
     fn step(&mut self, m: &M, s: &State<T, N>, dt: T) -> Result<State<T, N>, Error> {
         let h = check_step(s, dt)?;
         finish(stages(m, s, h)?)

@@ -1,7 +1,7 @@
 //! Semi-implicit (symplectic) Euler.
 
 use crate::integrator::{check_step, finish, Cost};
-use crate::Integrator;
+use crate::{Integrator, Method};
 use lagrange_core::{Error, Mechanism, Real, State};
 
 /// Semi-implicit Euler: `q'1 = q'0 + h q''(q0, q'0)`, then `q1 = q0 + h q'1`.
@@ -15,11 +15,13 @@ use lagrange_core::{Error, Mechanism, Real, State};
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct SemiImplicitEuler;
 
-impl<T: Real, const N: usize, M: Mechanism<T, N>> Integrator<T, N, M> for SemiImplicitEuler {
+impl Method for SemiImplicitEuler {
     const NAME: &'static str = "semi-implicit Euler";
     const ORDER: u32 = 1;
     const COST: Cost = Cost::explicit(1);
+}
 
+impl<T: Real, const N: usize, M: Mechanism<T, N>> Integrator<T, N, M> for SemiImplicitEuler {
     fn step(&mut self, m: &M, s: &State<T, N>, dt: T) -> Result<State<T, N>, Error> {
         let h = check_step(s, dt)?;
         let qd = s.qd + m.acceleration(s)? * h;

@@ -3,7 +3,7 @@
 
 use crate::integrator::{check_signed, check_step, finish, Cost, Work};
 use crate::newton::{self, BlockMatrix, Blocks, NewtonProblem, NewtonSettings, Start};
-use crate::{Integrator, SymmetricBase};
+use crate::{Integrator, Method, SymmetricBase};
 use lagrange_core::nalgebra::{SMatrix, SVector};
 use lagrange_core::{Error, Mechanism, Real, State};
 
@@ -85,9 +85,7 @@ impl<T: Real, M: Mechanism<T, N>, const N: usize> HalfKick<'_, T, M, N> {
     }
 }
 
-impl<T: Real, M: Mechanism<T, N>, const N: usize> NewtonProblem<T, N, 1>
-    for HalfKick<'_, T, M, N>
-{
+impl<T: Real, M: Mechanism<T, N>, const N: usize> NewtonProblem<T, N, 1> for HalfKick<'_, T, M, N> {
     fn residual(&mut self, v: &Blocks<T, N, 1>) -> Result<Blocks<T, N, 1>, Error> {
         let kicked = self.start.qd + self.mechanism.acceleration(&self.at(&v[0]))? * self.half;
         Ok([v[0] - kicked])
@@ -151,9 +149,7 @@ impl<T: Real, const N: usize> StormerVerlet<T, N> {
     }
 }
 
-impl<T: Real, const N: usize, M: Mechanism<T, N>> Integrator<T, N, M>
-    for StormerVerlet<T, N>
-{
+impl<T: Real, const N: usize> Method for StormerVerlet<T, N> {
     const NAME: &'static str = "Stormer-Verlet";
     const ORDER: u32 = 2;
     /// One acceleration per iteration of the implicit kick and one for the explicit kick (2
@@ -165,19 +161,19 @@ impl<T: Real, const N: usize, M: Mechanism<T, N>> Integrator<T, N, M>
         jacobians: 0,
     };
 
-    fn step(&mut self, m: &M, s: &State<T, N>, dt: T) -> Result<State<T, N>, Error> {
-        let h = check_step(s, dt)?;
-        self.advance(m, s, h)
-    }
-
     fn last_step(&self) -> Work {
         self.work
     }
 }
 
-impl<T: Real, const N: usize, M: Mechanism<T, N>> SymmetricBase<T, N, M>
-    for StormerVerlet<T, N>
-{
+impl<T: Real, const N: usize, M: Mechanism<T, N>> Integrator<T, N, M> for StormerVerlet<T, N> {
+    fn step(&mut self, m: &M, s: &State<T, N>, dt: T) -> Result<State<T, N>, Error> {
+        let h = check_step(s, dt)?;
+        self.advance(m, s, h)
+    }
+}
+
+impl<T: Real, const N: usize, M: Mechanism<T, N>> SymmetricBase<T, N, M> for StormerVerlet<T, N> {
     fn signed_step(&mut self, m: &M, s: &State<T, N>, h: T) -> Result<State<T, N>, Error> {
         let h = check_signed(s, h)?;
         self.advance(m, s, h)

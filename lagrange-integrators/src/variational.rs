@@ -1,9 +1,9 @@
 //! [`VariationalMidpoint`]: the discrete Euler-Lagrange equations of the midpoint discrete
 //! Lagrangian, with discrete forces (Lagrange-d'Alembert), in position-momentum form.
 
-use crate::integrator::{check_signed, check_step, Clock, Cost, Failure, Work};
+use crate::integrator::{check_signed, check_step, continues, Clock, Cost, Failure, Work};
 use crate::newton::{self, BlockMatrix, Blocks, NewtonProblem, NewtonSettings, Start};
-use crate::{Integrator, SymmetricBase};
+use crate::{Integrator, Method, SymmetricBase};
 use lagrange_core::nalgebra::{SMatrix, SVector};
 use lagrange_core::{
     central_difference_jacobian, Dual, Error, Jacobian, Lagrangian, Mechanism, NoForce, Real,
@@ -129,7 +129,12 @@ impl<T: Real + defmt::Format, const N: usize> defmt::Format for VariationalMidpo
 }
 
 /// `L = T - V` of `sys` at `(t, q, q')` in any scalar.
-fn lagrangian<T, S, Sys, const N: usize>(sys: &Sys, t: S, q: &SVector<S, N>, qd: &SVector<S, N>) -> S
+fn lagrangian<T, S, Sys, const N: usize>(
+    sys: &Sys,
+    t: S,
+    q: &SVector<S, N>,
+    qd: &SVector<S, N>,
+) -> S
 where
     T: Real,
     S: Scalar<Real = T>,
@@ -314,11 +319,7 @@ impl<T: Real, const N: usize> VariationalMidpoint<T, N> {
     }
 
     /// The momenta `p = dL/dq'` at `state` (the continuous Legendre transform).
-    pub fn momentum<Sys: Lagrangian<T, N>>(
-        &self,
-        sys: &Sys,
-        state: &State<T, N>,
-    ) -> SVector<T, N> {
+    pub fn momentum<Sys: Lagrangian<T, N>>(&self, sys: &Sys, state: &State<T, N>) -> SVector<T, N> {
         directional(sys, state.t, &state.q, &state.qd, T::zero())
     }
 
@@ -441,7 +442,10 @@ impl<T: Real, const N: usize> VariationalMidpoint<T, N> {
         h: T,
     ) -> Result<State<T, N>, Error> {
         let (z, guess) = match self.last.take() {
-            Some((out, z)) if out == *state => (z, self.guess(&state.q, h)),
+            // The driver's clock is the time.
+            Some((out, z)) if continues(&out, state) => {
+                (PhaseState { t: state.t, ..z }, self.guess(&state.q, h))
+            }
             _ => (self.phase_state(m, state), state.q + state.qd * h),
         };
         let next = self.step_from(m, &z, h, guess)?;
@@ -452,10 +456,9 @@ impl<T: Real, const N: usize> VariationalMidpoint<T, N> {
     }
 }
 
-impl<T: Real, const N: usize, M: Mechanism<T, N>> Integrator<T, N, M>
-    for VariationalMidpoint<T, N>
-{
+impl<T: Real, const N: usize> Method for VariationalMidpoint<T, N> {
     const NAME: &'static str = "variational midpoint";
+    const YOSHIDA4_NAME: &'static str = "Yoshida 4 (variational)";
     const ORDER: u32 = 2;
     /// Lagrangian evaluations in dual numbers, counted as accelerations: one first-order per
     /// Newton iteration, one for `p1` and one for the velocities; one second-order per Newton
@@ -466,13 +469,17 @@ impl<T: Real, const N: usize, M: Mechanism<T, N>> Integrator<T, N, M>
         jacobians: 1,
     };
 
+    fn last_step(&self) -> Work {
+        self.work
+    }
+}
+
+impl<T: Real, const N: usize, M: Mechanism<T, N>> Integrator<T, N, M>
+    for VariationalMidpoint<T, N>
+{
     fn step(&mut self, m: &M, s: &State<T, N>, dt: T) -> Result<State<T, N>, Error> {
         let h = check_step(s, dt)?;
         self.advance(m, s, h)
-    }
-
-    fn last_step(&self) -> Work {
-        self.work
     }
 
     /// In position-momentum form throughout, converting to velocities only at the end (the
@@ -494,7 +501,7 @@ impl<T: Real, const N: usize, M: Mechanism<T, N>> Integrator<T, N, M>
             return Ok(*state);
         }
         let mut z = match self.last.take() {
-            Some((out, z)) if out == *state => z,
+            Some((out, z)) if continues(&out, state) => PhaseState { t: state.t, ..z },
             _ => self.phase_state(m, state),
         };
         let mut guess = match self.motion {
@@ -507,9 +514,7 @@ impl<T: Real, const N: usize, M: Mechanism<T, N>> Integrator<T, N, M>
             before = z;
             z = self.step_from(m, &z, dt, guess).map_err(|e| {
                 // The last good state in velocities, when it can be had.
-                let last = self
-                    .velocity_state(m, &before, &state.qd)
-                    .unwrap_or(*state);
+                let last = self.velocity_state(m, &before, &state.qd).unwrap_or(*state);
                 fail(e, k, &last)
             })?;
             clock.tick(dt);

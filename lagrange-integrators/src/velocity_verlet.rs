@@ -1,7 +1,7 @@
 //! Velocity Verlet (Stormer-Verlet, kick-drift-kick).
 
 use crate::integrator::{check_step, finish, Cost};
-use crate::Integrator;
+use crate::{Integrator, Method};
 use lagrange_core::{Error, Mechanism, Real, State};
 
 /// Velocity Verlet in kick-drift-kick form:
@@ -25,11 +25,13 @@ use lagrange_core::{Error, Mechanism, Real, State};
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct VelocityVerlet;
 
-impl<T: Real, const N: usize, M: Mechanism<T, N>> Integrator<T, N, M> for VelocityVerlet {
+impl Method for VelocityVerlet {
     const NAME: &'static str = "velocity Verlet";
     const ORDER: u32 = 2;
     const COST: Cost = Cost::explicit(2);
+}
 
+impl<T: Real, const N: usize, M: Mechanism<T, N>> Integrator<T, N, M> for VelocityVerlet {
     fn step(&mut self, m: &M, s: &State<T, N>, dt: T) -> Result<State<T, N>, Error> {
         let h = check_step(s, dt)?;
         let half = h * T::HALF;

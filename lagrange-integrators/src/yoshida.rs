@@ -2,24 +2,26 @@
 //! symmetric second-order method.
 
 use crate::integrator::{check_step, Cost, Work};
-use crate::Integrator;
+use crate::{Integrator, Method};
 use lagrange_core::{Error, Mechanism, Real, State};
 
 /// A symmetric (time-reversible) one-step method of order 2: what [`Yoshida4`] can raise to
 /// order 4 (composing a non-symmetric method with these weights gives only order 3).
 /// [`StormerVerlet`](crate::StormerVerlet), [`ImplicitMidpoint`](crate::ImplicitMidpoint) and
 /// [`VariationalMidpoint`](crate::VariationalMidpoint) are.
-pub trait SymmetricBase<T: Real, const N: usize, M: Mechanism<T, N>>:
-    Integrator<T, N, M>
-{
+pub trait SymmetricBase<T: Real, const N: usize, M: Mechanism<T, N>>: Integrator<T, N, M> {
     /// A step of `h`, which may be negative: a composition steps back in its middle substep.
     ///
     /// # Errors
     /// [`Error::NonFiniteState`] for a non-finite `state` or result;
     /// [`Error::StepSizeUnderflow`] when `state.t + h` rounds to `state.t` (`h = 0` too); as
     /// [`Integrator::step`] otherwise.
-    fn signed_step(&mut self, mechanism: &M, state: &State<T, N>, h: T)
-        -> Result<State<T, N>, Error>;
+    fn signed_step(
+        &mut self,
+        mechanism: &M,
+        state: &State<T, N>,
+        h: T,
+    ) -> Result<State<T, N>, Error>;
 }
 
 /// The weights of the triple jump, `w1, w0, w1`:
@@ -86,13 +88,8 @@ impl<B: defmt::Format> defmt::Format for Yoshida4<B> {
     }
 }
 
-impl<T, B, M, const N: usize> Integrator<T, N, M> for Yoshida4<B>
-where
-    T: Real,
-    M: Mechanism<T, N>,
-    B: SymmetricBase<T, N, M>,
-{
-    const NAME: &'static str = "Yoshida 4";
+impl<B: Method> Method for Yoshida4<B> {
+    const NAME: &'static str = B::YOSHIDA4_NAME;
     const ORDER: u32 = 4;
     const COST: Cost = Cost {
         fixed: 3 * B::COST.fixed,
@@ -100,6 +97,18 @@ where
         jacobians: 3 * B::COST.jacobians,
     };
 
+    /// The three substeps together (iterations summed over them).
+    fn last_step(&self) -> Work {
+        self.work
+    }
+}
+
+impl<T, B, M, const N: usize> Integrator<T, N, M> for Yoshida4<B>
+where
+    T: Real,
+    M: Mechanism<T, N>,
+    B: SymmetricBase<T, N, M>,
+{
     fn step(&mut self, m: &M, s: &State<T, N>, dt: T) -> Result<State<T, N>, Error> {
         let dt = check_step(s, dt)?;
         let mut next = *s;
@@ -116,10 +125,5 @@ where
         // The substeps' times add up to dt only to rounding: land exactly.
         next.t = s.t + dt;
         Ok(next)
-    }
-
-    /// The three substeps together (iterations summed over them).
-    fn last_step(&self) -> Work {
-        self.work
     }
 }

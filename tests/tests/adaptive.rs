@@ -25,9 +25,8 @@ fn tolerance_sweep<const S: usize, const R: usize, P: EmbeddedPair<S, R>>(
     let mut errs = Vec::new();
     for &rtol in rtols {
         let settings = AdaptiveSettings::new(rtol, rtol * 1e-2)?;
-        let mut i =
-            EmbeddedRungeKutta::<f64, 1, S, R, P>::new(settings, &p, &State::at_rest([TH0]))?;
-        let end = i.integrate_to(&p, T_END)?;
+        let mut i = EmbeddedRungeKutta::<f64, 1, S, R, P>::new(settings);
+        let end = i.integrate_to(&p, &State::at_rest([TH0]), T_END)?;
         assert_eq!(end.t, T_END);
         let err = state_error(&end, &[th, thd]);
         let st = i.statistics();
@@ -81,10 +80,11 @@ fn event_crossings<const S: usize, const R: usize, P: EmbeddedPair<S, R>>(
     let p = SimplePendulum::new(1.0, 1.0, G, 0.0)?;
     let period = pendulum_period(TH0, G.sqrt())?;
     let settings = AdaptiveSettings::new(rtol, rtol * 1e-2)?;
-    let mut i = EmbeddedRungeKutta::<f64, 1, S, R, P>::new(settings, &p, &State::at_rest([TH0]))?;
+    let mut i = EmbeddedRungeKutta::<f64, 1, S, R, P>::new(settings);
     let mut misses = [0.0; 2];
+    let mut from = State::at_rest([TH0]);
     for (k, expected) in [0.25 * period, 0.75 * period].into_iter().enumerate() {
-        let stop = i.integrate_until_event(&p, T_END, |s: &State<f64, 1>| s.q[0])?;
+        let stop = i.integrate_until_event(&p, &from, T_END, |s: &State<f64, 1>| s.q[0])?;
         let Stop::Event(s) = stop else {
             return Err(Error::NoConvergence { iterations: 0 });
         };
@@ -97,7 +97,7 @@ fn event_crossings<const S: usize, const R: usize, P: EmbeddedPair<S, R>>(
             s.q[0]
         );
         assert!(misses[k].abs() < 1e-10);
-        assert_eq!(i.state().t, s.t);
+        from = s;
     }
     Ok(misses)
 }
@@ -123,16 +123,18 @@ fn dense_output_between_steps<const S: usize, const R: usize, P: EmbeddedPair<S,
 ) -> Result<(), Error> {
     let p = SimplePendulum::new(1.0, 1.0, G, 0.0)?;
     let settings = AdaptiveSettings::new(rtol, rtol * 1e-2)?;
-    let mut i = EmbeddedRungeKutta::<f64, 1, S, R, P>::new(settings, &p, &State::at_rest([TH0]))?;
+    let mut i = EmbeddedRungeKutta::<f64, 1, S, R, P>::new(settings);
     let (mut at_steps, mut between) = (0.0f64, 0.0f64);
     let exact = |t: f64| pendulum_from_rest(TH0, G.sqrt(), t).map(|(a, b)| [a, b]);
-    while i.state().t < T_END {
-        let t0 = i.state().t;
-        let s = i.step(&p)?;
+    let mut state = State::at_rest([TH0]);
+    while state.t < T_END {
+        let t0 = state.t;
+        let s = i.next_step(&p, &state, T_END)?;
+        state = s;
         at_steps = at_steps.max(state_error(&s, &exact(s.t)?));
         for k in 1..10 {
             let t = t0 + (s.t - t0) * f64::from(k) / 10.0;
-            let d = i.dense_output(&p, t)?;
+            let d = i.dense_output(t)?;
             assert_eq!(d.t, t);
             between = between.max(state_error(&d, &exact(t)?));
         }
@@ -168,14 +170,13 @@ fn dense_output_local_order<const S: usize, const R: usize, P: EmbeddedPair<S, R
     for &h in hs {
         // Loose tolerances, so that the one step of h is accepted as it is.
         let settings = AdaptiveSettings::new(0.5, 0.5)?.with_initial_step(h)?;
-        let mut i =
-            EmbeddedRungeKutta::<f64, 1, S, R, P>::new(settings, &p, &State::new(t0, [a], [b]))?;
-        i.step(&p)?;
+        let mut i = EmbeddedRungeKutta::<f64, 1, S, R, P>::new(settings);
+        i.next_step(&p, &State::new(t0, [a], [b]), t0 + h)?;
         assert_eq!(i.statistics().rejected, 0);
         let mut worst = 0.0f64;
         for k in 1..10 {
             let t = t0 + h * f64::from(k) / 10.0;
-            worst = worst.max(state_error(&i.dense_output(&p, t)?, &exact(t)?));
+            worst = worst.max(state_error(&i.dense_output(t)?, &exact(t)?));
         }
         errs.push(worst);
     }
@@ -208,8 +209,8 @@ fn adaptive_in_both_precisions<T: Real>() -> Result<(), Error> {
     let (th, thd) = pendulum_from_rest(TH0, G.sqrt(), T_END)?;
     let rtol = pick::<T>(1e-5, 1e-9);
     let settings = AdaptiveSettings::new(T::from_f64(rtol), T::from_f64(rtol * 1e-2))?;
-    let end5 = DormandPrince54::new(settings, &p, &start)?.integrate_to(&p, T::from_f64(T_END))?;
-    let end8 = DormandPrince853::new(settings, &p, &start)?.integrate_to(&p, T::from_f64(T_END))?;
+    let end5 = DormandPrince54::new(settings).integrate_to(&p, &start, T::from_f64(T_END))?;
+    let end8 = DormandPrince853::new(settings).integrate_to(&p, &start, T::from_f64(T_END))?;
     for (name, end, factor) in [
         ("DP5", end5, pick::<T>(45.0, 27.0)),
         ("DOP853", end8, pick::<T>(18.0, 1.0)),
@@ -232,20 +233,20 @@ fn impossible_runs_are_errors<T: Real>() -> Result<(), Error> {
     let rtol = pick::<T>(1e-5, 1e-12);
     let tight = AdaptiveSettings::new(T::from_f64(rtol), T::from_f64(rtol * 1e-2))?;
     let coarse = tight.with_step_bounds(T::from_f64(0.5), T::INFINITY)?;
-    let mut i = DormandPrince54::new(coarse, &p, &start)?;
-    assert_eq!(
-        i.integrate_to(&p, T::from_f64(T_END)),
-        Err(Error::StepSizeUnderflow)
-    );
-    assert!(i.state().is_finite());
+    let mut i = DormandPrince54::new(coarse);
+    let failed = i.integrate_to(&p, &start, T::from_f64(T_END));
+    assert_eq!(failed.map_err(|f| f.error), Err(Error::StepSizeUnderflow));
+    assert!(failed.is_err_and(|f| f.last.is_finite() && f.last.t >= T::zero()));
     let short = tight.with_max_steps(10)?;
-    let mut i = DormandPrince853::new(short, &p, &start)?;
+    let mut i = DormandPrince853::new(short);
+    let failed = i.integrate_to(&p, &start, T::from_f64(T_END));
     assert_eq!(
-        i.integrate_to(&p, T::from_f64(T_END)),
+        failed.map_err(|f| f.error),
         Err(Error::TooManySteps { steps: 10 })
     );
     assert_eq!(i.statistics().accepted, 10);
-    assert!(i.state().t > T::zero() && i.state().t < T::from_f64(T_END));
+    assert!(failed
+        .is_err_and(|f| f.step == 10 && f.last.t > T::zero() && f.last.t < T::from_f64(T_END)));
     Ok(())
 }
 
@@ -280,18 +281,24 @@ fn bad_settings_and_calls_are_refused<T: Real>() -> Result<(), Error> {
     refuses(ok.with_event_tolerance(-one), "event_tolerance");
 
     let p = SimplePendulum::new(one, one, T::from_f64(G), T::zero())?;
+    let mut i = DormandPrince54::new(ok);
     assert_eq!(
-        DormandPrince54::new(ok, &p, &State::at_rest([nan])).map(|_| ()),
+        i.integrate_to(&p, &State::at_rest([nan]), one)
+            .map_err(|f| f.error),
         Err(Error::NonFiniteState)
     );
-    let mut i = DormandPrince54::new(ok, &p, &State::at_rest([T::HALF]))?;
-    refuses(i.dense_output(&p, T::zero()), "t");
-    i.integrate_to(&p, one)?;
-    refuses(i.integrate_to(&p, T::HALF), "t_end");
-    refuses(i.integrate_to(&p, nan), "t_end");
-    refuses(i.dense_output(&p, T::from_f64(2.0)), "t");
+    refuses(i.dense_output(T::zero()), "t");
+    let end = i.integrate_to(&p, &State::at_rest([T::HALF]), one)?;
     refuses(
-        i.integrate_until_event(&p, T::from_f64(2.0), |_: &State<T, 1>| nan),
+        i.integrate_to(&p, &end, T::HALF).map_err(|f| f.error),
+        "t_end",
+    );
+    refuses(i.integrate_to(&p, &end, nan).map_err(|f| f.error), "t_end");
+    refuses(i.next_step(&p, &end, T::HALF), "t_end");
+    refuses(i.dense_output(T::from_f64(2.0)), "t");
+    refuses(
+        i.integrate_until_event(&p, &end, T::from_f64(2.0), |_: &State<T, 1>| nan)
+            .map_err(|f| f.error),
         "guard",
     );
     Ok(())
@@ -303,28 +310,27 @@ for_f32_and_f64!(
     bad_settings_and_calls_are_refused
 );
 
-/// An input changed between calls: after `refresh` the next step starts from the derivative
-/// of the changed mechanism, and the run matches RK4 with the same switch (reference at
-/// dt = 1e-4, error ~1e-14) to the tolerance (measured 1.2e-10) with at most a rejection or
-/// two (measured 1). Without `refresh` the first stage keeps the old input, and the error
-/// control rejects its way down to a tiny step (measured 17 rejections).
+/// An input changed between calls: after `restart` the next call starts afresh from the
+/// derivative of the changed mechanism, and the run matches RK4 with the same switch
+/// (reference at dt = 1e-4, error ~1e-14) to the tolerance (measured 1.2e-10) with at most a
+/// rejection or two (measured 1).
 #[test]
-fn refresh_after_changing_an_input() -> Result<(), Error> {
+fn restart_after_changing_an_input() -> Result<(), Error> {
     use lagrange_core::Input;
     use lagrange_integrators::{Integrator, Rk4};
     let mut driven = SimplePendulum::new(1.0, 1.0, G, 0.0)?.with_force(Input::new([0.0]));
     let start = State::at_rest([TH0]);
     let settings = AdaptiveSettings::new(1e-10, 1e-12)?;
-    let mut i = DormandPrince54::new(settings, &driven, &start)?;
-    i.integrate_to(&driven, 1.0)?;
+    let mut i = DormandPrince54::new(settings);
+    let middle = i.integrate_to(&driven, &start, 1.0)?;
     let mut reference = Rk4.integrate(&driven, &start, 1e-4, 10_000)?;
     driven.force_mut().value[0] = 5.0;
-    i.refresh();
-    let rejected = i.statistics().rejected;
-    let end = i.integrate_to(&driven, 2.0)?;
+    i.restart();
+    let end = i.integrate_to(&driven, &middle, 2.0)?;
     reference = Rk4.integrate(&driven, &reference, 1e-4, 10_000)?;
     let err = state_error(&end, &[reference.q[0], reference.qd[0]]);
-    let more = i.statistics().rejected - rejected;
+    // Statistics count from the fresh start.
+    let more = i.statistics().rejected;
     println!("after the switch: error {err:.2e}, {more} more rejections");
     assert!(err < 1e-9, "{err}");
     assert!(more <= 3, "{more} rejections");
@@ -347,8 +353,11 @@ where
     let mut ratios = Vec::new();
     for &rtol in rtols {
         let settings = AdaptiveSettings::new(T::from_f64(rtol), T::from_f64(rtol * 1e-2))?;
-        let end = EmbeddedRungeKutta::<T, 1, S, R, P>::new(settings, m, start)?
-            .integrate_to(m, T::from_f64(t_end))?;
+        let end = EmbeddedRungeKutta::<T, 1, S, R, P>::new(settings).integrate_to(
+            m,
+            start,
+            T::from_f64(t_end),
+        )?;
         ratios.push(state_error(&end, &exact) / rtol);
     }
     Ok(ratios)

@@ -5,8 +5,9 @@ use lagrange_core::{
     Error, EulerLagrange, Lagrangian, Mechanism, Real, Scalar, State, ViscousDamping,
 };
 use lagrange_integrators::{
-    BackwardEuler, ExplicitEuler, GaussLegendre2, ImplicitMidpoint, Integrator, RadauIIA2, Rk4,
-    SemiImplicitEuler, StormerVerlet, VariationalMidpoint, VelocityVerlet, Yoshida4,
+    AdaptiveSettings, BackwardEuler, DormandPrince54, ExplicitEuler, GaussLegendre2,
+    ImplicitMidpoint, Integrator, RadauIIA2, Rk4, SemiImplicitEuler, StormerVerlet,
+    VariationalMidpoint, VelocityVerlet, Yoshida4,
 };
 use lagrange_systems::exact::{jacobi_sn_cn, pendulum_from_rest};
 use lagrange_systems::{BeadOnRotatingHoop, DoublePendulum, FallingParticle, SimplePendulum};
@@ -67,9 +68,12 @@ fn constructors_name_the_bad_parameter<T: Real>() -> Result<(), Error> {
     Ok(())
 }
 
-/// Every integrator refuses a NaN or infinite state with `NonFiniteState` and a zero or
-/// non-finite step with `InvalidParameter { name: "dt" }`.
-fn check_integrator<T: Real, I: Integrator<T, 2>>(mut i: I) -> Result<(), Error> {
+/// Every integrator refuses a NaN or infinite state with `NonFiniteState` and a zero,
+/// negative or non-finite step with `InvalidParameter { name: "dt" }` (every method runs
+/// forward in time).
+fn check_integrator<T: Real, I: Integrator<T, 2, DoublePendulum<T>>>(
+    mut i: I,
+) -> Result<(), Error> {
     let dp = DoublePendulum::new(T::one(), T::one(), T::one(), T::one(), T::from_f64(9.81))?;
     let nan = T::from_f64(f64::NAN);
     let good = State::new(T::zero(), [T::HALF, T::zero()], [T::zero(); 2]);
@@ -86,10 +90,11 @@ fn check_integrator<T: Real, I: Integrator<T, 2>>(mut i: I) -> Result<(), Error>
             I::NAME
         );
     }
-    for dt in [T::zero(), nan, T::INFINITY] {
+    for dt in [T::zero(), nan, T::INFINITY, -T::from_f64(1e-3)] {
         refuses(i.step(&dp, &good, dt), "dt");
+        refuses(i.integrate(&dp, &good, dt, 0).map_err(|f| f.error), "dt");
     }
-    i.step(&dp, &good, -T::from_f64(1e-3))?;
+    i.step(&dp, &good, T::from_f64(1e-3))?;
     Ok(())
 }
 
@@ -104,11 +109,17 @@ fn integrators_refuse_bad_states_and_steps<T: Real>() -> Result<(), Error> {
     check_integrator::<T, _>(GaussLegendre2::default())?;
     check_integrator::<T, _>(BackwardEuler::default())?;
     check_integrator::<T, _>(RadauIIA2::default())?;
+    check_integrator::<T, _>(VariationalMidpoint::default())?;
+    check_integrator::<T, _>(Yoshida4::<VariationalMidpoint<T, 2>>::default())?;
+    check_integrator::<T, _>(DormandPrince54::new(AdaptiveSettings::new(
+        T::from_f64(1e-5),
+        T::from_f64(1e-7),
+    )?))?;
     check_variational::<T>()
 }
 
-/// The variational integrator, which steps a Lagrangian rather than any mechanism, refuses
-/// the same states and steps.
+/// The variational integrator on the automatic path, stepping and integrating in momentum
+/// form, refuses the same states and steps.
 fn check_variational<T: Real>() -> Result<(), Error> {
     let one = T::one();
     let dp = EulerLagrange::new(DoublePendulum::new(one, one, one, one, T::from_f64(9.81))?);
@@ -125,14 +136,15 @@ fn check_variational<T: Real>() -> Result<(), Error> {
             Err(Error::NonFiniteState)
         );
         assert_eq!(
-            vi.integrate(&dp, &bad, T::from_f64(1e-3), 3),
+            vi.integrate(&dp, &bad, T::from_f64(1e-3), 3)
+                .map_err(|f| f.error),
             Err(Error::NonFiniteState)
         );
     }
-    for dt in [T::zero(), nan, T::INFINITY] {
+    for dt in [T::zero(), nan, T::INFINITY, -T::from_f64(1e-3)] {
         refuses(vi.step(&dp, &good, dt), "dt");
     }
-    vi.step(&dp, &good, -T::from_f64(1e-3))?;
+    vi.step(&dp, &good, T::from_f64(1e-3))?;
     Ok(())
 }
 
@@ -163,7 +175,9 @@ fn blow_up_is_an_error<T: Real>() -> Result<(), Error> {
         assert!(s.is_finite());
     }
     let result = ExplicitEuler.integrate(&spring, &start, T::one(), 1000);
-    assert_eq!(result, Err(Error::NonFiniteState));
+    assert_eq!(result.map_err(|f| f.error), Err(Error::NonFiniteState));
+    // The failure names the step and keeps the last good state.
+    assert!(result.is_err_and(|f| f.step > 10 && f.step < 1000 && f.last.is_finite()));
     Ok(())
 }
 

@@ -23,7 +23,7 @@ fn damping_acts_through_the_rod<T: Real>() -> Result<(), Error> {
     let cartesian = Constrained::new(CartesianPendulum::new(m, l, g)?);
     let damped = cartesian.with_force(ViscousDamping::uniform(c)?);
     let tol = T::from_f64(pick::<T>(1e-5, 1e-13));
-    let mut stepper = Projected::new(Rk4, cartesian, Projection::new(tol, 4)?);
+    let mut stepper = Projected::new(Rk4, Projection::new(tol, 4)?);
     let dt = T::from_f64(1e-3);
     let mut s = State::at_rest([T::one()]);
     let mut cs = cartesian

@@ -71,7 +71,7 @@ fn inconsistent_start_is_refused<T: Real>() -> Result<(), Error> {
     )?);
     let dt = T::from_f64(1e-3);
     let tol = T::from_f64(1e-5);
-    let mut stepper = Projected::new(Rk4, p, Projection::new(tol, 4)?);
+    let mut stepper = Projected::new(Rk4, Projection::new(tol, 4)?);
     let off_circle = State::new(T::zero(), [T::from_f64(1.1), T::zero()], [T::zero(); 2]);
     let radial_velocity = State::new(T::zero(), [T::one(), T::zero()], [T::HALF, T::zero()]);
     for bad in [off_circle, radial_velocity] {
@@ -93,7 +93,7 @@ fn inconsistent_start_is_refused<T: Real>() -> Result<(), Error> {
         .parts()
         .assemble(T::zero(), T::HALF, T::one(), Branch::Right)?;
     s.q[2] += T::from_f64(0.01);
-    let mut stepper = Projected::new(Rk4, linkage, Projection::new(tol, 4)?);
+    let mut stepper = Projected::new(Rk4, Projection::new(tol, 4)?);
     assert!(matches!(
         stepper.step(&linkage, &s, dt),
         Err(Error::ConstraintViolated { .. })
@@ -104,7 +104,7 @@ fn inconsistent_start_is_refused<T: Real>() -> Result<(), Error> {
         [T::from_f64(f64::NAN), -T::one()],
         [T::zero(); 2],
     );
-    let mut stepper = Projected::new(Rk4, p, Projection::new(tol, 4)?);
+    let mut stepper = Projected::new(Rk4, Projection::new(tol, 4)?);
     assert_eq!(stepper.step(&p, &nan, dt), Err(Error::NonFiniteState));
     Ok(())
 }

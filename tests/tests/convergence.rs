@@ -16,14 +16,14 @@ const ORDER_TOLERANCE: f64 = 0.2;
 const T_END: f64 = 1.0;
 
 /// The final-state error of `I` at each step size against `reference`, and the fitted order.
-fn measured_order<I: Integrator<f64, N> + Default, M: Mechanism<f64, N>, const N: usize>(
+fn measured_order<I: Integrator<f64, N, M> + Default, M: Mechanism<f64, N>, const N: usize>(
     m: &M,
     start: &State<f64, N>,
     reference: &[f64],
     dts: &[f64],
 ) -> Result<f64, Error> {
     order_of(I::NAME, I::ORDER, reference, dts, |dt, steps| {
-        I::default().integrate(m, start, dt, steps)
+        Ok(I::default().integrate(m, start, dt, steps)?)
     })
 }
 
@@ -63,7 +63,7 @@ fn variational_order<L: Lagrangian<f64, N>, const N: usize>(
 ) -> Result<f64, Error> {
     let m = EulerLagrange::new(l);
     order_of("variational midpoint", 2, reference, dts, |dt, steps| {
-        VariationalMidpoint::default().integrate(&m, start, dt, steps)
+        Ok(VariationalMidpoint::default().integrate(&m, start, dt, steps)?)
     })
 }
 

@@ -11,7 +11,9 @@ const STEPS: u64 = 1000;
 /// Integrates from y = 100 m, v = 3 m/s with dt = 1e-3 for 1 s and compares with
 /// `y0 + v0 t - g t^2 / 2`. Each step rounds a handful of operations on values of size ~100, so
 /// the error is a random walk bounded by `STEPS * 4 eps * 100`.
-fn exact_to_rounding<T: Real, I: Integrator<T, 1>>(mut integrator: I) -> Result<(), Error> {
+fn exact_to_rounding<T: Real, I: Integrator<T, 1, FallingParticle<T>>>(
+    mut integrator: I,
+) -> Result<(), Error> {
     let g = T::from_f64(9.81);
     let p = FallingParticle::new(T::from_f64(2.0), g)?;
     let start = State::new(T::zero(), [T::from_f64(100.0)], [T::from_f64(3.0)]);

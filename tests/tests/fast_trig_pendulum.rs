@@ -12,7 +12,7 @@ use lagrange_tests::state_error;
 const G: f64 = 9.81;
 
 /// `max(|th - th_exact|, |th' - th'_exact|)` after `steps` steps of `dt` from `th0` at rest.
-fn error<M: Mechanism<f32, 1>, I: Integrator<f32, 1>>(
+fn error<M: Mechanism<f32, 1>, I: Integrator<f32, 1, M>>(
     m: &M,
     mut integrator: I,
     th0: f64,

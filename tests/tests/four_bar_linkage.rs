@@ -122,7 +122,7 @@ fn largest_difference(a: &[(f64, f64)], b: &[(f64, f64)]) -> (f64, f64) {
 fn constrained_run(dt: f64, stride: usize) -> Result<Vec<(f64, f64)>, Error> {
     let l = linkage::<f64>()?;
     let mut s = l.parts().assemble(0.0, 0.0, CRANK_RATE, Branch::Right)?;
-    let mut stepper = Projected::new(Rk4, l, Projection::new(1e-13, 4)?);
+    let mut stepper = Projected::new(Rk4, Projection::new(1e-13, 4)?);
     let steps = (5.0 / dt).round() as usize;
     let mut out = Vec::new();
     for i in 1..=steps {
@@ -183,7 +183,7 @@ fn residual_and_energy<T: Real>() -> Result<(), Error> {
         .assemble(T::zero(), T::zero(), T::from_f64(CRANK_RATE), Branch::Right)?;
     let e0 = l.energy(&start);
     let (mut worst_r, mut worst_e) = (T::zero(), T::zero());
-    Projected::new(Rk4, l, Projection::new(tol, 4)?).integrate_with(
+    Projected::new(Rk4, Projection::new(tol, 4)?).integrate_with(
         &l,
         &start,
         T::from_f64(DT),

@@ -41,7 +41,7 @@ impl Contacts<f64, 2, 1> for Ground {
     }
 }
 
-fn stepper(e: f64, mu: f64) -> Result<ContactStepper<Rk4, Ground, f64, 2, 1>, Error> {
+fn stepper(e: f64, mu: f64) -> Result<ContactStepper<f64, 2, 1, Rk4, Ground>, Error> {
     let model = ContactModel::new(e, REST_SPEED, 1e-10)?.with_friction(mu)?;
     Ok(ContactStepper::new(
         Rk4,

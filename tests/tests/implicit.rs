@@ -316,7 +316,7 @@ fn variational_observes_a_chain_falling_from_rest<T: Real>() -> Result<(), Error
     );
     let dt = T::from_f64(1e-3);
     let mut observed = 0;
-    let end = VariationalMidpoint::default().integrate_with(&chain, &start, dt, 500, |s, _| {
+    let end = VariationalMidpoint::default().integrate_with(&chain, &start, dt, 500, |s| {
         assert!(s.is_finite());
         observed += 1;
     })?;
@@ -360,7 +360,7 @@ fn variational_forces_converge_at_order_two() -> Result<(), Error> {
     // Damping alone removes energy at every step.
     let damped = EulerLagrange::new(p).with_force(ViscousDamping::uniform(0.3)?);
     let mut e = damped.energy(&start);
-    VariationalMidpoint::default().integrate_with(&damped, &start, 1e-2, 500, |s, _| {
+    VariationalMidpoint::default().integrate_with(&damped, &start, 1e-2, 500, |s| {
         let next = damped.energy(s);
         assert!(next <= e + 1e-12, "energy rose {e} -> {next}");
         e = next;

@@ -107,7 +107,9 @@ fn kepler_equation_solved<T: Real>() -> Result<(), Error> {
 /// The e = 0.5 orbit of P4 from periapsis, `steps` steps of `integrator` at `DT`: the position
 /// error against Kepler's equation at the final time, and the largest relative drift of the
 /// angular momentum on the way.
-fn after_ten_periods<T: Real, I: Integrator<T, 2>>(mut integrator: I) -> Result<(f64, f64), Error> {
+fn after_ten_periods<T: Real, I: Integrator<T, 2, Kepler<T>>>(
+    mut integrator: I,
+) -> Result<(f64, f64), Error> {
     let kepler = Kepler::new(T::from_f64(MU))?;
     let start64 = kepler_orbit(MU, A, E, 0.0)?;
     let start = State::new(

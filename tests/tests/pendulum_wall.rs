@@ -56,7 +56,7 @@ fn model<T: Real>() -> Result<ContactModel<T>, Error> {
 /// wall and is left out), and the final state.
 fn ratios<T, M, K, const N: usize, const C: usize>(
     m: &M,
-    stepper: &mut ContactStepper<Rk4, K, T, N, C>,
+    stepper: &mut ContactStepper<T, N, C, Rk4, K>,
     start: State<T, N>,
 ) -> Result<(Vec<f64>, State<T, N>), Error>
 where

@@ -39,7 +39,7 @@ fn steady_turn_is_the_exact_circle<T: Real>() -> Result<(), Error> {
     let rho = RADIUS * ROLL / TURN;
     let (mut d_pos, mut d_e, mut residual) = (0.0f64, 0.0f64, 0.0f64);
     let tol = T::from_f64(pick::<T>(1e-6, 1e-14));
-    Projected::new(Rk4, disk, Projection::new(tol, 2)?).integrate_with(
+    Projected::new(Rk4, Projection::new(tol, 2)?).integrate_with(
         &disk,
         &start,
         T::from_f64(1e-3),

@@ -1,9 +1,8 @@
 //! `cargo xtask`: the project's automation, in Rust so that it runs wherever cargo does.
 //!
-//! - `demo`: the origin's pendulum and a double pendulum with every integrator, a table and an
-//!   SVG plot under `target/lagrange-demo/`; then every standard mechanism (energy error and
-//!   cost per step and per acceleration), the chain's cost against N, and the Kepler orbit;
-//!   then a constrained and a colliding scene with their plots.
+//! - `demo`: runs the examples of `examples/` (the origin's pendulum and a chaotic double
+//!   pendulum with every integrator, your own mechanism, every standard mechanism, constraints,
+//!   impacts, a game loop), their plots under `target/lagrange-demo/`.
 //! - `test`: host tests of every crate, f32 and f64, the long runs (`#[ignore]`d) in release.
 //! - `bench`: run time against error (`benches/src/work_precision`): every integrator on the
 //!   standard problems, CSV, Markdown and SVG work-precision plots under
@@ -22,11 +21,7 @@
 mod cmd;
 mod cross;
 mod demo;
-mod demo_constraints;
-mod demo_integrators;
-mod demo_systems;
 mod mutants;
-mod plots;
 mod qemu;
 mod trig_fit;
 

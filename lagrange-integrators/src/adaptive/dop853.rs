@@ -261,14 +261,13 @@ impl EmbeddedPair<16, 4> for Dop853Pair {
 /// 5(4)'s for the same error.
 ///
 /// ```
-/// use lagrange_core::State;
-/// use lagrange_integrators::{AdaptiveSettings, DormandPrince853};
+/// use lagrange_integrators::prelude::*;
 /// use lagrange_systems::exact::pendulum_from_rest;
 /// use lagrange_systems::SimplePendulum;
 /// let p = SimplePendulum::new(1.0, 1.0, 9.81, 0.0)?;
 /// let settings = AdaptiveSettings::new(1e-12, 1e-14)?;
-/// let mut dop = DormandPrince853::new(settings, &p, &State::at_rest([0.5]))?;
-/// let end = dop.integrate_to(&p, 10.0)?;
+/// let mut dop = DormandPrince853::new(settings);
+/// let end = dop.integrate_to(&p, &State::at_rest([0.5]), 10.0)?;
 /// let (th, _) = pendulum_from_rest(0.5, 9.81f64.sqrt(), 10.0)?;
 /// assert!((end.q[0] - th).abs() < 1e-10);
 /// # Ok::<(), lagrange_core::Error>(())

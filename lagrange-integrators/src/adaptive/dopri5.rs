@@ -102,18 +102,19 @@ impl EmbeddedPair<7, 1> for Dopri5Pair {
 /// [`DormandPrince853`](crate::DormandPrince853).
 ///
 /// ```
-/// use lagrange_core::State;
-/// use lagrange_integrators::{AdaptiveSettings, DormandPrince54};
+/// use lagrange_integrators::prelude::*;
 /// use lagrange_systems::SimplePendulum;
 /// let p = SimplePendulum::new(1.0_f64, 1.0, 9.81, 0.0)?;
-/// let mut dp = DormandPrince54::new(AdaptiveSettings::new(1e-8, 1e-10)?, &p, &State::at_rest([0.5]))?;
-/// let end = dp.integrate_to(&p, 10.0)?;
+/// let mut dp = DormandPrince54::new(AdaptiveSettings::new(1e-8, 1e-10)?);
+/// let end = dp.integrate_to(&p, &State::at_rest([0.5]), 10.0)?;
 /// assert_eq!(end.t, 10.0);
-/// // Sample inside the last step.
-/// if let Some((t0, t1)) = dp.dense_interval() {
-///     let midway = dp.dense_output(&p, 0.5 * (t0 + t1))?;
-///     assert!(midway.t > t0 && midway.t < t1);
-/// }
+/// // One more step of the controller's choosing, and a sample inside it.
+/// let next = dp.next_step(&p, &end, 20.0)?;
+/// let midway = dp.dense_output(0.5 * (end.t + next.t))?;
+/// assert!(midway.t > end.t && midway.t < next.t);
+/// // As an integrator, it lands on a frame's time through its dense output.
+/// let frame = dp.step(&p, &next, 1.0 / 60.0)?;
+/// assert_eq!(frame.t, next.t + 1.0 / 60.0);
 /// # Ok::<(), lagrange_core::Error>(())
 /// ```
 pub type DormandPrince54<T, const N: usize> = EmbeddedRungeKutta<T, N, 7, 1, Dopri5Pair>;

@@ -3,8 +3,8 @@
 
 use super::controller::PiController;
 use super::AdaptiveSettings;
-use crate::integrator::{check_step, Cost, Failure, Work};
-use crate::Integrator;
+use crate::integrator::{check_step, continues, Cost, Failure, Work};
+use crate::{Integrator, Method};
 use core::marker::PhantomData;
 use lagrange_core::nalgebra::SVector;
 use lagrange_core::{Error, Mechanism, Real, State};
@@ -225,7 +225,7 @@ where
         state: &State<T, N>,
     ) -> Result<(), Error> {
         state.check_finite()?;
-        if self.output.as_ref() == Some(state) {
+        if self.output.is_some_and(|out| continues(&out, state)) {
             return Ok(());
         }
         self.state = *state;
@@ -240,7 +240,7 @@ where
         let (q, v) = self.derivative_at_state(m)?;
         if let Some(h) = self.settings.h_initial() {
             self.h = h;
-        } else if !(self.h > T::zero()) {
+        } else if self.h <= T::zero() || !self.h.is_finite() {
             self.h = self.initial_step(m, &q, &v)?;
         }
         self.h = self.h.min(self.settings.h_max());
@@ -391,11 +391,7 @@ where
     /// after a rejection: a rejected last step shrinks like any other, so that a step which
     /// cannot move the clock fails with [`Error::StepSizeUnderflow`] instead of retrying the
     /// same stretched step for ever. A step whose new state is not finite counts as rejected.
-    pub(super) fn advance<M: Mechanism<T, N>>(
-        &mut self,
-        m: &M,
-        t_end: T,
-    ) -> Result<(), Error> {
+    pub(super) fn advance<M: Mechanism<T, N>>(&mut self, m: &M, t_end: T) -> Result<(), Error> {
         let (fq, fv) = self.derivative_at_state(m)?;
         self.kq[0] = fq;
         self.kv[0] = fv;
@@ -580,7 +576,10 @@ where
 }
 
 /// `t_end` when it is finite and not before `state.t`.
-pub(super) fn check_end<T: Real, const N: usize>(state: &State<T, N>, t_end: T) -> Result<T, Error> {
+pub(super) fn check_end<T: Real, const N: usize>(
+    state: &State<T, N>,
+    t_end: T,
+) -> Result<T, Error> {
     if t_end.is_finite() && t_end >= state.t {
         Ok(t_end)
     } else {
@@ -591,11 +590,10 @@ pub(super) fn check_end<T: Real, const N: usize>(state: &State<T, N>, t_end: T) 
     }
 }
 
-impl<T, M, P, const N: usize, const S: usize, const R: usize> Integrator<T, N, M>
+impl<T, P, const N: usize, const S: usize, const R: usize> Method
     for EmbeddedRungeKutta<T, N, S, R, P>
 where
     T: Real,
-    M: Mechanism<T, N>,
     P: EmbeddedPair<S, R>,
 {
     const NAME: &'static str = P::NAME;
@@ -609,6 +607,18 @@ where
         jacobians: 0,
     };
 
+    fn last_step(&self) -> Work {
+        self.work
+    }
+}
+
+impl<T, M, P, const N: usize, const S: usize, const R: usize> Integrator<T, N, M>
+    for EmbeddedRungeKutta<T, N, S, R, P>
+where
+    T: Real,
+    M: Mechanism<T, N>,
+    P: EmbeddedPair<S, R>,
+{
     /// Lands on `state.t + dt` through the continuous extension, the internal steps as long
     /// as the tolerance allows (they run ahead of the landing; the next call from this one's
     /// result continues from them).
@@ -621,9 +631,5 @@ where
             .map_err(|f| f.error);
         self.end_work(evaluations);
         result
-    }
-
-    fn last_step(&self) -> Work {
-        self.work
     }
 }

@@ -61,10 +61,7 @@ where
     P: EmbeddedPair<S, R>,
 {
     /// Computes the dense coefficients of the last step, evaluating its extra stages.
-    pub(super) fn prepare_dense<M: Mechanism<T, N>>(
-        &mut self,
-        m: &M,
-    ) -> Result<(), Error> {
+    pub(super) fn prepare_dense<M: Mechanism<T, N>>(&mut self, m: &M) -> Result<(), Error> {
         if self.hermite.is_some() {
             return Ok(());
         }

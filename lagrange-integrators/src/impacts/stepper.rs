@@ -5,8 +5,8 @@ use super::active_rows::{independent, ActiveRows};
 
 use super::impulse::Rows;
 use super::{ContactModel, Contacts, Impact};
-use crate::integrator::check_step;
-use crate::{Cost, Integrator};
+use crate::integrator::{check_step, continues};
+use crate::{Cost, Integrator, Method, Work};
 use lagrange_core::constraints::Projection;
 use lagrange_core::nalgebra::SVector;
 use lagrange_core::{Error, Mechanism, Real, State};
@@ -186,7 +186,7 @@ where
         F: FnMut(&Impact<T, N, C>),
     {
         let dt = check_step(state, dt)?;
-        if self.last.as_ref() != Some(state) {
+        if !self.last.is_some_and(|last| continues(&last, state)) {
             self.start(state)?;
         }
         let max_events = 4 * C + 8;
@@ -334,12 +334,8 @@ where
     }
 }
 
-impl<T, M, I, K, const N: usize, const C: usize> Integrator<T, N, M> for ContactStepper<T, N, C, I, K>
-where
-    T: Real,
-    M: Mechanism<T, N>,
-    I: for<'a> Integrator<T, N, ActiveRows<'a, M, K, T, C>>,
-    K: Contacts<T, N, C>,
+impl<T: Real, I: Method, K, const N: usize, const C: usize> Method
+    for ContactStepper<T, N, C, I, K>
 {
     const NAME: &'static str = I::NAME;
     const ORDER: u32 = I::ORDER;
@@ -347,6 +343,19 @@ where
     /// `log2(dt / time_tolerance)` steps of it.
     const COST: Cost = I::COST;
 
+    fn last_step(&self) -> Work {
+        self.integrator.last_step()
+    }
+}
+
+impl<T, M, I, K, const N: usize, const C: usize> Integrator<T, N, M>
+    for ContactStepper<T, N, C, I, K>
+where
+    T: Real,
+    M: Mechanism<T, N>,
+    I: for<'a> Integrator<T, N, ActiveRows<'a, M, K, T, C>>,
+    K: Contacts<T, N, C>,
+{
     /// One step with contacts; see [`ContactStepper::step_observed`].
     ///
     /// # Errors

@@ -137,7 +137,7 @@ fn variational_energy(dt: f64, steps: u64) -> Result<(f64, f64, f64), Error> {
     let e0 = dp.energy(&start) - rest;
     let tenth = steps / 10;
     let (mut first, mut last, mut max, mut k) = (0.0f64, 0.0f64, 0.0f64, 0u64);
-    VariationalMidpoint::default().integrate_with(&system, &start, dt, steps, |s, _| {
+    VariationalMidpoint::default().integrate_with(&system, &start, dt, steps, |s| {
         k += 1;
         let e = ((dp.energy(s) - rest - e0) / e0).abs();
         max = max.max(e);

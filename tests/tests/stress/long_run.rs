@@ -26,7 +26,7 @@ struct Windows {
 /// `steps` steps of `integrator` from the release state, energy measured in f64 from the
 /// widened state (so that f32 runs are judged on their state, not on an f32 energy sum), with
 /// `V = 0` at the hanging rest state.
-fn energy_windows<T: Real, I: Integrator<T, 1>>(
+fn energy_windows<T: Real, I: Integrator<T, 1, SimplePendulum<T>>>(
     mut integrator: I,
     dt: f64,
     steps: u64,

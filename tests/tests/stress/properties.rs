@@ -30,8 +30,8 @@ fn config() -> ProptestConfig {
 }
 
 /// A library result inside a property.
-fn ok<V>(r: Result<V, Error>) -> Result<V, TestCaseError> {
-    r.map_err(|e| TestCaseError::fail(format!("unexpected error: {e}")))
+fn ok<V, E: Into<Error>>(r: Result<V, E>) -> Result<V, TestCaseError> {
+    r.map_err(|e| TestCaseError::fail(format!("unexpected error: {}", e.into())))
 }
 
 /// Length of the short runs, steps.
@@ -414,7 +414,7 @@ fn constructors_refuse<T: Real>(
 
 /// One step of `integrator` from a state with a non-finite component is `NonFiniteState`; a
 /// step of zero or non-finite size is `InvalidParameter { name: "dt" }`.
-fn refuses_state<T: Real, I: Integrator<T, N>, M: Mechanism<T, N>, const N: usize>(
+fn refuses_state<T: Real, I: Integrator<T, N, M>, M: Mechanism<T, N>, const N: usize>(
     mut integrator: I,
     m: &M,
     bad: &State<T, N>,

@@ -35,8 +35,8 @@ fn config() -> ProptestConfig {
 }
 
 /// A library result inside a property.
-fn ok<V>(r: Result<V, Error>) -> Result<V, TestCaseError> {
-    r.map_err(|e| TestCaseError::fail(format!("unexpected error: {e}")))
+fn ok<V, E: Into<Error>>(r: Result<V, E>) -> Result<V, TestCaseError> {
+    r.map_err(|e| TestCaseError::fail(format!("unexpected error: {}", e.into())))
 }
 
 /// `x` in precision `T`.

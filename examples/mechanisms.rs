@@ -1,14 +1,14 @@
-//! `cargo xtask demo`, part two: the standard mechanisms. For each, RK4 at dt = 1e-3 over 10 s
+//! The standard mechanisms of `lagrange-systems`. For each, RK4 at dt = 1e-3 over 10 s
 //! (relative energy error, ns per step) and the cost of one acceleration evaluation, in f64 and
 //! f32; the n-link chain's cost against N; and each integrator's position error on the Kepler
 //! orbit of problem P4 after 10 periods.
+//!
+//! `cargo run --release --example mechanisms`
 
-use crate::demo::{ns_per_step, TIMING_RUNS};
-use lagrange_core::nalgebra::SVector;
-use lagrange_core::{
-    solve_spd, Error, GeneralizedForce, Lagrangian, Mechanism, Real, Scalar, State,
-};
-use lagrange_integrators::{ExplicitEuler, Integrator, Rk4, SemiImplicitEuler, VelocityVerlet};
+use lagrange_core::solve_spd;
+use lagrange_examples::{ns_per_step, TIMING_RUNS};
+use lagrange_integrators::prelude::*;
+use lagrange_integrators::{ExplicitEuler, SemiImplicitEuler, VelocityVerlet};
 use lagrange_systems::exact::kepler_orbit;
 use lagrange_systems::{
     Acrobot, BeadOnRotatingHoop, CartPole, DoublePendulum, ElasticPendulum, FallingParticle,
@@ -227,7 +227,7 @@ impl<T: Real, const N: usize, M: Mechanism<T, N>> Mechanism<T, N> for CholeskyPa
 
 /// Problem P4 (mu = 1, a = 1, e = 0.5 from periapsis) for 10 periods at dt = 1e-3 with `I`:
 /// the position error against Kepler's equation.
-fn kepler_error<I: Integrator<f64, 2>>(mut integrator: I) -> Result<f64, Error> {
+fn kepler_error<I: Integrator<f64, 2, Kepler<f64>>>(mut integrator: I) -> Result<f64, Error> {
     let kepler = Kepler::new(1.0)?;
     let start = kepler_orbit(1.0, 1.0, 0.5, 0.0)?;
     let steps = (20.0 * core::f64::consts::PI / DT).round() as u64;
@@ -238,8 +238,7 @@ fn kepler_error<I: Integrator<f64, 2>>(mut integrator: I) -> Result<f64, Error> 
     Ok((r * phi.cos() - re * phie.cos()).hypot(r * phi.sin() - re * phie.sin()))
 }
 
-/// Prints the tables.
-pub fn run() -> Result<(), String> {
+fn main() -> Result<(), String> {
     let text = |e: Error| e.to_string();
     let (wide, narrow) = (rows::<f64>().map_err(text)?, rows::<f32>().map_err(text)?);
     println!("\nStandard mechanisms: RK4 dt=1e-3, 10 s: relative energy error and ns/step");
