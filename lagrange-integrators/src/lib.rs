@@ -33,8 +33,8 @@
 //! real-time loops: an accumulator, a cap on steps per frame, interpolated states to draw.
 //!
 //! [`Projected`] wraps any of them to project onto constraints after every step;
-//! [`ContactStepper`] ([`impacts`]) wraps any of them to step through impacts and resting
-//! contacts.
+//! [`ContactStepper`] wraps any of them to step through impacts and resting contacts (the laws
+//! of [`lagrange_core::constraints::contact`]).
 //!
 //! ```
 //! use lagrange_core::prelude::*;
@@ -54,10 +54,10 @@
 
 mod adaptive;
 mod backward_euler;
+mod contact_stepper;
 mod explicit_euler;
 mod fixed_timestep;
 mod gauss_legendre;
-pub mod impacts;
 mod implicit_midpoint;
 mod implicit_rk;
 mod integrator;
@@ -77,13 +77,14 @@ pub use adaptive::{
     EmbeddedRungeKutta, Statistics, Stop,
 };
 pub use backward_euler::{BackwardEuler, BackwardEulerTableau};
+pub use contact_stepper::ContactStepper;
 pub use explicit_euler::ExplicitEuler;
 pub use fixed_timestep::{FixedTimestep, Frame};
 pub use gauss_legendre::{GaussLegendre2, GaussLegendre2Tableau};
-pub use impacts::{ContactModel, ContactStepper, Contacts, Impact};
 pub use implicit_midpoint::{ImplicitMidpoint, MidpointTableau};
 pub use implicit_rk::{ImplicitRungeKutta, ImplicitTableau};
 pub use integrator::{Clock, Cost, Failure, Integrator, Method, Work};
+pub use lagrange_core::constraints::contact::{ActiveRows, ContactModel, Contacts, Impact};
 pub use newton::NewtonSettings;
 pub use projected::Projected;
 pub use radau_iia::{RadauIIA2, RadauIIA2Tableau};

@@ -104,7 +104,7 @@ impl<T: Real> Stabilization<T> {
     /// The right-hand side of the acceleration-level constraint equation `J q'' = target`:
     /// `-J'q'` without stabilisation, `-J'q' - 2 alpha (J q') - beta^2 phi` with Baumgarte.
     /// `phi` is called only when `beta` is not zero.
-    pub fn target<const C: usize>(
+    pub(crate) fn target<const C: usize>(
         &self,
         velocity_product: &SVector<T, C>,
         velocity_residual: &SVector<T, C>,
@@ -150,7 +150,7 @@ pub struct ConstrainedAcceleration<T: Real, const N: usize, const C: usize> {
 /// # Errors
 /// [`Error::RedundantConstraints`] for dependent or singular active rows;
 /// [`Error::NonFiniteState`]; whatever the mechanism's law returns.
-pub fn constrained_acceleration<T, M, K, F, const N: usize, const C: usize>(
+pub(crate) fn constrained_acceleration<T, M, K, F, const N: usize, const C: usize>(
     mechanism: &M,
     constraints: &K,
     stabilization: &Stabilization<T>,
@@ -191,7 +191,7 @@ where
 ///
 /// # Errors
 /// [`Error::NonFiniteState`] when the result is not finite.
-pub fn solve_kkt<T: Real, const N: usize, const C: usize>(
+pub(crate) fn solve_kkt<T: Real, const N: usize, const C: usize>(
     schur: &Schur<T, N, C>,
     free_acceleration: &SVector<T, N>,
     target: &SVector<T, C>,

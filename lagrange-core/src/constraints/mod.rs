@@ -3,12 +3,12 @@
 //! - [`Constraints`]: `C` holonomic (`phi(q) = 0`) or Pfaffian (`A(q) q' = 0`) rows, with their
 //!   Jacobian `J` and velocity-product term `J'q'`; hand-derived, or from `phi` or `A` alone by
 //!   dual numbers through [`Holonomic`] and [`Pfaffian`].
-//! - [`Schur`]: the factored Schur complement `J M^-1 J^T`, fixed-size, on the stack; the
-//!   shared core of every solve below. Dependent rows give
+//! - The [`Constrained`] wrapper (a free mechanism and its rows, [`Held`] together or written as
+//!   one type): `q''` and the multipliers `lambda` (the constraint forces) from the KKT system,
+//!   solved inside by its Schur complement `J M^-1 J^T` (fixed-size, on the stack), so that any
+//!   integrator steps a constrained mechanism. Dependent rows give
 //!   [`Error::RedundantConstraints`](crate::Error::RedundantConstraints).
-//! - [`constrained_acceleration`] and the [`Constrained`] wrapper (a free mechanism and its rows,
-//!   [`Held`] together or written as one type): `q''` and the multipliers `lambda` (the
-//!   constraint forces), so that any integrator steps a constrained mechanism.
+//! - [`contact`]: unilateral contacts, their rows in force and their impacts.
 //! - Drift control: [`Stabilization::Baumgarte`] inside the acceleration, or a
 //!   [`Projection`] back onto `phi = 0` and `J q' = 0` after each step.
 //! - Diagnostics on demand: [`Constraints::residual`] and [`Constraints::check_state`].
@@ -18,16 +18,16 @@
 
 mod automatic;
 mod constrained;
+pub mod contact;
 mod projection;
 mod schur;
 mod set;
 
 pub use automatic::{Holonomic, HolonomicConstraints, Pfaffian, PfaffianConstraints};
-pub use constrained::{
-    constrained_acceleration, solve_kkt, Constrained, ConstrainedAcceleration, Held, Stabilization,
-};
+pub(crate) use constrained::constrained_acceleration;
+pub use constrained::{Constrained, ConstrainedAcceleration, Held, Stabilization};
 pub use projection::Projection;
-pub use schur::Schur;
+pub(crate) use schur::Schur;
 pub use set::{Constraints, Residual};
 
 use crate::Real;

@@ -19,7 +19,7 @@ use nalgebra::{SMatrix, SVector};
 /// `lambda = S^-1 r` ([`Schur::multipliers`]) and the mass-weighted correction
 /// `dq = M^-1 J^T S^-1 r` ([`Schur::correction`]) that changes `J q` by exactly `r`.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Schur<T: Real, const N: usize, const C: usize> {
+pub(crate) struct Schur<T: Real, const N: usize, const C: usize> {
     jacobian: SMatrix<T, C, N>,
     mobility: SMatrix<T, N, C>,
     factor: SMatrix<T, C, C>,
@@ -39,7 +39,7 @@ impl<T: Real, const N: usize, const C: usize> Schur<T, N, C> {
     /// [`Error::RedundantConstraints`] naming the first dependent active row;
     /// [`Error::NonFiniteState`] when `S` is not finite; whatever
     /// [`Mechanism::solve_mass`] returns.
-    pub fn new<M, K>(
+    pub(crate) fn new<M, K>(
         mechanism: &M,
         constraints: &K,
         state: &State<T, N>,
@@ -61,7 +61,7 @@ impl<T: Real, const N: usize, const C: usize> Schur<T, N, C> {
     ///
     /// # Errors
     /// As [`Schur::new`], with `solve_mass`'s errors.
-    pub fn from_parts<F>(
+    pub(crate) fn from_parts<F>(
         jacobian: SMatrix<T, C, N>,
         mut solve_mass: F,
         active: &[bool; C],
@@ -95,20 +95,14 @@ impl<T: Real, const N: usize, const C: usize> Schur<T, N, C> {
 
     /// The Jacobian of the active rows (inactive rows are zero).
     #[must_use]
-    pub fn jacobian(&self) -> &SMatrix<T, C, N> {
+    pub(crate) fn jacobian(&self) -> &SMatrix<T, C, N> {
         &self.jacobian
-    }
-
-    /// The rows taking part.
-    #[must_use]
-    pub fn active(&self) -> &[bool; C] {
-        &self.active
     }
 
     /// `S^-1 r` on the active rows, zero on the inactive ones (whose entries of `r` are
     /// ignored): the multipliers or impulses that change `J q` (or `J q'`) by `r`.
     #[must_use]
-    pub fn multipliers(&self, r: &SVector<T, C>) -> SVector<T, C> {
+    pub(crate) fn multipliers(&self, r: &SVector<T, C>) -> SVector<T, C> {
         let mut x = SVector::<T, C>::from_fn(|i, _| if self.active[i] { r[i] } else { T::zero() });
         let l = &self.factor;
         for i in 0..C {
@@ -131,14 +125,14 @@ impl<T: Real, const N: usize, const C: usize> Schur<T, N, C> {
     /// `M^-1 J^T lambda`: the change of `q''` (or `q'`, or `q`) that the generalized force
     /// (impulse, displacement) `J^T lambda` causes.
     #[must_use]
-    pub fn response(&self, lambda: &SVector<T, C>) -> SVector<T, N> {
+    pub(crate) fn response(&self, lambda: &SVector<T, C>) -> SVector<T, N> {
         self.mobility * lambda
     }
 
     /// `M^-1 J^T S^-1 r`: the smallest change in the mass-weighted norm that changes `J x` by
     /// `r` on the active rows.
     #[must_use]
-    pub fn correction(&self, r: &SVector<T, C>) -> SVector<T, N> {
+    pub(crate) fn correction(&self, r: &SVector<T, C>) -> SVector<T, N> {
         self.response(&self.multipliers(r))
     }
 }

@@ -3,9 +3,9 @@
 
 use super::active_rows::independent;
 use super::{ContactModel, Contacts};
-use lagrange_core::constraints::Schur;
-use lagrange_core::nalgebra::SVector;
-use lagrange_core::{Error, Mechanism, Real, State};
+use crate::constraints::Schur;
+use crate::nalgebra::SVector;
+use crate::{Error, Mechanism, Real, State};
 
 /// One impact: the state just before and just after the velocity jump.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -56,15 +56,25 @@ struct Jump<T: Real, const N: usize, const C: usize> {
     kept: [bool; C],
 }
 
-/// What an impact acts on: the contact set and the rows' roles.
-pub(crate) struct Rows<'a, K, T, const C: usize> {
-    pub(crate) contacts: &'a K,
-    pub(crate) model: &'a ContactModel<T>,
+/// The impact law of a contact set: what an impact acts on, the rows' roles and the model.
+#[derive(Debug, Clone, Copy)]
+pub struct Impacts<'a, T, const C: usize, K> {
+    contacts: &'a K,
+    model: &'a ContactModel<T>,
     /// Bilateral rows: their velocity residual stays zero through the impact.
-    pub(crate) bilateral: [bool; C],
+    bilateral: [bool; C],
 }
 
-impl<K, T: Real, const C: usize> Rows<'_, K, T, C> {
+impl<'a, T: Real, const C: usize, K> Impacts<'a, T, C, K> {
+    /// Impacts on `contacts` under `model`, the rows marked `bilateral` held throughout.
+    pub fn new(contacts: &'a K, model: &'a ContactModel<T>, bilateral: [bool; C]) -> Self {
+        Self {
+            contacts,
+            model,
+            bilateral,
+        }
+    }
+
     /// The velocity jump at `state` where the contacts `struck` hit, with the contacts in
     /// `resting` (updated: contacts that come to rest join, contacts the impact lifts leave).
     ///
@@ -90,7 +100,11 @@ impl<K, T: Real, const C: usize> Rows<'_, K, T, C> {
     /// impulse (at most `mu` times its normal impulse, never reversing the sliding) and the
     /// velocities are projected once more onto the bilateral and resting rows; both only
     /// remove energy.
-    pub(crate) fn impact<M, const N: usize>(
+    ///
+    /// # Errors
+    /// [`Error::RedundantConstraints`] for dependent bilateral rows; [`Error::NonFiniteState`];
+    /// whatever [`Mechanism::solve_mass`] returns.
+    pub fn impact<M, const N: usize>(
         &self,
         mechanism: &M,
         state: &State<T, N>,

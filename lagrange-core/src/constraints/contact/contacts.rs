@@ -1,9 +1,9 @@
 //! [`Contacts`]: unilateral constraints `g(q) >= 0`, with an optional tangent for friction.
 
-use lagrange_core::constraints::{Constraints, Holonomic, HolonomicConstraints};
-use lagrange_core::nalgebra::SMatrix;
-use lagrange_core::nalgebra::SVector;
-use lagrange_core::Real;
+use crate::constraints::{Constraints, Holonomic, HolonomicConstraints};
+use crate::nalgebra::SMatrix;
+use crate::nalgebra::SVector;
+use crate::Real;
 
 /// A set of `C` rows of which some are unilateral contacts `g_i(q) >= 0` (ground, walls,
 /// joint limits on a coordinate): the gap `g` is the row's

@@ -1,10 +1,11 @@
-//! [`ContactStepper`]: fixed steps with contacts found inside the step, impacts at the contact
-//! time, and resting contacts held as constraints.
+//! [`ContactStepper`]: any integrator stepping through contacts: found inside the step, impacts
+//! at the contact time, resting contacts held as constraints (the laws of
+//! [`lagrange_core::constraints::contact`]).
 
-use super::active_rows::{independent, ActiveRows};
+use lagrange_core::constraints::contact::{
+    drop_dependent_contacts, ActiveRows, ContactModel, Contacts, Impact, Impacts,
+};
 
-use super::impulse::Rows;
-use super::{ContactModel, Contacts, Impact};
 use crate::integrator::{check_step, continues};
 use crate::{Cost, Integrator, Method, Work};
 use lagrange_core::constraints::Projection;
@@ -142,23 +143,16 @@ fn held<const C: usize>(bilateral: &[bool; C], resting: &[bool; C]) -> [bool; C]
     core::array::from_fn(|i| bilateral[i] || resting[i])
 }
 
-/// The mechanism the inner integrator steps between events: `mechanism` held by the
-/// bilateral and resting rows of `contacts`, with `model`'s friction.
+/// The law the inner integrator steps between events: `mechanism` held by the bilateral and
+/// resting rows of `contacts`, with `model`'s friction.
 fn active<'a, M, K, T: Real, const C: usize>(
     mechanism: &'a M,
     contacts: &'a K,
     model: &ContactModel<T>,
     bilateral: &[bool; C],
     resting: &[bool; C],
-) -> ActiveRows<'a, M, K, T, C> {
-    ActiveRows {
-        mechanism,
-        contacts,
-        active: held(bilateral, resting),
-        unilateral: core::array::from_fn(|i| !bilateral[i]),
-        friction: model.friction(),
-        slip_speed: model.rest_speed(),
-    }
+) -> ActiveRows<'a, T, C, M, K> {
+    ActiveRows::new(mechanism, contacts, model, bilateral, resting)
 }
 
 impl<T, I, K, const N: usize, const C: usize> ContactStepper<T, N, C, I, K>
@@ -182,7 +176,7 @@ where
     ) -> Result<State<T, N>, Error>
     where
         M: Mechanism<T, N>,
-        I: for<'a> Integrator<T, N, ActiveRows<'a, M, K, T, C>>,
+        I: for<'a> Integrator<T, N, ActiveRows<'a, T, C, M, K>>,
         F: FnMut(&Impact<T, N, C>),
     {
         let dt = check_step(state, dt)?;
@@ -212,16 +206,12 @@ where
                 break;
             }
             let (lo, at, struck) = self.locate(mechanism, &s, &start_gaps, remaining, crossed)?;
-            let rows = Rows {
-                contacts: &self.contacts,
-                model: &self.model,
-                bilateral: self.bilateral,
-            };
-            let (after, impact) = rows.impact(mechanism, &at, struck, &mut self.resting)?;
+            let impacts = Impacts::new(&self.contacts, &self.model, self.bilateral);
+            let (after, impact) = impacts.impact(mechanism, &at, struck, &mut self.resting)?;
             // Resting contacts that depend on the others (more of them than degrees of
             // freedom) are left free: the others hold the motion.
             let mut held = self.held();
-            independent(
+            drop_dependent_contacts(
                 mechanism,
                 &self.contacts,
                 &after,
@@ -254,7 +244,7 @@ where
                 &self.bilateral,
                 &self.resting,
             );
-            let (_, still) = rows.solve(&s, &lagrange_core::NoForce)?;
+            let still = rows.still_in_force(&s)?;
             for (r, kept) in self.resting.iter_mut().zip(still) {
                 *r = *r && kept;
             }
@@ -302,7 +292,7 @@ where
     ) -> Result<(T, State<T, N>, [bool; C]), Error>
     where
         M: Mechanism<T, N>,
-        I: for<'a> Integrator<T, N, ActiveRows<'a, M, K, T, C>>,
+        I: for<'a> Integrator<T, N, ActiveRows<'a, T, C, M, K>>,
     {
         let (mut lo, mut hi, mut at, mut struck) = (T::zero(), remaining, *s, crossed);
         while hi - lo > self.model.time_tolerance() {
@@ -353,7 +343,7 @@ impl<T, M, I, K, const N: usize, const C: usize> Integrator<T, N, M>
 where
     T: Real,
     M: Mechanism<T, N>,
-    I: for<'a> Integrator<T, N, ActiveRows<'a, M, K, T, C>>,
+    I: for<'a> Integrator<T, N, ActiveRows<'a, T, C, M, K>>,
     K: Contacts<T, N, C>,
 {
     /// One step with contacts; see [`ContactStepper::step_observed`].

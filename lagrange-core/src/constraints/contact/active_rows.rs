@@ -1,19 +1,16 @@
 //! [`ActiveRows`]: a mechanism under the rows of a contact set that are in force (bilateral
-//! rows and resting contacts), which is what a [`ContactStepper`](super::ContactStepper)'s
-//! integrator steps between events.
+//! rows and resting contacts), which is what a contact stepper's integrator steps between
+//! events; and [`drop_dependent_contacts`], which keeps the rows in force independent.
 
-use super::Contacts;
-use lagrange_core::constraints::{
-    constrained_acceleration, ConstrainedAcceleration, Schur, Stabilization,
-};
-use lagrange_core::nalgebra::{SMatrix, SVector};
-use lagrange_core::{
+use super::{ContactModel, Contacts};
+use crate::constraints::{constrained_acceleration, ConstrainedAcceleration, Schur, Stabilization};
+use crate::nalgebra::{SMatrix, SVector};
+use crate::{
     Borrowed, Error, GeneralizedForce, Input, Jacobian, Lagrangian, Mechanism, Real, Scalar, State,
 };
 
-/// A mechanism held by the rows of its contact set that are in force: the law that a
-/// [`ContactStepper`](super::ContactStepper)'s inner integrator steps between events (made by
-/// the stepper, not by hand).
+/// A mechanism held by the rows of its contact set that are in force (bilateral rows and
+/// resting contacts): the law that a contact stepper's integrator steps between events.
 ///
 /// Inside every solve, a unilateral row whose multiplier comes out negative (its contact
 /// would pull) is dropped and the rest solved again, so a resting contact lets go as soon as
@@ -22,19 +19,52 @@ use lagrange_core::{
 /// force from the frictionless solve, then one more solve with the friction forces applied
 /// (exact when tangent and normal are decoupled in the mass metric, as for a point on flat
 /// ground; one fixed-point pass otherwise).
-pub struct ActiveRows<'a, M, K, T, const C: usize> {
-    pub(crate) mechanism: &'a M,
-    pub(crate) contacts: &'a K,
-    pub(crate) active: [bool; C],
-    pub(crate) unilateral: [bool; C],
-    pub(crate) friction: T,
-    pub(crate) slip_speed: T,
+#[derive(Debug, Clone, Copy)]
+pub struct ActiveRows<'a, T, const C: usize, M, K> {
+    mechanism: &'a M,
+    contacts: &'a K,
+    active: [bool; C],
+    unilateral: [bool; C],
+    friction: T,
+    slip_speed: T,
 }
 
-impl<T: Real, M, K, const C: usize> ActiveRows<'_, M, K, T, C> {
+impl<'a, T: Real, const C: usize, M, K> ActiveRows<'a, T, C, M, K> {
+    /// `mechanism` held by the rows of `contacts` in force: the `bilateral` ones and the
+    /// `resting` contacts, with `model`'s friction (a resting contact sliding faster than
+    /// the model's rest speed feels the full Coulomb force).
+    pub fn new(
+        mechanism: &'a M,
+        contacts: &'a K,
+        model: &ContactModel<T>,
+        bilateral: &[bool; C],
+        resting: &[bool; C],
+    ) -> Self {
+        Self {
+            mechanism,
+            contacts,
+            active: core::array::from_fn(|i| bilateral[i] || resting[i]),
+            unilateral: core::array::from_fn(|i| !bilateral[i]),
+            friction: model.friction(),
+            slip_speed: model.rest_speed(),
+        }
+    }
+
+    /// The rows still in force at `state`: those in force less the contacts that would pull.
+    ///
+    /// # Errors
+    /// As [`Mechanism::acceleration`] of this law.
+    pub fn still_in_force<const N: usize>(&self, state: &State<T, N>) -> Result<[bool; C], Error>
+    where
+        M: Mechanism<T, N>,
+        K: Contacts<T, N, C>,
+    {
+        Ok(self.solve(state, &crate::NoForce)?.1)
+    }
+
     /// Accelerations and multipliers at `state` with `extra` force, and the rows still in
     /// force after the pulling ones were dropped.
-    pub(crate) fn solve<F: GeneralizedForce<T, N>, const N: usize>(
+    fn solve<F: GeneralizedForce<T, N>, const N: usize>(
         &self,
         state: &State<T, N>,
         extra: &F,
@@ -132,13 +162,30 @@ fn redundant_contact<const C: usize>(
     active.get(row).copied().unwrap_or(false) && unilateral.get(row).copied().unwrap_or(false)
 }
 
-/// The Schur complement of the `active` rows with every contact (row not in `bilateral`) that
-/// depends on the rows before it left out of `active`: several contacts holding the same
-/// freedom, or more resting contacts than degrees of freedom.
+/// Leaves out of `active` every contact (row not in `bilateral`) that depends on the rows
+/// before it: several contacts holding the same freedom, or more resting contacts than degrees
+/// of freedom (the others already hold the motion, and how the force divides among them is
+/// not determined).
 ///
 /// # Errors
-/// [`Error::RedundantConstraints`] when bilateral rows depend on each other; as
-/// [`Schur::new`] otherwise.
+/// [`Error::RedundantConstraints`] when bilateral rows depend on each other;
+/// [`Error::NonFiniteState`]; whatever [`Mechanism::solve_mass`] returns.
+pub fn drop_dependent_contacts<T, M, K, const N: usize, const C: usize>(
+    mechanism: &M,
+    contacts: &K,
+    state: &State<T, N>,
+    active: &mut [bool; C],
+    bilateral: &[bool; C],
+) -> Result<(), Error>
+where
+    T: Real,
+    M: Mechanism<T, N>,
+    K: Contacts<T, N, C>,
+{
+    independent(mechanism, contacts, state, active, bilateral).map(drop)
+}
+
+/// The Schur complement of the `active` rows after [`drop_dependent_contacts`].
 pub(crate) fn independent<T, M, K, const N: usize, const C: usize>(
     mechanism: &M,
     contacts: &K,
@@ -165,7 +212,7 @@ where
     }
 }
 
-impl<T, M, K, const N: usize, const C: usize> Lagrangian<T, N> for ActiveRows<'_, M, K, T, C>
+impl<T, M, K, const N: usize, const C: usize> Lagrangian<T, N> for ActiveRows<'_, T, C, M, K>
 where
     T: Real,
     M: Lagrangian<T, N>,
@@ -182,7 +229,7 @@ where
     }
 }
 
-impl<T, M, K, const N: usize, const C: usize> Mechanism<T, N> for ActiveRows<'_, M, K, T, C>
+impl<T, M, K, const N: usize, const C: usize> Mechanism<T, N> for ActiveRows<'_, T, C, M, K>
 where
     T: Real,
     M: Mechanism<T, N>,
@@ -218,7 +265,7 @@ where
         extra: &F,
     ) -> Result<(SVector<T, N>, Jacobian<T, N>), Error> {
         if self.active.iter().any(|&on| on) {
-            lagrange_core::jacobian_by_differences(self, state, extra)
+            crate::jacobian_by_differences(self, state, extra)
         } else {
             self.mechanism.law_jacobian(state, extra)
         }

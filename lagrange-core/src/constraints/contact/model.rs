@@ -1,7 +1,7 @@
 //! [`ContactModel`]: restitution, friction, the resting threshold and the event-location
 //! tolerance of unilateral contacts.
 
-use lagrange_core::{validate, Error, Real};
+use crate::{validate, Error, Real};
 
 /// How contacts behave and how precisely their events are located.
 ///
