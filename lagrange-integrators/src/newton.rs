@@ -45,6 +45,12 @@ const SLOW_RATE: f64 = 0.5;
 /// makes Newton factorise it anew at the current iterate (simplified Newton gone stale).
 const REFRESH_RATE: f64 = 0.25;
 
+/// Simplified Newton whose rate, kept up, would still need more than this many iterations to
+/// reach the tolerance factorises its matrix anew too: a slow but steady contraction (a large
+/// step over a law whose Jacobian changes fast along it) costs more iterations than a fresh
+/// matrix, which restores Newton's quadratic convergence.
+const STALE_ITERATIONS: i32 = 4;
+
 impl<T: Real> NewtonSettings<T> {
     /// Relative `tolerance` (at least `EPSILON`, below 1) and at most `max_iterations`
     /// iterations per step (1 to 1000).
@@ -356,7 +362,10 @@ where
                 }
             } else if age <= 1 && size <= floor && exceeds(rate, slow) {
                 return Ok(iteration);
-            } else if age >= 1 && exceeds(rate, refresh) {
+            } else if age >= 1
+                && (exceeds(rate, refresh)
+                    || rate.powi(STALE_ITERATIONS) > settings.tolerance / size)
+            {
                 lu = None;
             }
         }
