@@ -193,6 +193,16 @@ fn double_pendulum_energy_over_a_million_steps() -> Result<(), Error> {
     fixed(ImplicitMidpoint::default(), &dp, &start, dt, scale).assert_bounded(p, 1.1e-5);
     fixed(GaussLegendre2::default(), &dp, &start, dt, scale).assert_bounded(p, 3e-9);
     variational(&auto, &start, dt, scale).assert_bounded(p, 2.5e-5);
+    // Yoshida's composition of the variational integrator: order 4 and symplectic for this
+    // configuration-dependent mass matrix (measured 7.05e-8, ratio last/first tenth 1.000).
+    fixed(
+        Yoshida4::<VariationalMidpoint<f64, 2>>::default(),
+        &dp,
+        &start,
+        dt,
+        scale,
+    )
+    .assert_bounded(p, 1.1e-7);
     fixed(Rk4, &dp, &start, dt, scale).assert_drifts(p);
     fixed(ExplicitEuler, &dp, &start, dt, scale).assert_gains_energy(p);
     // Reported for comparison: semi-implicit Euler (symplectic only for separable systems)
@@ -228,6 +238,15 @@ fn kepler_energy_over_a_million_steps() -> Result<(), Error> {
     fixed(ImplicitMidpoint::default(), &kepler, &start, dt, scale).assert_bounded(p, 5.5e-5);
     fixed(GaussLegendre2::default(), &kepler, &start, dt, scale).assert_bounded(p, 6e-10);
     variational(&auto, &start, dt, scale).assert_bounded(p, 2e-5);
+    // Measured 8.26e-9 (ratio last/first tenth 0.96).
+    fixed(
+        Yoshida4::<VariationalMidpoint<f64, 2>>::default(),
+        &kepler,
+        &start,
+        dt,
+        scale,
+    )
+    .assert_bounded(p, 1.3e-8);
     fixed(Rk4, &kepler, &start, dt, scale).assert_drifts(p);
     fixed(ExplicitEuler, &kepler, &start, dt, scale).assert_gains_energy(p);
     fixed(SemiImplicitEuler, &kepler, &start, dt, scale).report(p);
