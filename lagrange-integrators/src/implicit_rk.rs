@@ -41,7 +41,7 @@ pub trait ImplicitTableau<const S: usize> {
 /// the motion.
 ///
 /// Cost per step: one acceleration Jacobian, then `S` accelerations per Newton iteration
-/// ([`Integrator::last_step`] tells how many the last step took; measured on a double
+/// ([`Method::last_step`] tells how many the last step took; measured on a double
 /// pendulum, the last iteration confirming convergence: 4 to 5 at `h = 1e-2`, 3 to 4 at
 /// `h = 1e-3`; 2 for a linear mechanism).
 ///

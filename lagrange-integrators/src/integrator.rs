@@ -7,7 +7,7 @@ use lagrange_core::{Error, Mechanism, Real, State};
 /// What a step of a method costs, in evaluations of the mechanism's acceleration law, for
 /// every method alike: `fixed + per_iteration * iterations` accelerations and `jacobians`
 /// Jacobians per step, where `iterations` is the number of iterations of the step's implicit
-/// equations (Newton, or a fixed point), which [`Integrator::last_step`] reports.
+/// equations (Newton, or a fixed point), which [`Method::last_step`] reports.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Cost {

@@ -41,9 +41,9 @@ pub const YOSHIDA4_WEIGHTS: [f64; 3] = [
 /// of `w1 h`, `w0 h` (negative: a step back) and `w1 h` ([`YOSHIDA4_WEIGHTS`]).
 ///
 /// Order 4, fixed step, as explicit or implicit as its base; 3 base steps per step (6
-/// acceleration evaluations over [`StormerVerlet`] where the acceleration does not depend on
+/// acceleration evaluations over [`StormerVerlet`](crate::StormerVerlet) where the acceleration does not depend on
 /// `q'`). Symmetric for any mechanism; symplectic wherever its base is (over
-/// [`StormerVerlet`]: constant mass matrix and forces of `q` only, where it is Forest-Ruth's
+/// [`StormerVerlet`](crate::StormerVerlet): constant mass matrix and forces of `q` only, where it is Forest-Ruth's
 /// method), with a bounded `O(h^4)` energy error and no drift there; on regular motion of
 /// other conservative mechanisms (pendulum chains, polar coordinates) reversibility keeps the
 /// energy error bounded too. The step back makes its error constant larger than RK4's at the

@@ -16,7 +16,8 @@
 //!   checks the library's against them.
 //! - `mutants`: mutation testing of the numerical core with `cargo-mutants`, a report per file
 //!   under `target/mutants/` (hours; not part of `ci`).
-//! - `ci`: format check, clippy with `-D warnings`, test, cross, qemu.
+//! - `ci`: format check, clippy with `-D warnings`, the library crates' docs (warnings denied)
+//!   and packages, test, cross, qemu.
 
 mod cmd;
 mod cross;
@@ -101,10 +102,38 @@ const LONG_TEST: [&[&str]; 1] = [&[
     "--ignored",
 ]];
 
+/// The publishable library crates.
+const LIBRARIES: [&str; 6] = [
+    "-p",
+    "lagrange-core",
+    "-p",
+    "lagrange-integrators",
+    "-p",
+    "lagrange-systems",
+];
+
+/// The library crates' documentation, every feature on, with rustdoc's warnings denied; and
+/// their packages, each built from its packaged files against the others'.
+fn publishable() -> Result<(), String> {
+    let doc = cmd::run(
+        cmd::cargo()
+            .env("RUSTDOCFLAGS", "-D warnings")
+            .args(["doc", "--quiet", "--no-deps", "--all-features"])
+            .args(LIBRARIES),
+    );
+    let package = cmd::run(
+        cmd::cargo()
+            .args(["package", "--quiet", "--allow-dirty"])
+            .args(LIBRARIES),
+    );
+    doc.and(package)
+}
+
 /// Everything CI checks; every step runs and every failure is reported at the end.
 fn ci() -> Result<(), String> {
     let failures: Vec<String> = [
         cmd::run_all(&CHECKS),
+        publishable(),
         cmd::run_all(&TEST),
         cmd::run_all(&DOC_TEST),
         cmd::run_all(&LONG_TEST),

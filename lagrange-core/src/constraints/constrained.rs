@@ -215,8 +215,18 @@ pub(crate) fn solve_kkt<T: Real, const N: usize, const C: usize>(
 /// A mechanism under `C` constraints, from one value `P` that is both the unconstrained
 /// mechanism and its constraint rows (a standard constrained mechanism of `lagrange-systems`,
 /// or [`Held`]: any mechanism with rows of your own, made by
-/// [`Mechanism::held_by`]). It moves as the KKT system of [`constrained_acceleration`]
-/// says, so every integrator steps it unchanged.
+/// [`Mechanism::held_by`]). It moves as its KKT system says, so every integrator steps it
+/// unchanged:
+///
+/// ```text
+/// [ M  J^T ] [  q''    ]   [ f + Q + extra                     ]
+/// [ J   0  ] [ -lambda ] = [ -J'q' - 2 alpha J q' - beta^2 phi ]     (Baumgarte terms when chosen)
+/// ```
+///
+/// solved by its Schur complement: `a0 = M^-1 (f + Q + extra)` (the unconstrained law, a
+/// closed form where there is one), `(J M^-1 J^T) lambda = target - J a0`,
+/// `q'' = a0 + M^-1 J^T lambda`: one law, `C` mass solves, one Jacobian and one
+/// velocity-product evaluation (plus `phi` for Baumgarte) and a `C x C` Cholesky, on the stack.
 ///
 /// Its law ([`Mechanism::law`]) is the constrained one; mass matrix, `f`, `Q`, energies and
 /// `solve_mass` are the unconstrained mechanism's. Forces added by
@@ -298,7 +308,8 @@ impl<T: Real, const C: usize, P> Constrained<T, C, P> {
     /// Accelerations and multipliers at `state`.
     ///
     /// # Errors
-    /// As [`constrained_acceleration`].
+    /// [`Error::RedundantConstraints`] for dependent or singular rows;
+    /// [`Error::NonFiniteState`]; whatever the unconstrained mechanism's law returns.
     pub fn solve<const N: usize>(
         &self,
         state: &State<T, N>,
@@ -312,7 +323,8 @@ impl<T: Real, const C: usize, P> Constrained<T, C, P> {
     /// As [`Constrained::solve`] with an extra generalized force.
     ///
     /// # Errors
-    /// As [`constrained_acceleration`].
+    /// [`Error::RedundantConstraints`] for dependent or singular rows;
+    /// [`Error::NonFiniteState`]; whatever the unconstrained mechanism's law returns.
     pub fn solve_with<F: GeneralizedForce<T, N>, const N: usize>(
         &self,
         state: &State<T, N>,

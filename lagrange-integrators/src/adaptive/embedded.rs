@@ -600,7 +600,7 @@ where
     const ORDER: u32 = P::ORDER;
     /// Per internal step accepted (`fixed`, with the first stage of the next step reused), and
     /// per rejected attempt (`per_iteration`: a rejection is an iteration of the step-size
-    /// search); [`Integrator::last_step`] reports both counts of a call.
+    /// search); [`Method::last_step`] reports both counts of a call.
     const COST: Cost = Cost {
         fixed: P::FSAL as u32,
         per_iteration: P::FSAL as u32,
