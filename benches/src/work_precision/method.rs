@@ -6,11 +6,12 @@ use super::ode_peer::Peer;
 use super::outcome::{Observer, Outcome};
 use super::problem::Problem;
 use super::real::BenchReal;
-use lagrange_core::{Error, EulerLagrange, Mechanism, Real, State};
+use lagrange_core::{Error, Mechanism, Real, State};
 use lagrange_integrators::{
-    AdaptiveSettings, BackwardEuler, Dop853Pair, Dopri5Pair, EmbeddedPair, EmbeddedRungeKutta,
-    ExplicitEuler, GaussLegendre2, ImplicitMidpoint, Integrator, RadauIIA2, Rk4, SemiImplicitEuler,
-    StormerVerlet, VariationalMidpoint, VelocityVerlet, Yoshida4,
+    AdaptiveSettings, BackwardEuler, Clock, Dop853Pair, Dopri5Pair, EmbeddedPair,
+    EmbeddedRungeKutta, ExplicitEuler, Failure, GaussLegendre2, ImplicitMidpoint, Integrator,
+    RadauIIA2, Rk4, SemiImplicitEuler, StormerVerlet, VariationalMidpoint, VelocityVerlet,
+    Yoshida4,
 };
 use std::marker::PhantomData;
 
@@ -153,7 +154,8 @@ pub fn for_each(v: &mut impl MethodVisitor) {
     v.visit(&Library(GaussLegendre2Family));
     v.visit(&Library(BackwardEulerFamily));
     v.visit(&Library(RadauIIA2Family));
-    v.visit(&Variational);
+    v.visit(&Library(VariationalMidpointFamily));
+    v.visit(&Library(Yoshida4VariationalFamily));
     v.visit(&Adaptive::<7, 1, Dopri5Pair>::new(Tableau::DormandPrince54));
     v.visit(&Adaptive::<16, 4, Dop853Pair>::new(
         Tableau::DormandPrince853,
@@ -163,11 +165,14 @@ pub fn for_each(v: &mut impl MethodVisitor) {
     v.visit(&OdeSolvers(Peer::Dop853));
 }
 
-/// A fixed-step integrator of the library, for every scalar and dimension at once (which a
-/// bound `Integrator<T, N>` cannot say for all `T` and `N`): a family of integrator types.
+/// A fixed-step integrator of the library, for every scalar, dimension and mechanism at once
+/// (which a bound `Integrator<T, N, M>` cannot say for all `T`, `N` and `M`): a family of
+/// integrator types, each declared by one line of [`fixed_step!`].
 pub trait FixedStep {
     /// The integrator in precision `T` for `N` degrees of freedom.
-    type Of<T: Real, const N: usize>: Integrator<T, N>;
+    type Of<T: Real, const N: usize>;
+    /// Name for tables and legends: the integrator's own.
+    const NAME: &'static str;
     /// The largest stable `h w` on an undamped linear oscillator (the imaginary-axis extent
     /// of the stability region), for the explicit methods whose value is classical.
     const LINEAR_STABILITY_LIMIT: Option<f64>;
@@ -175,6 +180,76 @@ pub trait FixedStep {
     const EXPLICIT: bool;
     /// A new integrator (default settings).
     fn make<T: Real, const N: usize>() -> Self::Of<T, N>;
+    /// [`run`] with a new integrator of the family on `mechanism`.
+    ///
+    /// # Errors
+    /// As [`run`].
+    fn run<T: Real, M: Mechanism<T, N>, const N: usize>(
+        mechanism: &M,
+        start: &State<T, N>,
+        dt: T,
+        steps: u64,
+        observe: Observer<'_, T, N>,
+    ) -> Result<Outcome<T, N>, String>;
+}
+
+/// `steps` steps of `dt` from `start` by `integrator`: one call of `integrate` when not
+/// observed; else the steps one by one as `integrate` takes them (on the same compensated
+/// clock), calling `observe` with every new state and summing the work of each
+/// (`last_step`), which the sweep checks ends at the same state to the bit.
+///
+/// # Errors
+/// The failed step, with the time it started from.
+pub fn run<T, M, I, const N: usize>(
+    mut integrator: I,
+    mechanism: &M,
+    start: &State<T, N>,
+    dt: T,
+    steps: u64,
+    observe: Observer<'_, T, N>,
+) -> Result<Outcome<T, N>, String>
+where
+    T: Real,
+    M: Mechanism<T, N>,
+    I: Integrator<T, N, M>,
+{
+    let Some(observe) = observe else {
+        return integrator
+            .integrate(mechanism, start, dt, steps)
+            .map(|end| Outcome {
+                end,
+                steps,
+                evals: None,
+                work: None,
+            })
+            .map_err(|f| f.to_string());
+    };
+    let mut s = *start;
+    let mut clock = Clock::new(start.t);
+    let (mut evals, mut jacobians) = (0, 0);
+    for step in 0..steps {
+        let mut next = integrator.step(mechanism, &s, dt).map_err(|error| {
+            Failure {
+                error,
+                step,
+                last: s,
+            }
+            .to_string()
+        })?;
+        clock.tick(dt);
+        next.t = clock.time();
+        s = next;
+        let work = integrator.last_step();
+        evals += u64::from(work.evaluations);
+        jacobians += u64::from(work.jacobians);
+        observe(&s);
+    }
+    Ok(Outcome {
+        end: s,
+        steps,
+        evals: None,
+        work: Some((evals, jacobians)),
+    })
 }
 
 /// Declares a [`FixedStep`] family per line: its marker type, the integrator type (in terms of
@@ -186,10 +261,21 @@ macro_rules! fixed_step {
             pub struct $family;
             impl FixedStep for $family {
                 type Of<T: Real, const N: usize> = $ty;
+                const NAME: &'static str =
+                    <Self::Of<f64, 1> as lagrange_integrators::Method>::NAME;
                 const LINEAR_STABILITY_LIMIT: Option<f64> = $limit;
                 const EXPLICIT: bool = $explicit;
                 fn make<T: Real, const N: usize>() -> Self::Of<T, N> {
                     $make
+                }
+                fn run<T: Real, M: Mechanism<T, N>, const N: usize>(
+                    mechanism: &M,
+                    start: &State<T, N>,
+                    dt: T,
+                    steps: u64,
+                    observe: Observer<'_, T, N>,
+                ) -> Result<Outcome<T, N>, String> {
+                    run(Self::make::<T, N>(), mechanism, start, dt, steps, observe)
                 }
             }
         )*
@@ -210,11 +296,10 @@ fixed_step! {
     GaussLegendre2Family: GaussLegendre2<T> = GaussLegendre2::default(), false, None;
     BackwardEulerFamily: BackwardEuler<T> = BackwardEuler::default(), false, None;
     RadauIIA2Family: RadauIIA2<T> = RadauIIA2::default(), false, None;
-}
-
-/// The name of a family's integrator.
-fn family_name<F: FixedStep>() -> &'static str {
-    <F::Of<f64, 1> as Integrator<f64, 1>>::NAME
+    VariationalMidpointFamily: VariationalMidpoint<T, N> =
+        VariationalMidpoint::default(), false, None;
+    Yoshida4VariationalFamily: Yoshida4<VariationalMidpoint<T, N>> =
+        Yoshida4::new(VariationalMidpoint::default()), false, None;
 }
 
 /// A fixed-step integrator of the library.
@@ -222,7 +307,7 @@ pub struct Library<F>(pub F);
 
 impl<F: FixedStep> Method for Library<F> {
     fn name(&self) -> &'static str {
-        family_name::<F>()
+        F::NAME
     }
     fn origin(&self) -> Origin {
         Origin::Library
@@ -253,74 +338,7 @@ impl<F: FixedStep> Method for Library<F> {
         let Param::Step { dt, steps } = param else {
             return None;
         };
-        let mut integrator = F::make::<T, N>();
-        let dt = T::real(dt);
-        let end = match observe {
-            Some(o) => integrator.integrate_with(mechanism, start, dt, steps, o),
-            None => integrator.integrate(mechanism, start, dt, steps),
-        };
-        Some(
-            end.map(|end| Outcome {
-                end,
-                steps,
-                evals: None,
-            })
-            .map_err(|e| e.to_string()),
-        )
-    }
-}
-
-/// The variational midpoint integrator, on the problem's mechanism as a Lagrangian system
-/// (`EulerLagrange` over it: the discrete Euler-Lagrange equations need `L`, not `q''`).
-/// It evaluates the Lagrangian in dual numbers, never `acceleration`: its evaluation count is
-/// reported as 0.
-pub struct Variational;
-
-impl Method for Variational {
-    fn name(&self) -> &'static str {
-        "variational midpoint"
-    }
-    fn origin(&self) -> Origin {
-        Origin::Library
-    }
-    fn kind(&self) -> Kind {
-        Kind::FixedStep
-    }
-    fn solve<T, P, M, const N: usize, const N2: usize>(
-        &self,
-        problem: &P,
-        _mechanism: &M,
-        start: &State<T, N>,
-        _t_end: T,
-        param: Param,
-        observe: Observer<'_, T, N>,
-    ) -> Option<Result<Outcome<T, N>, String>>
-    where
-        T: BenchReal,
-        P: Problem<N, N2>,
-        M: Mechanism<T, N>,
-    {
-        let Param::Step { dt, steps } = param else {
-            return None;
-        };
-        let system = match problem.mechanism::<T>() {
-            Ok(m) => EulerLagrange::new(m),
-            Err(e) => return Some(Err(e.to_string())),
-        };
-        let mut integrator = VariationalMidpoint::<T, N>::default();
-        let dt = T::real(dt);
-        let end = match observe {
-            Some(o) => integrator.integrate_with(&system, start, dt, steps, |s, _| o(s)),
-            None => integrator.integrate(&system, start, dt, steps),
-        };
-        Some(
-            end.map(|end| Outcome {
-                end,
-                steps,
-                evals: None,
-            })
-            .map_err(|e| e.to_string()),
-        )
+        Some(F::run(mechanism, start, T::real(dt), steps, observe))
     }
 }
 
@@ -373,30 +391,34 @@ impl<const S: usize, const R: usize, Pair: EmbeddedPair<S, R>> Method for Adapti
         let Param::Tolerance(tol) = param else {
             return None;
         };
-        let solve = || -> Result<Outcome<T, N>, Error> {
+        let solve = || -> Result<Outcome<T, N>, String> {
             let tol = T::real(tol);
-            let settings = AdaptiveSettings::new(tol, tol)?.with_max_steps(MAX_ADAPTIVE_STEPS)?;
-            let mut rk = EmbeddedRungeKutta::<T, N, S, R, Pair>::new(settings, mechanism, start)?;
+            let settings = AdaptiveSettings::new(tol, tol)
+                .and_then(|s| s.with_max_steps(MAX_ADAPTIVE_STEPS))
+                .map_err(|e| e.to_string())?;
+            let mut rk = EmbeddedRungeKutta::<T, N, S, R, Pair>::new(settings);
             let end = match observe {
-                None => rk.integrate_to(mechanism, t_end)?,
+                None => rk.integrate_to(mechanism, start, t_end),
                 // The steps of `integrate_to` (each told where the end is, so that the last
                 // lands on it), with the observer riding on a guard that never changes sign:
                 // the observed run and the timed runs are the same computation.
-                Some(o) => *rk
-                    .integrate_until_event(mechanism, t_end, |s| {
+                Some(o) => rk
+                    .integrate_until_event(mechanism, start, t_end, |s| {
                         o(s);
                         T::one()
-                    })?
-                    .state(),
-            };
+                    })
+                    .map(|stop| *stop.state()),
+            }
+            .map_err(|f| f.to_string())?;
             let stats = rk.statistics();
             Ok(Outcome {
                 end,
                 steps: stats.accepted + stats.rejected,
                 evals: None,
+                work: None,
             })
         };
-        Some(solve().map_err(|e| e.to_string()))
+        Some(solve())
     }
 }
 
@@ -449,6 +471,7 @@ impl Method for HandRk4 {
                 end,
                 steps,
                 evals: Some(4 * steps),
+                work: None,
             })
         } else {
             Err(Error::NonFiniteState.to_string())

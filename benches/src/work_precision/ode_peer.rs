@@ -172,6 +172,7 @@ where
             end,
             steps: u64::from(stats.accepted_steps + stats.rejected_steps),
             evals: None,
+            work: None,
         })
     } else {
         Err(Error::NonFiniteState.to_string())

@@ -12,6 +12,10 @@ pub struct Outcome<T: Real, const N: usize> {
     /// Acceleration evaluations, when the method counts them itself (otherwise the runner
     /// counts calls to `Mechanism::acceleration`).
     pub evals: Option<u64>,
+    /// The method's own count of its work, `(evaluations, Jacobians)` summed over its steps
+    /// (the library's fixed-step integrators, from `Integrator::last_step`), where the runner
+    /// keeps it: it sees work that calls to the law do not show.
+    pub work: Option<(u64, u64)>,
 }
 
 /// An observer of every state a solve passes through (`None` in timed runs).

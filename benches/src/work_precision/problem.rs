@@ -2,7 +2,7 @@
 //! and the energy convention of `shared/BENCH_PROBLEMS.md`.
 
 use super::real::BenchReal;
-use lagrange_core::{Error, Lagrangian, Mechanism, State};
+use lagrange_core::{Error, Mechanism, State};
 
 /// The final state a run is measured against, with where it came from.
 pub struct Reference<const N: usize> {
@@ -19,9 +19,9 @@ pub struct Reference<const N: usize> {
 /// because `ode_solvers` wants a static vector of the whole state and stable Rust cannot write
 /// `2 * N` in a type).
 pub trait Problem<const N: usize, const N2: usize> {
-    /// The mechanism simulated, in precision `T` (also a [`Lagrangian`], for the variational
-    /// integrator).
-    type Mech<T: BenchReal>: Mechanism<T, N> + Lagrangian<T, N>;
+    /// The mechanism simulated, in precision `T` (a [`Lagrangian`](lagrange_core::Lagrangian)
+    /// too, as every mechanism is: the variational integrator steps its `L`).
+    type Mech<T: BenchReal>: Mechanism<T, N>;
 
     /// Short key used in file names, the CSV and `--only`: `P1`, `P3-N20`, ...
     fn id(&self) -> &'static str;

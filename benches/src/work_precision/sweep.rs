@@ -334,6 +334,15 @@ impl<P: Problem<N, N2>, const N: usize, const N2: usize> SweepMethods<'_, P, N, 
                     failures = 0;
                     row.steps = out.steps;
                     row.evals = out.evals.unwrap_or(row.evals);
+                    // The wrapper counts calls of the law (and the value inside each
+                    // Jacobian); a method that evaluates its mechanism otherwise (the
+                    // variational integrator: the Lagrangian in dual numbers) has its own
+                    // count, which the wrapper does not see. Where both exist they agree up
+                    // to that value inside each Jacobian, which the wrapper adds.
+                    if let Some((evals, jacobians)) = out.work {
+                        row.evals = row.evals.max(evals);
+                        row.jacobians = row.jacobians.max(jacobians);
+                    }
                     row.final_error = state_error(&widen(&end), &self.reference.state);
                     row.seconds = timing.median;
                     row.runs = timing.runs;
