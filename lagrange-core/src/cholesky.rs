@@ -28,43 +28,67 @@ pub fn solve_spd<T: Real, const N: usize>(
     m: &SMatrix<T, N, N>,
     b: &SVector<T, N>,
 ) -> Result<SVector<T, N>, Error> {
-    let mut l = SMatrix::<T, N, N>::zeros();
-    for j in 0..N {
-        let mut d = m[(j, j)];
-        for k in 0..j {
-            d -= l[(j, k)] * l[(j, k)];
-        }
-        if !d.is_finite() {
-            return Err(Error::NonFiniteState);
-        }
-        if d <= m[(j, j)].abs() * T::EPSILON {
-            return Err(Error::SingularMassMatrix { pivot: j });
-        }
-        let ljj = d.sqrt();
-        l[(j, j)] = ljj;
-        for i in j + 1..N {
-            let mut s = m[(i, j)];
+    Ok(Cholesky::factor(m)?.solve(b))
+}
+
+/// The Cholesky factor `L` of a symmetric positive definite matrix, `m = L L^T`: factored once,
+/// it solves `m x = b` for any number of right-hand sides (a constant mass matrix).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Cholesky<T: Real, const N: usize> {
+    l: SMatrix<T, N, N>,
+}
+
+impl<T: Real, const N: usize> Cholesky<T, N> {
+    /// Factors `m`, reading only its lower triangle.
+    ///
+    /// # Errors
+    /// As [`solve_spd`].
+    pub fn factor(m: &SMatrix<T, N, N>) -> Result<Self, Error> {
+        let mut l = SMatrix::<T, N, N>::zeros();
+        for j in 0..N {
+            let mut d = m[(j, j)];
             for k in 0..j {
-                s -= l[(i, k)] * l[(j, k)];
+                d -= l[(j, k)] * l[(j, k)];
             }
-            l[(i, j)] = s / ljj;
+            if !d.is_finite() {
+                return Err(Error::NonFiniteState);
+            }
+            if d <= m[(j, j)].abs() * T::EPSILON {
+                return Err(Error::SingularMassMatrix { pivot: j });
+            }
+            let ljj = d.sqrt();
+            l[(j, j)] = ljj;
+            for i in j + 1..N {
+                let mut s = m[(i, j)];
+                for k in 0..j {
+                    s -= l[(i, k)] * l[(j, k)];
+                }
+                l[(i, j)] = s / ljj;
+            }
         }
+        Ok(Self { l })
     }
-    // Forward substitution L y = b, then back substitution L^T x = y, in place.
-    let mut x = *b;
-    for i in 0..N {
-        let mut s = x[i];
-        for k in 0..i {
-            s -= l[(i, k)] * x[k];
+
+    /// `x` with `m x = b`: forward substitution `L y = b`, then back substitution
+    /// `L^T x = y`, in place.
+    #[must_use]
+    pub fn solve(&self, b: &SVector<T, N>) -> SVector<T, N> {
+        let l = &self.l;
+        let mut x = *b;
+        for i in 0..N {
+            let mut s = x[i];
+            for k in 0..i {
+                s -= l[(i, k)] * x[k];
+            }
+            x[i] = s / l[(i, i)];
         }
-        x[i] = s / l[(i, i)];
-    }
-    for i in (0..N).rev() {
-        let mut s = x[i];
-        for k in i + 1..N {
-            s -= l[(k, i)] * x[k];
+        for i in (0..N).rev() {
+            let mut s = x[i];
+            for k in i + 1..N {
+                s -= l[(k, i)] * x[k];
+            }
+            x[i] = s / l[(i, i)];
         }
-        x[i] = s / l[(i, i)];
+        x
     }
-    Ok(x)
 }

@@ -218,6 +218,8 @@ where
     F: GeneralizedForce<T, N>,
 {
     const EXPLICIT_TIME: bool = M::EXPLICIT_TIME;
+    const CONSTANT_MASS: bool = M::CONSTANT_MASS;
+    const DRIVEN: bool = M::DRIVEN;
     fn kinetic<S: Scalar<Real = T>>(&self, t: S, q: &SVector<S, N>, qd: &SVector<S, N>) -> S {
         self.mechanism.kinetic(t, q, qd)
     }

@@ -3,8 +3,8 @@
 
 use crate::mechanism::finite;
 use crate::{
-    central_difference_jacobian, Dual, Error, GeneralizedForce, Jacobian, Mechanism, Real, Scalar,
-    State,
+    central_difference_jacobian, solve_spd, Cholesky, Dual, Error, GeneralizedForce, Jacobian,
+    Mechanism, Real, Scalar, State,
 };
 use nalgebra::{SMatrix, SVector};
 
@@ -45,6 +45,18 @@ pub trait Lagrangian<T: Real, const N: usize> {
     /// True when the kinetic energy depends on `t` explicitly (a driven mechanism written in
     /// a fixed frame), so that `d2L/dq'dt` is needed: one more dual evaluation per call.
     const EXPLICIT_TIME: bool = false;
+
+    /// True when the mass matrix `d2T/dq'2` is the same at every state (masses and inertias
+    /// times squared velocities of fixed coordinates: springs, particles, carts). The automatic
+    /// path ([`EulerLagrange`]) then factors it once, when it is made, and its right-hand side
+    /// skips differentiating `T` (which is then `-dV/dq`). A `T` that does depend on `q` or
+    /// `t` must not claim it: its equations would be wrong.
+    const CONSTANT_MASS: bool = false;
+
+    /// True when the mechanism is driven from outside: time enters its equations, or its
+    /// energy `T + V` is not conserved because something keeps moving it (a spinning hoop).
+    /// A scene never puts a driven mechanism to sleep by default.
+    const DRIVEN: bool = Self::EXPLICIT_TIME;
 
     /// Every term of `L` that depends on the velocities: the kinetic energy `T(t, q, q')`.
     fn kinetic<S: Scalar<Real = T>>(&self, t: S, q: &SVector<S, N>, qd: &SVector<S, N>) -> S;
@@ -101,21 +113,38 @@ type Directional<T> = Dual<T, 1>;
 /// keeps the stack use of a long chain at that of `M` itself), then `2 N` mass solves. Only the
 /// Lagrangian's [`Lagrangian::non_conservative_force`] is differentiated by central
 /// differences, and an extra force by its own [`GeneralizedForce::jacobian`].
+///
+/// Where [`Lagrangian::CONSTANT_MASS`] holds, `M` is evaluated and factored once, when the
+/// mechanism is made, and `f` is `-dV/dq` (plus the time term): the kinetic energy is then
+/// never differentiated in a step.
 #[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub struct EulerLagrange<L> {
+pub struct EulerLagrange<T: Real, const N: usize, L> {
     lagrangian: L,
+    /// The factored constant mass matrix (or why it could not be factored), when
+    /// [`Lagrangian::CONSTANT_MASS`] holds.
+    mass: Option<Result<Cholesky<T, N>, Error>>,
 }
 
-impl<L> EulerLagrange<L> {
+impl<T: Real, const N: usize, L: Lagrangian<T, N>> EulerLagrange<T, N, L> {
     /// The mechanism of `lagrangian`.
     pub fn new(lagrangian: L) -> Self {
-        Self { lagrangian }
+        let mass = L::CONSTANT_MASS.then(|| {
+            let zero = SVector::zeros();
+            Cholesky::factor(&mass_matrix_in(&lagrangian, T::zero(), &zero, &zero))
+        });
+        Self { lagrangian, mass }
     }
     /// The Lagrangian.
     #[must_use]
     pub fn lagrangian(&self) -> &L {
         &self.lagrangian
+    }
+}
+
+#[cfg(feature = "defmt")]
+impl<T: Real, const N: usize, L: defmt::Format> defmt::Format for EulerLagrange<T, N, L> {
+    fn format(&self, f: defmt::Formatter<'_>) {
+        defmt::write!(f, "EulerLagrange({})", self.lagrangian);
     }
 }
 
@@ -157,24 +186,27 @@ where
     S: Scalar<Real = T>,
     L: Lagrangian<T, N>,
 {
-    // Outer direction k on q_k, inner direction i on q'_i: r.eps[k].re = dT/dq_k and
-    // r.eps[k].eps[i] = d2T/dq_k dq'_i.
-    let inner_qd = SVector::<D2<S, N>, N>::from_fn(|i, _| D2::constant(D1::variable(qd[i], i)));
-    let outer_q = SVector::<D2<S, N>, N>::from_fn(|k, _| D2::variable(D1::constant(q[k]), k));
-    let r = l.kinetic(d2_constant(t), &outer_q, &inner_qd);
-
     let v = l.potential(
         D1::constant(t),
         &SVector::<D1<S, N>, N>::from_fn(|k, _| D1::variable(q[k], k)),
     );
-
-    let mut f = SVector::<S, N>::from_fn(|i, _| {
-        let mut fi = r.eps[i].re - v.eps[i];
-        for k in 0..N {
-            fi -= r.eps[k].eps[i] * qd[k];
-        }
-        fi
-    });
+    let inner_qd = SVector::<D2<S, N>, N>::from_fn(|i, _| D2::constant(D1::variable(qd[i], i)));
+    let mut f = if L::CONSTANT_MASS {
+        // dT/dq = 0 and d2T/dq'dq = 0: nothing of T to differentiate.
+        SVector::<S, N>::from_fn(|i, _| -v.eps[i])
+    } else {
+        // Outer direction k on q_k, inner direction i on q'_i: r.eps[k].re = dT/dq_k and
+        // r.eps[k].eps[i] = d2T/dq_k dq'_i.
+        let outer_q = SVector::<D2<S, N>, N>::from_fn(|k, _| D2::variable(D1::constant(q[k]), k));
+        let r = l.kinetic(d2_constant(t), &outer_q, &inner_qd);
+        SVector::<S, N>::from_fn(|i, _| {
+            let mut fi = r.eps[i].re - v.eps[i];
+            for k in 0..N {
+                fi -= r.eps[k].eps[i] * qd[k];
+            }
+            fi
+        })
+    };
 
     if L::EXPLICIT_TIME {
         // Outer direction 0 on t: r.eps[0].eps[i] = d2T/dt dq'_i.
@@ -205,8 +237,10 @@ fn seeded<T: Real, const N: usize>(
     })
 }
 
-impl<T: Real, const N: usize, L: Lagrangian<T, N>> Lagrangian<T, N> for EulerLagrange<L> {
+impl<T: Real, const N: usize, L: Lagrangian<T, N>> Lagrangian<T, N> for EulerLagrange<T, N, L> {
     const EXPLICIT_TIME: bool = L::EXPLICIT_TIME;
+    const CONSTANT_MASS: bool = L::CONSTANT_MASS;
+    const DRIVEN: bool = L::DRIVEN;
     fn kinetic<S: Scalar<Real = T>>(&self, t: S, q: &SVector<S, N>, qd: &SVector<S, N>) -> S {
         self.lagrangian.kinetic(t, q, qd)
     }
@@ -244,13 +278,21 @@ fn residual_jacobian<T: Real, const N: usize, L: Lagrangian<T, N>>(
     j
 }
 
-impl<T: Real, const N: usize, L: Lagrangian<T, N>> Mechanism<T, N> for EulerLagrange<L> {
+impl<T: Real, const N: usize, L: Lagrangian<T, N>> Mechanism<T, N> for EulerLagrange<T, N, L> {
     fn mass_matrix(&self, s: &State<T, N>) -> SMatrix<T, N, N> {
         mass_matrix_in(&self.lagrangian, s.t, &s.q, &s.qd)
     }
 
     fn rhs(&self, s: &State<T, N>) -> SVector<T, N> {
         rhs_in(&self.lagrangian, s.t, &s.q, &s.qd)
+    }
+
+    /// With the factor made once where the mass matrix is constant.
+    fn solve_mass(&self, s: &State<T, N>, b: &SVector<T, N>) -> Result<SVector<T, N>, Error> {
+        match &self.mass {
+            Some(factor) => factor.as_ref().map(|c| c.solve(b)).map_err(|e| *e),
+            None => solve_spd(&self.mass_matrix(s), b),
+        }
     }
 
     /// Exact: `M dq''/dx = d(f + Q + extra)/dx - (dM/dx) q''` (see the type's docs).

@@ -58,7 +58,7 @@ mod scalar_trig;
 mod state;
 pub mod validate;
 
-pub use cholesky::solve_spd;
+pub use cholesky::{solve_spd, Cholesky};
 pub use constraints::{
     Constrained, Constraints, Held, Holonomic, HolonomicConstraints, Pfaffian, PfaffianConstraints,
     Projection, Stabilization,

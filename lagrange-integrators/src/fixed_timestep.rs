@@ -1,28 +1,8 @@
 //! [`FixedTimestep`]: steps a mechanism at a fixed `dt` from variable frame times, with a cap
 //! on the steps per frame and state interpolation for rendering.
 
-use crate::{Clock, Integrator};
-use lagrange_core::{validate, Error, Mechanism, Real, State};
-
-/// What one frame did.
-#[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub struct Frame<T> {
-    /// Fixed steps taken.
-    pub steps: u32,
-    /// Simulated time given up because the frame needed more steps than the cap (zero in a
-    /// frame that kept up): the simulation runs slower than real time instead of spiralling.
-    /// Always finite.
-    pub dropped: T,
-}
-
-/// Whole steps of the accumulated time are taken when within this many epsilons of a step,
-/// so that frame times equal to `dt` give one step per frame despite rounding.
-const STEP_SLACK_EPS: f64 = 64.0;
-
-/// Whole steps in the accumulator below this count are dropped exactly (the fraction of a
-/// step left over is kept); above it the accumulator is cleared: `2^22`, exact in `f32`.
-const WHOLE_STEPS_EXACT: f64 = 4_194_304.0;
+use crate::{Frame, FrameClock, Integrator};
+use lagrange_core::{Error, Mechanism, Real, State};
 
 /// The fixed-timestep loop of a game or a real-time controller: frame times of any length
 /// accumulate, the mechanism advances in steps of exactly `dt` (so that its behaviour does not
@@ -40,7 +20,7 @@ const WHOLE_STEPS_EXACT: f64 = 4_194_304.0;
 /// spiral of death): the simulation falls behind real time instead. Whatever a frame time (a
 /// pause in a debugger, `T::MAX`), the time beyond the cap is dropped whole and the next
 /// frames are stepped as if it had not come. The states' times are the start's plus the steps
-/// taken times `dt`, summed without rounding drift ([`Clock`]): an `f32` clock at 1/120 s stays
+/// taken times `dt`, summed without rounding drift ([`FrameClock`]): an `f32` clock at 1/120 s stays
 /// within an ulp of `n dt` after 10^8 steps.
 ///
 /// ```
@@ -59,12 +39,9 @@ const WHOLE_STEPS_EXACT: f64 = 4_194_304.0;
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FixedTimestep<T: Real, const N: usize, I> {
     integrator: I,
-    dt: T,
-    max_steps_per_frame: u32,
-    accumulator: T,
+    clock: FrameClock<T>,
     previous: State<T, N>,
     current: State<T, N>,
-    clock: Clock<T>,
 }
 
 impl<T: Real, const N: usize, I> FixedTimestep<T, N, I> {
@@ -80,27 +57,18 @@ impl<T: Real, const N: usize, I> FixedTimestep<T, N, I> {
         max_steps_per_frame: u32,
         start: State<T, N>,
     ) -> Result<Self, Error> {
-        let dt = lagrange_core::validate::positive("dt", dt)?;
-        if max_steps_per_frame == 0 {
-            return Err(Error::InvalidParameter {
-                name: "max_steps_per_frame",
-                reason: "must be at least 1",
-            });
-        }
+        let clock = FrameClock::new(dt, max_steps_per_frame, start.t)?;
         start.check_finite()?;
         Ok(Self {
             integrator,
-            dt,
-            max_steps_per_frame,
-            accumulator: T::zero(),
+            clock,
             previous: start,
             current: start,
-            clock: Clock::new(start.t),
         })
     }
 
     /// Adds `frame_time` (zero or positive, finite) to the accumulated time and takes the
-    /// fixed steps it pays for, up to the cap.
+    /// fixed steps it pays for, up to the cap ([`FrameClock::advance`]).
     ///
     /// # Errors
     /// [`Error::InvalidParameter`] `frame_time` when negative or not finite (nothing changes);
@@ -114,51 +82,22 @@ impl<T: Real, const N: usize, I> FixedTimestep<T, N, I> {
     where
         I: Integrator<T, N, M>,
     {
-        let frame_time = validate::non_negative("frame_time", frame_time)?;
-        // A frame time so large that the sum overflows is as good as the largest: the cap
-        // drops it anyway.
-        self.accumulator = (self.accumulator + frame_time).min(T::MAX);
-        let mut steps = 0;
-        while self.due() && steps < self.max_steps_per_frame {
-            let mut next = self.integrator.step(mechanism, &self.current, self.dt)?;
-            self.clock.tick(self.dt);
-            next.t = self.clock.time();
-            self.previous = self.current;
-            self.current = next;
-            self.accumulator -= self.dt;
-            steps += 1;
-        }
-        let mut dropped = T::zero();
-        if self.due() {
-            // Keep the fraction of a step; drop the whole steps beyond the cap (all of the
-            // time when it is too large for its whole steps to be counted exactly).
-            let whole = (self.accumulator / self.dt).floor();
-            let kept = if whole < T::from_f64(WHOLE_STEPS_EXACT) {
-                self.accumulator - whole * self.dt
-            } else {
-                T::zero()
-            };
-            // A remainder that is a whole step but for rounding is one: dropped too.
-            let kept = if kept >= self.dt * (T::one() - T::from_f64(STEP_SLACK_EPS) * T::EPSILON) {
-                T::zero()
-            } else {
-                kept.max(T::zero())
-            };
-            dropped = self.accumulator - kept;
-            self.accumulator = kept;
-        }
-        Ok(Frame { steps, dropped })
-    }
-
-    /// True when the accumulated time pays for a whole step.
-    fn due(&self) -> bool {
-        self.accumulator >= self.dt * (T::one() - T::from_f64(STEP_SLACK_EPS) * T::EPSILON)
+        let (integrator, previous, current) =
+            (&mut self.integrator, &mut self.previous, &mut self.current);
+        let dt = self.clock.dt();
+        self.clock.advance(frame_time, |t| {
+            let mut next = integrator.step(mechanism, current, dt)?;
+            next.t = t;
+            *previous = *current;
+            *current = next;
+            Ok(())
+        })
     }
 
     /// The fraction of a step accumulated but not yet taken, in `[0, 1]`.
     #[must_use]
     pub fn alpha(&self) -> T {
-        (self.accumulator / self.dt).max(T::zero()).min(T::one())
+        self.clock.alpha()
     }
 
     /// The state to draw: linear interpolation between the last two steps by
@@ -190,7 +129,7 @@ impl<T: Real, const N: usize, I> FixedTimestep<T, N, I> {
     /// The fixed step.
     #[must_use]
     pub fn dt(&self) -> T {
-        self.dt
+        self.clock.dt()
     }
 
     /// The integrator (to read its statistics or change its settings).
@@ -204,10 +143,9 @@ impl<T: Real, const N: usize, I> FixedTimestep<T, N, I> {
     /// [`Error::NonFiniteState`] for a non-finite `state`.
     pub fn reset(&mut self, state: State<T, N>) -> Result<(), Error> {
         state.check_finite()?;
+        self.clock.reset(state.t)?;
         self.previous = state;
         self.current = state;
-        self.accumulator = T::zero();
-        self.clock = Clock::new(state.t);
         Ok(())
     }
 }

@@ -57,6 +57,7 @@ mod backward_euler;
 mod contact_stepper;
 mod explicit_euler;
 mod fixed_timestep;
+mod frame_clock;
 mod gauss_legendre;
 mod implicit_midpoint;
 mod implicit_rk;
@@ -79,7 +80,8 @@ pub use adaptive::{
 pub use backward_euler::{BackwardEuler, BackwardEulerTableau};
 pub use contact_stepper::ContactStepper;
 pub use explicit_euler::ExplicitEuler;
-pub use fixed_timestep::{FixedTimestep, Frame};
+pub use fixed_timestep::FixedTimestep;
+pub use frame_clock::{Frame, FrameClock};
 pub use gauss_legendre::{GaussLegendre2, GaussLegendre2Tableau};
 pub use implicit_midpoint::{ImplicitMidpoint, MidpointTableau};
 pub use implicit_rk::{ImplicitRungeKutta, ImplicitTableau};

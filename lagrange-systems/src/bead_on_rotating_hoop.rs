@@ -100,6 +100,8 @@ impl<T: Real> Mechanism<T, 1> for BeadOnRotatingHoop<T> {
 }
 
 impl<T: Real> Lagrangian<T, 1> for BeadOnRotatingHoop<T> {
+    /// The hoop is kept spinning: `T + V` is not conserved (the Jacobi integral is).
+    const DRIVEN: bool = true;
     fn kinetic<S: Scalar<Real = T>>(&self, _t: S, q: &SVector<S, 1>, qd: &SVector<S, 1>) -> S {
         let sin = q[0].sin();
         let w = S::from_real(self.omega);

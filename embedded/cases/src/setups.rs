@@ -105,10 +105,10 @@ impl<T: Real> Setup<T, 2> for CartPoleSetup {
 pub struct CartPoleLagrangianSetup;
 
 impl<T: Real> Setup<T, 2> for CartPoleLagrangianSetup {
-    type Mechanism = EulerLagrange<CartPole<T>>;
+    type Mechanism = EulerLagrange<T, 2, CartPole<T>>;
     const NAME: &'static str = "cart-pole (automatic)";
     const DT: f64 = 1e-3;
-    fn build() -> Result<(EulerLagrange<CartPole<T>>, State<T, 2>), Error> {
+    fn build() -> Result<(EulerLagrange<T, 2, CartPole<T>>, State<T, 2>), Error> {
         cart_pole().map(|(cp, s)| (EulerLagrange::new(cp), s))
     }
 }

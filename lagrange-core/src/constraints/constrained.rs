@@ -350,6 +350,8 @@ where
     P: Lagrangian<T, N>,
 {
     const EXPLICIT_TIME: bool = P::EXPLICIT_TIME;
+    const CONSTANT_MASS: bool = P::CONSTANT_MASS;
+    const DRIVEN: bool = P::DRIVEN;
     fn kinetic<S: Scalar<Real = T>>(&self, t: S, q: &SVector<S, N>, qd: &SVector<S, N>) -> S {
         self.parts.kinetic(t, q, qd)
     }
@@ -440,6 +442,8 @@ impl<M, K> Held<M, K> {
 
 impl<T: Real, const N: usize, M: Lagrangian<T, N>, K> Lagrangian<T, N> for Held<M, K> {
     const EXPLICIT_TIME: bool = M::EXPLICIT_TIME;
+    const CONSTANT_MASS: bool = M::CONSTANT_MASS;
+    const DRIVEN: bool = M::DRIVEN;
     fn kinetic<S: Scalar<Real = T>>(&self, t: S, q: &SVector<S, N>, qd: &SVector<S, N>) -> S {
         self.mechanism.kinetic(t, q, qd)
     }
