@@ -90,7 +90,7 @@ pub fn double_pendulum<T: Real>() -> Result<Fixture<DoublePendulum<T>, T, 2>, Er
 /// # Errors
 /// Never, for these parameters.
 pub fn double_pendulum_automatic<T: Real>(
-) -> Result<Fixture<EulerLagrange<DoublePendulum<T>>, T, 2>, Error> {
+) -> Result<Fixture<EulerLagrange<T, 2, DoublePendulum<T>>, T, 2>, Error> {
     let f = double_pendulum::<T>()?;
     Ok(Fixture {
         name: "double pendulum (automatic)",
