@@ -61,6 +61,14 @@ pub enum Error {
     /// was zero (the step is too large for the mechanism's Jacobian, or the Jacobian is
     /// degenerate).
     SingularJacobian,
+    /// An instance handle that names no instance of a scene's bank: never issued by it, or
+    /// of an instance removed since.
+    NoSuchInstance,
+    /// A scene's bank already holds as many instances as it has room for.
+    BankFull {
+        /// The bank's capacity.
+        capacity: usize,
+    },
 }
 
 impl fmt::Display for Error {
@@ -91,6 +99,10 @@ impl fmt::Display for Error {
             }
             Self::SingularJacobian => {
                 f.write_str("the Newton matrix of an implicit step is singular")
+            }
+            Self::NoSuchInstance => f.write_str("no such instance in this bank"),
+            Self::BankFull { capacity } => {
+                write!(f, "the bank is full ({capacity} instances)")
             }
         }
     }

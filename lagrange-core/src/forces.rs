@@ -270,6 +270,13 @@ where
         self.mechanism
             .law_force(state, &(Borrowed(&self.force), Borrowed(extra)))
     }
+    fn velocity_jump(
+        &self,
+        state: &State<T, N>,
+        impulse: &SVector<T, N>,
+    ) -> Result<SVector<T, N>, Error> {
+        self.mechanism.velocity_jump(state, impulse)
+    }
 }
 
 /// A forced constrained mechanism keeps its rows: what a projection reads.

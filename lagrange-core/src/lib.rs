@@ -9,7 +9,8 @@
 //!   solve ([`solve_spd`]) unless a system gives a closed form.
 //! - [`Lagrangian`] and [`EulerLagrange`]: write `T` and `V` once and get the equations of
 //!   motion by automatic differentiation.
-//! - [`GeneralizedForce`], [`ViscousDamping`], [`Input`], [`Forced`]: forces added by wrapping.
+//! - [`GeneralizedForce`], [`ViscousDamping`], [`Input`], [`Forced`]: forces added by wrapping;
+//!   [`Controlled`]: a mechanism whose input is set between steps.
 //! - [`constraints`]: holonomic and Pfaffian constraints with Lagrange multipliers
 //!   ([`Constrained`]), Baumgarte [`Stabilization`] and [`Projection`] against drift.
 //! - [`Jacobian`]: `d/dq` and `d/dq'` of the equations of motion, exact from dual numbers for
@@ -45,6 +46,7 @@
 
 mod cholesky;
 pub mod constraints;
+mod controlled;
 mod dual;
 mod error;
 pub mod fast_trig;
@@ -63,6 +65,7 @@ pub use constraints::{
     Constrained, Constraints, Held, Holonomic, HolonomicConstraints, Pfaffian, PfaffianConstraints,
     Projection, Stabilization,
 };
+pub use controlled::Controlled;
 pub use dual::Dual;
 pub use error::Error;
 pub use forces::{Borrowed, Forced, GeneralizedForce, Input, NoForce, ViscousDamping};

@@ -167,6 +167,36 @@ pub trait Mechanism<T: Real, const N: usize>: Lagrangian<T, N> {
         }
     }
 
+    /// The change of velocities `dq'` that a generalized impulse `p` (a force integrated over
+    /// an instant: N s, or N m s on an angle) causes at `state`: `M^-1 p` for a free
+    /// mechanism (one [`Mechanism::solve_mass`]). A constrained mechanism keeps its velocity
+    /// constraints: `J dq' = 0`, its rows' reaction impulses added ([`Constrained`]).
+    ///
+    /// ```
+    /// use lagrange_core::prelude::*;
+    /// # use lagrange_core::nalgebra::Vector1;
+    /// # struct Wheel;
+    /// # impl Lagrangian<f64, 1> for Wheel {
+    /// #     fn kinetic<S: Scalar<Real = f64>>(&self, _: S, _: &SVector<S, 1>, qd: &SVector<S, 1>) -> S { qd[0] * qd[0] * 2.0 }
+    /// #     fn potential<S: Scalar<Real = f64>>(&self, _: S, _: &SVector<S, 1>) -> S { S::zero() }
+    /// # }
+    /// // A wheel of inertia 4 kg m^2 given an angular impulse of 2 N m s spins at 0.5 rad/s.
+    /// let wheel = EulerLagrange::new(Wheel);
+    /// let dqd = wheel.velocity_jump(&State::at_rest([0.0]), &Vector1::new(2.0))?;
+    /// assert!((dqd[0] - 0.5).abs() < 1e-15);
+    /// # Ok::<(), lagrange_core::Error>(())
+    /// ```
+    ///
+    /// # Errors
+    /// As [`Mechanism::solve_mass`]; [`Error::NonFiniteState`] when the result is not finite.
+    fn velocity_jump(
+        &self,
+        state: &State<T, N>,
+        impulse: &SVector<T, N>,
+    ) -> Result<SVector<T, N>, Error> {
+        finite(self.solve_mass(state, impulse)?)
+    }
+
     /// This mechanism with `force` added to its generalized forces.
     ///
     /// ```

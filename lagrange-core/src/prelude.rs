@@ -6,7 +6,7 @@
 
 pub use crate::constraints::{Constrained, Constraints, Projection, Stabilization};
 pub use crate::{
-    Error, EulerLagrange, GeneralizedForce, Input, Lagrangian, Mechanism, Real, Scalar, State,
-    ViscousDamping,
+    Controlled, Error, EulerLagrange, GeneralizedForce, Input, Lagrangian, Mechanism, Real, Scalar,
+    State, ViscousDamping,
 };
 pub use nalgebra::SVector;

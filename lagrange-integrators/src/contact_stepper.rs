@@ -353,4 +353,16 @@ where
     fn step(&mut self, mechanism: &M, state: &State<T, N>, dt: T) -> Result<State<T, N>, Error> {
         self.step_observed(mechanism, state, dt, |_| {})
     }
+
+    /// The inner integrator's, with the bilateral rows and the contacts resting now held.
+    fn law_acceleration(&self, mechanism: &M, state: &State<T, N>) -> Result<SVector<T, N>, Error> {
+        let rows = active(
+            mechanism,
+            &self.contacts,
+            &self.model,
+            &self.bilateral,
+            &self.resting,
+        );
+        self.integrator.law_acceleration(&rows, state)
+    }
 }

@@ -2,6 +2,7 @@
 //! ([`Cost`], [`Work`]), what a failed run reports ([`Failure`]), and the checks they share.
 
 use core::fmt;
+use lagrange_core::nalgebra::SVector;
 use lagrange_core::{Error, Mechanism, Real, State};
 
 /// What a step of a method costs, in evaluations of the mechanism's acceleration law, for
@@ -150,6 +151,17 @@ pub trait Integrator<T: Real, const N: usize, M: Mechanism<T, N>>: Method {
     /// [`Error::NonFiniteState`] when `state` is not finite, or the new state is not (a step
     /// past the stability limit); whatever the mechanism's law returns.
     fn step(&mut self, mechanism: &M, state: &State<T, N>, dt: T) -> Result<State<T, N>, Error>;
+
+    /// The accelerations of the law this method steps, at `state`: the mechanism's own
+    /// ([`Mechanism::acceleration`]) by default; a [`ContactStepper`](crate::ContactStepper)
+    /// holds the contacts resting now (a ball on the floor does not accelerate). What a
+    /// scene's sleep test reads, with the velocities zeroed.
+    ///
+    /// # Errors
+    /// As [`Mechanism::acceleration`].
+    fn law_acceleration(&self, mechanism: &M, state: &State<T, N>) -> Result<SVector<T, N>, Error> {
+        mechanism.acceleration(state)
+    }
 
     /// Takes `steps` steps of `dt` from `state` and returns the last state. The time of the
     /// `k`-th state is `state.t + k dt` summed without rounding drift (a compensated sum), so

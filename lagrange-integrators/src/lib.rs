@@ -32,6 +32,9 @@
 //! [`FixedTimestep`] drives any fixed-step integrator from variable frame times for games and
 //! real-time loops: an accumulator, a cap on steps per frame, interpolated states to draw.
 //!
+//! [`scene`]: many mechanisms in banks ([`scene::Bank`]), advanced together by one such clock
+//! ([`scene::Scene`]), with sleeping at rest chosen per bank.
+//!
 //! [`Projected`] wraps any of them to project onto constraints after every step;
 //! [`ContactStepper`] wraps any of them to step through impacts and resting contacts (the laws
 //! of [`lagrange_core::constraints::contact`]).
@@ -67,6 +70,7 @@ pub mod prelude;
 mod projected;
 mod radau_iia;
 mod rk4;
+pub mod scene;
 mod semi_implicit_euler;
 mod stormer_verlet;
 mod variational;

@@ -1,8 +1,9 @@
 //! The names a program that steps mechanisms needs: `use lagrange_integrators::prelude::*;`.
 //!
 //! Everything of [`lagrange_core::prelude`], the [`Integrator`] trait and the integrators and
-//! drivers most programs use.
+//! drivers most programs use, and scenes.
 
+pub use crate::scene::{Bank, NeverSleeps, Scene, Sleeps};
 pub use crate::{
     AdaptiveSettings, DormandPrince54, DormandPrince853, FixedTimestep, GaussLegendre2, Integrator,
     Method, Projected, Rk4, StormerVerlet, VariationalMidpoint, Yoshida4,

@@ -3,6 +3,7 @@
 use crate::integrator::{continues, Work};
 use crate::{Cost, Integrator, Method};
 use lagrange_core::constraints::{Constraints, Projection};
+use lagrange_core::nalgebra::SVector;
 use lagrange_core::{Error, Mechanism, Real, State};
 
 /// An integrator whose every step ends with a [`Projection`] of the new state back onto
@@ -92,5 +93,10 @@ where
         let projected = self.projection.project(mechanism, mechanism, &next)?;
         self.last = Some(projected);
         Ok(projected)
+    }
+
+    /// The inner integrator's.
+    fn law_acceleration(&self, mechanism: &M, state: &State<T, N>) -> Result<SVector<T, N>, Error> {
+        self.integrator.law_acceleration(mechanism, state)
     }
 }

@@ -3,7 +3,7 @@
 use crate::small_solve::solve_sym2;
 use lagrange_core::nalgebra::{Matrix2, SVector, Vector2};
 use lagrange_core::{
-    validate, Error, GeneralizedForce, Lagrangian, Mechanism, Real, Scalar, State,
+    validate, Controlled, Error, GeneralizedForce, Lagrangian, Mechanism, Real, Scalar, State,
 };
 
 /// Spong's acrobot: two rigid links in a vertical plane, the first hinged to a fixed pivot
@@ -193,6 +193,17 @@ impl<T: Real> Acrobot<T> {
             -k * s2 * w1 * w1 - phi2,
         );
         (Matrix2::new(d11, d12, d12, d22), f)
+    }
+}
+
+/// The input is the elbow torque, N m.
+impl<T: Real> Controlled<T> for Acrobot<T> {
+    type Input = T;
+    fn input(&self) -> T {
+        self.torque()
+    }
+    fn set_input(&mut self, input: T) -> Result<(), Error> {
+        self.set_torque(input)
     }
 }
 

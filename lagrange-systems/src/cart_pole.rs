@@ -3,7 +3,7 @@
 use crate::small_solve::solve_sym2;
 use lagrange_core::nalgebra::{Matrix2, SVector, Vector2};
 use lagrange_core::{
-    validate, Error, GeneralizedForce, Lagrangian, Mechanism, Real, Scalar, State,
+    validate, Controlled, Error, GeneralizedForce, Lagrangian, Mechanism, Real, Scalar, State,
 };
 
 /// The cart-pole: a cart of mass `M` on a frictionless horizontal track, driven by a horizontal
@@ -122,6 +122,17 @@ impl<T: Real> CartPole<T> {
         let thd = s.qd[1];
         let f = Vector2::new(ml * sin * thd * thd, ml * self.gravity * sin);
         (mass, f)
+    }
+}
+
+/// The input is the horizontal force on the cart, N.
+impl<T: Real> Controlled<T> for CartPole<T> {
+    type Input = T;
+    fn input(&self) -> T {
+        self.force()
+    }
+    fn set_input(&mut self, input: T) -> Result<(), Error> {
+        self.set_force(input)
     }
 }
 

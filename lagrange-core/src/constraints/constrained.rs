@@ -2,6 +2,7 @@
 //! mechanism wrapper, and [`Stabilization`] (Baumgarte) against drift.
 
 use super::{Constraints, Schur};
+use crate::mechanism::finite;
 use crate::{
     validate, Error, GeneralizedForce, Jacobian, Lagrangian, Mechanism, NoForce, Real, Scalar,
     State,
@@ -394,6 +395,19 @@ where
         let rows = self.parts.jacobian(&state.q);
         Ok(self.parts.law_force(state, extra)? + rows.transpose() * lambda)
     }
+    /// The free jump `M^-1 p` less what would break the velocity constraints: with
+    /// `S mu = -J M^-1 p`, `dq' = M^-1 (p + J^T mu)`, so that `J dq' = 0` (the rows' reaction
+    /// impulses `J^T mu`).
+    fn velocity_jump(
+        &self,
+        state: &State<T, N>,
+        impulse: &SVector<T, N>,
+    ) -> Result<SVector<T, N>, Error> {
+        let free = self.parts.velocity_jump(state, impulse)?;
+        let schur = Schur::new(&self.parts, &self.parts, state, &[true; C])?;
+        let reaction = schur.multipliers(&-(schur.jacobian() * free));
+        finite(free + schur.response(&reaction))
+    }
 }
 
 /// The rows of a constrained mechanism are its parts' rows: what a projection reads.
@@ -485,6 +499,13 @@ impl<T: Real, const N: usize, M: Mechanism<T, N>, K> Mechanism<T, N> for Held<M,
         extra: &F,
     ) -> Result<SVector<T, N>, Error> {
         self.mechanism.law_force(state, extra)
+    }
+    fn velocity_jump(
+        &self,
+        state: &State<T, N>,
+        impulse: &SVector<T, N>,
+    ) -> Result<SVector<T, N>, Error> {
+        self.mechanism.velocity_jump(state, impulse)
     }
 }
 
