@@ -1,6 +1,8 @@
-//! Fixtures of the criterion micro-benchmarks (`cargo bench -p lagrange-benches`): each
+//! Wall-clock timing shared by the bench binaries ([`timing`]), and fixtures of the criterion micro-benchmarks (`cargo bench -p lagrange-benches`): each
 //! standard system with the parameters of the bench's problems and a moving state at which
 //! every term of its equations is non-zero.
+
+pub mod timing;
 
 use lagrange_core::{Error, EulerLagrange, Real, State};
 use lagrange_systems::{

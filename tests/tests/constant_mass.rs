@@ -3,39 +3,9 @@
 //! its right-hand side without differentiating `T`, with the same accelerations as the same
 //! Lagrangian without the claim.
 
-use lagrange_core::nalgebra::SVector;
-use lagrange_core::{Error, EulerLagrange, Lagrangian, Mechanism, Real, Scalar, State};
+use lagrange_cases::SpringChain;
+use lagrange_core::{Error, EulerLagrange, Mechanism, Real, State};
 use lagrange_tests::{for_f32_and_f64, Rng};
-
-/// `N` masses in a line joined by springs, the first to a wall: `T = sum m_i x_i'^2 / 2`,
-/// `V = sum k_i (x_i - x_(i-1))^2 / 2 + a cubic hardening`, masses and stiffnesses all
-/// different. `CLAIM` says whether it declares its mass matrix constant.
-struct SpringChain<T, const N: usize, const CLAIM: bool> {
-    masses: [T; N],
-    stiffnesses: [T; N],
-}
-
-impl<T: Real, const N: usize, const CLAIM: bool> Lagrangian<T, N> for SpringChain<T, N, CLAIM> {
-    const CONSTANT_MASS: bool = CLAIM;
-    fn kinetic<S: Scalar<Real = T>>(&self, _t: S, _q: &SVector<S, N>, qd: &SVector<S, N>) -> S {
-        let mut t = S::zero();
-        for i in 0..N {
-            t += qd[i] * qd[i] * (T::HALF * self.masses[i]);
-        }
-        t
-    }
-    fn potential<S: Scalar<Real = T>>(&self, _t: S, q: &SVector<S, N>) -> S {
-        let mut v = S::zero();
-        let mut before = S::zero();
-        for i in 0..N {
-            let stretch = q[i] - before;
-            v += stretch * stretch * (T::HALF * self.stiffnesses[i])
-                + stretch * stretch * stretch * stretch * T::from_f64(0.25);
-            before = q[i];
-        }
-        v
-    }
-}
 
 /// The largest difference, in ulps of the acceleration's size, between the two paths at
 /// random states of a random chain.

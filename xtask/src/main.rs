@@ -6,7 +6,9 @@
 //! - `test`: host tests of every crate, f32 and f64, the long runs (`#[ignore]`d) in release.
 //! - `bench`: run time against error (`benches/src/work_precision`): every integrator on the
 //!   standard problems, CSV, Markdown and SVG work-precision plots under
-//!   `target/lagrange-bench/` (not part of `ci`). `--quick` for a smoke run.
+//!   `target/lagrange-bench/` (not part of `ci`). `--quick` for a smoke run. `--scene`: the
+//!   cost of a scene's frame against the fraction awake and against plain loops, and the
+//!   constant-mass skip (`scene.csv`, `scene.md`).
 //! - `cross`: thumbv7em-none-eabihf builds of the library crates, with and without `defmt`,
 //!   and a linked no_std binary with no allocator, with its size.
 //! - `qemu`: the firmware on an emulated Cortex-M4F (QEMU `mps2-an386`), its defmt log compared
@@ -34,7 +36,7 @@ fn main() -> ExitCode {
         "demo" => demo::run(),
         "test" => cmd::run_all(&TEST).and(cmd::run_all(&LONG_TEST)),
         "cross" => cross::run(),
-        "bench" => cmd::run(cmd::cargo().args(BENCH).args(std::env::args().skip(2))),
+        "bench" => bench(&std::env::args().skip(2).collect::<Vec<_>>()),
         "qemu" => qemu::run(),
         "mutants" => mutants::run(&std::env::args().skip(2).collect::<Vec<_>>()),
         "ci" => ci(),
@@ -68,6 +70,30 @@ const BENCH: [&str; 9] = [
     "work-precision",
     "--",
 ];
+
+/// The scene bench (`--scene`), run like the work-precision bench.
+const SCENE_BENCH: [&str; 9] = [
+    "run",
+    "--quiet",
+    "--profile",
+    "xtask",
+    "-p",
+    "lagrange-benches",
+    "--bin",
+    "scene-cost",
+    "--",
+];
+
+/// `cargo xtask bench [--scene] ...`: the work-precision bench, or with `--scene` the scene
+/// bench, with the other flags passed on.
+fn bench(args: &[String]) -> Result<(), String> {
+    let which = if args.iter().any(|a| a == "--scene") {
+        SCENE_BENCH
+    } else {
+        BENCH
+    };
+    cmd::run(cmd::cargo().args(which).args(args))
+}
 
 /// Host tests of the whole workspace: unit, integration and doc tests, f32 and f64 alike.
 const TEST: [&[&str]; 1] = [&["test", "--workspace", "--all-targets", "--quiet"]];

@@ -30,13 +30,13 @@ mod report;
 mod scipy_peer;
 mod stability;
 mod sweep;
-mod timing;
+
 mod work_precision;
 
+use lagrange_benches::timing::{self, Budget};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
-use timing::Budget;
 
 /// What to run and how much time to spend on it.
 pub struct Options {

@@ -28,6 +28,7 @@ mod case;
 mod kernels;
 mod libm_trig_pendulum;
 mod setups;
+mod spring_chain;
 
 pub use case::{Case, Outcome, Precision, MAX_WORDS};
 pub use kernels::{Kernel, KERNELS, KERNEL_CALLS};
@@ -36,6 +37,7 @@ pub use setups::{
     CartPoleLagrangianSetup, CartPoleSetup, DoublePendulumSetup, LibmTrigPendulumSetup,
     PendulumSetup, Setup,
 };
+pub use spring_chain::SpringChain;
 
 use lagrange_integrators::{Rk4, SemiImplicitEuler, StormerVerlet, VelocityVerlet};
 

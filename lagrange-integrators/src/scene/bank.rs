@@ -1,7 +1,7 @@
 //! [`Bank`]: up to `K` instances of one mechanism type, stepped by one kind of integrator,
 //! with the awake instances packed in front.
 
-use super::{NeverSleeps, Sleep};
+use super::{NeverSleeps, Sleep, Sleeps};
 use crate::Integrator;
 use heapless::Vec;
 use lagrange_core::nalgebra::SVector;
@@ -537,6 +537,7 @@ where
 
     /// Moves the awake instances whose step failed out of the awake region.
     #[cold]
+    #[inline(never)]
     fn set_aside_failures(&mut self) {
         let mut place = self.awake;
         while place > 0 {
@@ -552,7 +553,9 @@ where
     }
 
     /// The rest check of the awake instances (from the back, so that one put to sleep is
-    /// replaced by one already checked).
+    /// replaced by one already checked). Out of line: it runs one step in `interval`, and
+    /// inlined it would crowd the step loop.
+    #[inline(never)]
     fn settle(&mut self) {
         let Some(rule) = self.sleep.rule().copied() else {
             return;
@@ -627,6 +630,26 @@ where
             }
             _ => Err(Error::NoSuchInstance),
         }
+    }
+}
+
+impl<T, const N: usize, const K: usize, M, I> Bank<T, N, K, M, I, Sleeps<T>>
+where
+    T: Real,
+    M: Mechanism<T, N>,
+    I: Integrator<T, N, M> + Clone,
+{
+    /// Adds an instance already at rest, asleep: at `q` with zero velocities (a prop placed
+    /// in a level). It costs nothing until something wakes it.
+    ///
+    /// # Errors
+    /// As [`Bank::add`].
+    pub fn add_asleep(&mut self, mechanism: M, q: [T; N]) -> Result<Id, Error> {
+        let id = self.add(mechanism, State::at_rest(q))?;
+        let place = self.place(id)?;
+        self.awake -= 1;
+        self.swap(place, self.awake);
+        Ok(id)
     }
 }
 
