@@ -22,7 +22,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, ExitStatus, Stdio};
 use std::time::{Duration, Instant};
 
-use lagrange_cases::{CASES, KERNELS, KERNEL_CALLS, STEPS};
+use lagrange_cases::{CASES, KERNELS, KERNEL_CALLS, SLEEPERS, STEPS};
 
 use crate::cmd;
 use crate::cross::{self, TARGET};
@@ -67,6 +67,9 @@ const RUN_TIMEOUT: Duration = Duration::from_secs(120);
 /// The issue's budget: instructions per step of the `f32` RK4 pendulum on the M4F.
 const PENDULUM_RK4_F32_BUDGET: f64 = 600.0;
 
+/// The issue's budget: instructions an asleep instance of a scene costs per frame.
+const ASLEEP_BUDGET: f64 = 30.0;
+
 /// The issue's budget: `.text` bytes of the one-mechanism image at opt-level 3.
 const ONE_MECHANISM_TEXT_BUDGET: u32 = 8 * 1024;
 
@@ -85,7 +88,16 @@ pub fn run() -> Result<(), String> {
     // The libm-trig one-mechanism image first: the default build then overwrites its ELF.
     let libm_text = build(&["--bin", "one-mechanism", "--features", "libm-trig"])
         .and_then(|dir| text_size(&dir.join("one-mechanism")));
-    let dir = match build(&["--bin", "lockstep", "--bin", "one-mechanism"]) {
+    let dir = match build(&[
+        "--bin",
+        "lockstep",
+        "--bin",
+        "one-mechanism",
+        "--bin",
+        "scene-text",
+        "--bin",
+        "loop-text",
+    ]) {
         Ok(dir) => dir,
         Err(e) => return Err(format!("xtask qemu: {e}")),
     };
@@ -516,8 +528,32 @@ fn lockstep(elf: &Path, decoder: &Path) -> Result<Vec<String>, String> {
         }
         _ => failures.push("no f32 RK4 pendulum cost to check against its budget".into()),
     }
+    failures.extend(asleep_cost(&per_step));
     failures.extend(kernels(&log, per_tick));
     Ok(failures)
+}
+
+/// What an asleep instance costs a frame: the difference between the scene cases with
+/// [`SLEEPERS`] asleep beside one awake and with none, per sleeper; the failed check, if any.
+fn asleep_cost(per_step: &BTreeMap<usize, f64>) -> Option<String> {
+    let find = |system: &str| {
+        CASES
+            .iter()
+            .position(|c| c.system == system)
+            .and_then(|id| per_step.get(&id).copied())
+    };
+    let (Some(none), Some(many)) = (find("scene, 1 awake"), find("scene, 1 awake + 64 asleep"))
+    else {
+        return Some("no cost measured for the scene cases with and without sleepers".into());
+    };
+    let each = (many - none) / SLEEPERS as f64;
+    println!(
+        "scene frame: {none:.1} instructions with one pendulum awake, {many:.1} with {SLEEPERS} \
+         more asleep: {each:.2} per sleeper per frame; budget {ASLEEP_BUDGET}"
+    );
+    (each > ASLEEP_BUDGET).then(|| {
+        format!("an asleep instance costs {each:.2} instructions per frame, over {ASLEEP_BUDGET}")
+    })
 }
 
 /// Compares the kernels' digests with the host's and prints instructions per call (the
@@ -591,6 +627,16 @@ fn sizes(
             ));
         }
     }
+    let scene = text_size(&dir.join("scene-text"))?;
+    let plain = text_size(&dir.join("loop-text"))?;
+    println!(
+        "  {:<40} {scene:>8} B\n  {:<40} {plain:>8} B\n  a scene without sleeping against the \
+         loop it replaces: {:+} B ({:.2}x; goal: no bigger)",
+        "scene-text (16 pendulums in a scene)",
+        "loop-text (16 pendulums, a FixedTimestep each)",
+        i64::from(scene) - i64::from(plain),
+        f64::from(scene) / f64::from(plain)
+    );
     match libm_one_mechanism {
         Ok(text) => println!("  {:<40} {text:>8} B", "one-mechanism with libm-trig"),
         Err(e) => failures.push(format!("one-mechanism with libm-trig: {e}")),

@@ -55,6 +55,16 @@ impl Outcome {
         Self { words, len }
     }
 
+    /// An outcome of up to [`MAX_WORDS`] words of its own (a scene's digest and counts);
+    /// words beyond that are dropped.
+    #[must_use]
+    pub fn from_words(given: &[u64]) -> Self {
+        let mut words = [0; MAX_WORDS];
+        let len = given.len().min(MAX_WORDS);
+        words[..len].copy_from_slice(&given[..len]);
+        Self { words, len }
+    }
+
     /// The words: `t`, `q`, `q'`, each an `f32`'s or `f64`'s bits.
     #[must_use]
     pub fn words(&self) -> &[u64] {
@@ -108,6 +118,24 @@ impl Case {
             precision: T::NAME,
             dof: N,
             runner: run_variational::<T, N, S>,
+        }
+    }
+
+    /// A case run by `runner` of its own (a scripted scene: `steps` counts its frames).
+    #[must_use]
+    pub const fn scripted(
+        system: &'static str,
+        method: &'static str,
+        precision: &'static str,
+        dof: usize,
+        runner: fn(u32) -> Result<Outcome, Error>,
+    ) -> Self {
+        Self {
+            system,
+            method,
+            precision,
+            dof,
+            runner,
         }
     }
 

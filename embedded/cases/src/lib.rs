@@ -27,12 +27,14 @@
 mod case;
 mod kernels;
 mod libm_trig_pendulum;
+mod scenes;
 mod setups;
 mod spring_chain;
 
 pub use case::{Case, Outcome, Precision, MAX_WORDS};
 pub use kernels::{Kernel, KERNELS, KERNEL_CALLS};
 pub use libm_trig_pendulum::LibmTrigPendulum;
+pub use scenes::{many_sleepers, no_sleepers, scripted, with_sleepers, SLEEPERS};
 pub use setups::{
     CartPoleLagrangianSetup, CartPoleSetup, DoublePendulumSetup, LibmTrigPendulumSetup,
     PendulumSetup, Setup,
@@ -56,7 +58,7 @@ pub const STEPS: u32 = 1000;
 /// Stormer-Verlet (symmetric, with an implicit kick), and by the variational midpoint rule,
 /// symplectic for any Lagrangian (on the automatic Euler-Lagrange path, Newton iterations in
 /// dual numbers).
-pub const CASES: [Case; 18] = [
+pub const CASES: [Case; 22] = [
     Case::new::<f32, 1, PendulumSetup, Rk4>(),
     Case::new::<f64, 1, PendulumSetup, Rk4>(),
     Case::new::<f32, 1, PendulumSetup, VelocityVerlet>(),
@@ -75,6 +77,22 @@ pub const CASES: [Case; 18] = [
     Case::new::<f64, 2, CartPoleSetup, StormerVerlet<f64, 2>>(),
     Case::variational::<f32, 2, CartPoleLagrangianSetup>(),
     Case::variational::<f64, 2, CartPoleLagrangianSetup>(),
+    Case::scripted(
+        "scene (sleep, wake)",
+        "Stormer-Verlet, RK4",
+        "f32",
+        1,
+        scripted::<f32>,
+    ),
+    Case::scripted(
+        "scene (sleep, wake)",
+        "Stormer-Verlet, RK4",
+        "f64",
+        1,
+        scripted::<f64>,
+    ),
+    Case::scripted("scene, 1 awake", "RK4", "f32", 1, no_sleepers),
+    Case::scripted("scene, 1 awake + 64 asleep", "RK4", "f32", 1, many_sleepers),
 ];
 
 #[cfg(test)]

@@ -72,27 +72,47 @@ struct Slot<T: Real, const N: usize, M, I> {
     /// 0 while not found at rest; else 1 + the steps spanned by its consecutive checks at
     /// rest.
     quiet: u32,
+    /// Why its last step failed, while it is set aside.
+    failure: Option<Error>,
 }
 
 impl<T: Real, const N: usize, M: Mechanism<T, N>, I: Integrator<T, N, M>> Slot<T, N, M, I> {
-    /// One step of `dt`, landing at the scene's time `t`; the error when the step failed
-    /// (the state is then untouched).
+    /// One step of `dt`, landing at the scene's time `t`; false when it failed (the state is
+    /// then untouched and the error kept).
     #[inline(always)]
-    fn advance(&mut self, dt: T, t: T) -> Option<Error> {
+    fn advance(&mut self, dt: T, t: T) -> bool {
         match self.integrator.step(&self.mechanism, &self.current, dt) {
             Ok(mut next) => {
                 next.t = t;
                 self.previous = self.current;
                 self.current = next;
-                None
+                true
             }
-            Err(e) => Some(e),
+            Err(e) => {
+                self.fail(e);
+                false
+            }
         }
+    }
+
+    /// Keeps the error of a failed step (out of line: rare, and the error is large).
+    #[cold]
+    #[inline(never)]
+    fn fail(&mut self, e: Error) {
+        self.failure = Some(e);
     }
 }
 
-/// Marks an index with no instance in [`Bank`]'s table of places.
-const VACANT: u32 = u32::MAX;
+/// What a bank knows of one id index: where its instance is and which generation of the
+/// index is live. All zeros for an index never given out, so that a bank's table starts
+/// cleared.
+#[derive(Debug, Clone, Copy, Default)]
+struct Entry {
+    /// The instance's place in the bank's slots plus one, or 0 when the index is free.
+    place: u32,
+    /// The generation of the id now (or next) given out for this index.
+    generation: u32,
+}
 
 /// Up to `K` instances of the mechanism type `M`, each with its own parameters and input
 /// (its own value of `M`), its own state and its own copy of the integrator `I` (made from
@@ -153,14 +173,12 @@ pub struct Bank<T: Real, const N: usize, const K: usize, M, I, Z = NeverSleeps> 
     sleep: Z,
     slots: Vec<Slot<T, N, M, I>, K>,
     awake: usize,
-    /// By id index: the instance's place in `slots`, or [`VACANT`].
-    places: [u32; K],
-    /// By id index: the generation of the id now (or next) given out.
-    generations: [u32; K],
-    /// By id index: why the instance's last step failed.
-    failures: [Option<Error>; K],
-    /// Id indices free to give out.
+    /// By id index.
+    entries: [Entry; K],
+    /// Id indices given back by removed instances, to give out again.
     free: Vec<u32, K>,
+    /// Id indices never given out yet: `fresh..K`.
+    fresh: u32,
     time: T,
     steps: u64,
 }
@@ -177,27 +195,22 @@ where
     ///
     /// # Errors
     /// [`Error::InvalidParameter`] `K` when zero or above `u32::MAX - 1`.
+    #[inline(always)] // built in place in the caller: a bank is large, and moving it costs a copy
     pub fn new(integrator: I, sleep: Z) -> Result<Self, Error> {
-        if K == 0 || K >= VACANT as usize {
+        if K == 0 || K >= u32::MAX as usize {
             return Err(Error::InvalidParameter {
                 name: "K",
                 reason: "a bank holds at least 1 and fewer than u32::MAX instances",
             });
-        }
-        let mut free = Vec::new();
-        for index in (0..K).rev() {
-            // K indices fit in a Vec of capacity K, and in u32 (checked above).
-            let _ = free.push(u32::try_from(index).unwrap_or(VACANT));
         }
         Ok(Self {
             integrator,
             sleep,
             slots: Vec::new(),
             awake: 0,
-            places: [VACANT; K],
-            generations: [0; K],
-            failures: [None; K],
-            free,
+            entries: [Entry::default(); K],
+            free: Vec::new(),
+            fresh: 0,
             time: T::zero(),
             steps: 0,
         })
@@ -211,9 +224,14 @@ where
     /// holds `K` instances. The bank is then unchanged.
     pub fn add(&mut self, mechanism: M, state: State<T, N>) -> Result<Id, Error> {
         state.check_finite()?;
-        let Some(&index) = self.free.last() else {
-            return Err(Error::BankFull { capacity: K });
+        let full = Error::BankFull { capacity: K };
+        let index = match self.free.last() {
+            Some(&index) => index,
+            None if (self.fresh as usize) < K => self.fresh,
+            None => return Err(full),
         };
+        let place = self.slots.len();
+        let stored = u32::try_from(place + 1).map_err(|_| full)?;
         let current = State {
             t: self.time,
             ..state
@@ -225,19 +243,19 @@ where
             previous: current,
             id: index,
             quiet: 0,
+            failure: None,
         };
+        let entry = self.entries.get_mut(index as usize).ok_or(full)?;
         if self.slots.push(slot).is_err() {
-            return Err(Error::BankFull { capacity: K });
+            return Err(full);
         }
-        self.free.pop();
-        let i = index as usize;
-        self.places[i] = self.last_place();
-        self.failures[i] = None;
-        self.rouse(self.slots.len() - 1);
-        Ok(Id {
-            index,
-            generation: self.generations[i],
-        })
+        entry.place = stored;
+        let generation = entry.generation;
+        if self.free.pop().is_none() {
+            self.fresh += 1;
+        }
+        self.rouse(place);
+        Ok(Id { index, generation })
     }
 
     /// Removes an instance, returning its mechanism and state. Its [`Id`] then names nothing.
@@ -251,16 +269,16 @@ where
             self.swap(place, self.awake);
             place = self.awake;
         }
-        let slot = self.slots.swap_remove(place);
-        if place < self.slots.len() {
-            let moved = self.slots[place].id as usize;
-            self.places[moved] = u32::try_from(place).unwrap_or(VACANT);
+        // The last slot takes the place of the one removed.
+        self.swap(place, self.slots.len().saturating_sub(1));
+        let slot = self.slots.pop().ok_or(Error::NoSuchInstance)?;
+        if let Some(entry) = self.entries.get_mut(id.index as usize) {
+            *entry = Entry {
+                place: 0,
+                generation: entry.generation.wrapping_add(1),
+            };
         }
-        let i = id.index as usize;
-        self.places[i] = VACANT;
-        self.failures[i] = None;
-        self.generations[i] = self.generations[i].wrapping_add(1);
-        // The index was taken from `free`, so there is room to give it back.
+        // The index was taken from `free` or `fresh`, so there is room to give it back.
         let _ = self.free.push(id.index);
         Ok((slot.mechanism, slot.current))
     }
@@ -270,7 +288,7 @@ where
     /// # Errors
     /// [`Error::NoSuchInstance`].
     pub fn state(&self, id: Id) -> Result<&State<T, N>, Error> {
-        Ok(&self.slots[self.place(id)?].current)
+        Ok(&self.slot(id)?.current)
     }
 
     /// The state to draw: linear interpolation between the instance's last two states by
@@ -281,7 +299,7 @@ where
     /// # Errors
     /// [`Error::NoSuchInstance`]; [`Error::InvalidParameter`] `alpha` outside `[0, 1]`.
     pub fn interpolated(&self, id: Id, alpha: T) -> Result<State<T, N>, Error> {
-        let slot = &self.slots[self.place(id)?];
+        let slot = self.slot(id)?;
         if !(alpha >= T::zero() && alpha <= T::one()) {
             return Err(Error::InvalidParameter {
                 name: "alpha",
@@ -301,7 +319,7 @@ where
     /// # Errors
     /// [`Error::NoSuchInstance`].
     pub fn mechanism(&self, id: Id) -> Result<&M, Error> {
-        Ok(&self.slots[self.place(id)?].mechanism)
+        Ok(&self.slot(id)?.mechanism)
     }
 
     /// Awake, asleep, or failed.
@@ -310,12 +328,11 @@ where
     /// [`Error::NoSuchInstance`].
     pub fn status(&self, id: Id) -> Result<Status, Error> {
         let place = self.place(id)?;
-        Ok(if place < self.awake {
-            Status::Awake
-        } else if let Some(e) = self.failures[id.index as usize] {
-            Status::Failed(e)
-        } else {
-            Status::Asleep
+        let slot = self.slots.get(place).ok_or(Error::NoSuchInstance)?;
+        Ok(match slot.failure {
+            _ if place < self.awake => Status::Awake,
+            Some(e) => Status::Failed(e),
+            None => Status::Asleep,
         })
     }
 
@@ -325,7 +342,7 @@ where
     /// # Errors
     /// [`Error::NoSuchInstance`].
     pub fn energies(&self, id: Id) -> Result<Energies<T>, Error> {
-        let slot = &self.slots[self.place(id)?];
+        let slot = self.slot(id)?;
         Ok(Energies {
             kinetic: slot.mechanism.kinetic_energy(&slot.current),
             potential: slot.mechanism.potential_energy(&slot.current),
@@ -341,14 +358,11 @@ where
     pub fn set_state(&mut self, id: Id, state: State<T, N>) -> Result<(), Error> {
         let place = self.place(id)?;
         state.check_finite()?;
-        let slot = &mut self.slots[place];
-        slot.current = State {
-            t: self.time,
-            ..state
-        };
+        let time = self.time;
+        let slot = self.at_mut(place)?;
+        slot.current = State { t: time, ..state };
         slot.previous = slot.current;
-        self.restart(place);
-        Ok(())
+        self.restart(place)
     }
 
     /// Applies a generalized impulse (N s on a length, N m s on an angle; finite) to the
@@ -367,16 +381,13 @@ where
                 reason: "must be finite",
             });
         }
-        let slot = &mut self.slots[place];
+        let slot = self.at_mut(place)?;
         let qd = slot.current.qd + slot.mechanism.velocity_jump(&slot.current, impulse)?;
         if !qd.iter().all(|x| x.is_finite()) {
             return Err(Error::NonFiniteState);
         }
         slot.current.qd = qd;
-        slot.current.t = self.time;
-        slot.previous.t = self.time;
-        self.restart(place);
-        Ok(())
+        self.restart(place)
     }
 
     /// Sets the instance's input ([`Controlled`]). An input equal to the one in force
@@ -389,13 +400,12 @@ where
         M: Controlled<T>,
     {
         let place = self.place(id)?;
-        let mechanism = &mut self.slots[place].mechanism;
+        let mechanism = &mut self.at_mut(place)?.mechanism;
         if mechanism.input() == input {
             return Ok(());
         }
         mechanism.set_input(input)?;
-        self.restart(place);
-        Ok(())
+        self.restart(place)
     }
 
     /// Changes the instance's mechanism (its parameters, its input) by `change`, which may
@@ -427,11 +437,12 @@ where
         M: Clone + PartialEq,
     {
         let place = self.place(id)?;
-        let mut changed = self.slots[place].mechanism.clone();
+        let mechanism = &mut self.at_mut(place)?.mechanism;
+        let mut changed = mechanism.clone();
         let result = change(&mut changed)?;
-        if changed != self.slots[place].mechanism {
-            self.slots[place].mechanism = changed;
-            self.restart(place);
+        if changed != *mechanism {
+            *mechanism = changed;
+            self.restart(place)?;
         }
         Ok(result)
     }
@@ -443,7 +454,7 @@ where
     pub fn wake(&mut self, id: Id) -> Result<(), Error> {
         let place = self.place(id)?;
         if place >= self.awake {
-            self.restart(place);
+            self.restart(place)?;
         }
         Ok(())
     }
@@ -462,11 +473,8 @@ where
     pub fn iter(&self) -> impl Iterator<Item = (Id, &State<T, N>)> + '_ {
         self.slots.iter().map(|slot| {
             let index = slot.id;
-            let id = Id {
-                index,
-                generation: self.generations[index as usize],
-            };
-            (id, &slot.current)
+            let generation = self.entries.get(index as usize).map_or(0, |e| e.generation);
+            (Id { index, generation }, &slot.current)
         })
     }
 
@@ -501,15 +509,15 @@ where
     }
 
     /// Steps every awake instance by `dt`, landing at time `t`, in place order; then, every
-    /// [`Sleeps::interval`](super::Sleeps::interval) steps where the bank sleeps, checks the
-    /// awake instances for rest. Returns how many instances failed this step (they keep
-    /// their last good state and are set aside: [`Status::Failed`]).
+    /// [`Sleeps::interval`] steps where the bank sleeps, checks the awake instances for
+    /// rest. Returns how many instances failed this step (they keep their last good state
+    /// and are set aside: [`Status::Failed`]).
     pub(crate) fn step(&mut self, dt: T, t: T) -> u32 {
         self.time = t;
         let mut failed = 0;
-        for slot in &mut self.slots[..self.awake] {
-            if let Some(e) = slot.advance(dt, t) {
-                self.failures[slot.id as usize] = Some(e);
+        let awake = self.slots.get_mut(..self.awake).unwrap_or_default();
+        for slot in awake {
+            if !slot.advance(dt, t) {
                 failed += 1;
             }
         }
@@ -519,7 +527,7 @@ where
         if let Some(rule) = self.sleep.rule() {
             let interval = u64::from(rule.interval());
             self.steps += 1;
-            if self.steps % interval == 0 {
+            if self.steps.checked_rem(interval) == Some(0) {
                 self.settle();
             }
         }
@@ -542,8 +550,10 @@ where
         let mut place = self.awake;
         while place > 0 {
             place -= 1;
-            let slot = &mut self.slots[place];
-            if self.failures[slot.id as usize].is_some() {
+            let Some(slot) = self.slots.get_mut(place) else {
+                continue;
+            };
+            if slot.failure.is_some() {
                 slot.previous = slot.current;
                 slot.quiet = 0;
                 self.awake -= 1;
@@ -564,7 +574,9 @@ where
         let mut place = self.awake;
         while place > 0 {
             place -= 1;
-            let slot = &mut self.slots[place];
+            let Some(slot) = self.slots.get_mut(place) else {
+                continue;
+            };
             if !rule.rests(&slot.mechanism, &slot.integrator, &slot.current) {
                 slot.quiet = 0;
                 continue;
@@ -586,50 +598,61 @@ where
 
     /// Puts the instance at `place` among the awake (if it is not), with a fresh copy of the
     /// bank's integrator, at the bank's time, cleared of any failure.
-    fn restart(&mut self, place: usize) {
-        let slot = &mut self.slots[place];
-        slot.integrator = self.integrator.clone();
+    fn restart(&mut self, place: usize) -> Result<(), Error> {
+        let (time, integrator) = (self.time, self.integrator.clone());
+        let slot = self.at_mut(place)?;
+        slot.integrator = integrator;
         slot.quiet = 0;
-        slot.current.t = self.time;
-        slot.previous.t = self.time;
-        self.failures[slot.id as usize] = None;
+        slot.current.t = time;
+        slot.previous.t = time;
+        slot.failure = None;
         self.rouse(place);
+        Ok(())
     }
 
     /// Moves the instance at `place` into the awake region when it is outside it.
     fn rouse(&mut self, place: usize) {
-        if place >= self.awake {
+        if place >= self.awake && place < self.slots.len() {
             self.swap(place, self.awake);
             self.awake += 1;
         }
     }
 
-    /// Swaps two places, keeping the table of places in step.
+    /// Swaps two places, keeping the entries in step.
     fn swap(&mut self, a: usize, b: usize) {
-        if a == b {
+        let (low, high) = (a.min(b), a.max(b));
+        // Two disjoint borrows and a plain swap: `slice::swap` pulls in `memmove` on targets
+        // without it in hardware, which alone outweighs a bank's code.
+        let Some((front, back)) = self.slots.split_at_mut_checked(high) else {
             return;
+        };
+        let (Some(x), Some(y)) = (front.get_mut(low), back.first_mut()) else {
+            return;
+        };
+        core::mem::swap(x, y);
+        for (slot, place) in [(x, low), (y, high)] {
+            if let Some(entry) = self.entries.get_mut(slot.id as usize) {
+                entry.place = u32::try_from(place + 1).unwrap_or(0);
+            }
         }
-        self.slots.swap(a, b);
-        for place in [a, b] {
-            let id = self.slots[place].id as usize;
-            self.places[id] = u32::try_from(place).unwrap_or(VACANT);
-        }
-    }
-
-    /// The place of the last slot.
-    fn last_place(&self) -> u32 {
-        u32::try_from(self.slots.len().saturating_sub(1)).unwrap_or(VACANT)
     }
 
     /// The place of the instance `id` names.
     fn place(&self, id: Id) -> Result<usize, Error> {
-        let i = id.index as usize;
-        match self.places.get(i) {
-            Some(&place) if place != VACANT && self.generations[i] == id.generation => {
-                Ok(place as usize)
-            }
+        match self.entries.get(id.index as usize) {
+            Some(e) if e.place != 0 && e.generation == id.generation => Ok(e.place as usize - 1),
             _ => Err(Error::NoSuchInstance),
         }
+    }
+
+    /// The slot of the instance `id` names.
+    fn slot(&self, id: Id) -> Result<&Slot<T, N, M, I>, Error> {
+        self.slots.get(self.place(id)?).ok_or(Error::NoSuchInstance)
+    }
+
+    /// The slot at `place`.
+    fn at_mut(&mut self, place: usize) -> Result<&mut Slot<T, N, M, I>, Error> {
+        self.slots.get_mut(place).ok_or(Error::NoSuchInstance)
     }
 }
 

@@ -4,8 +4,8 @@ use super::{Bank, Sleep};
 use crate::Integrator;
 use lagrange_core::{Mechanism, Real};
 
-/// The banks of a scene, stepped together: one [`Bank`], or a tuple (up to 8) or an array
-/// of values that are [`Banks`] themselves, stepped in order (a tuple's first element
+/// The banks of a scene, stepped together: one [`Bank`], a mutable reference to banks, or a
+/// tuple (up to 8) or an array of values that are [`Banks`] themselves, stepped in order (a tuple's first element
 /// first, an array's from index 0).
 pub trait Banks<T: Real> {
     /// Steps every awake instance of every bank once by `dt`, landing at time `t`, in the
@@ -30,6 +30,19 @@ where
 
     fn set_time(&mut self, t: T) {
         Bank::set_time(self, t);
+    }
+}
+
+/// Banks owned elsewhere (a `static`, a game's own storage), stepped by a scene that borrows
+/// them.
+impl<T: Real, B: Banks<T> + ?Sized> Banks<T> for &mut B {
+    #[inline]
+    fn step(&mut self, dt: T, t: T) -> u32 {
+        (**self).step(dt, t)
+    }
+
+    fn set_time(&mut self, t: T) {
+        (**self).set_time(t);
     }
 }
 

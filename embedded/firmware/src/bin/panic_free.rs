@@ -1,7 +1,7 @@
 //! The panic-free check: steps every shipped unconstrained mechanism with every shipped
 //! fixed-step integrator (explicit, symplectic, Yoshida, implicit Runge-Kutta with Newton), in
 //! `f32` and `f64`, plus the automatic Euler-Lagrange path with a damping force
-//! and the variational integrator, from inputs the optimiser cannot see (`black_box`), with
+//! and the variational integrator, and a scene that sleeps and wakes, from inputs the optimiser cannot see (`black_box`), with
 //! `panic-never` as the panic handler. That handler references an undefined symbol, so the
 //! image links only if the optimised stepping code holds no panic path at all (no bounds
 //! check, unwrap or overflow check left). `cargo xtask qemu` builds it in release (opt-level 3)
@@ -13,8 +13,10 @@
 use core::hint::black_box;
 
 use cortex_m_rt::{entry, exception, ExceptionFrame};
+use lagrange_core::nalgebra::SVector;
 use lagrange_core::{Error, EulerLagrange, Mechanism, Real, State, ViscousDamping};
 use lagrange_firmware::exit;
+use lagrange_integrators::scene::{Bank, Scene, Sleeps};
 use lagrange_integrators::{
     BackwardEuler, ExplicitEuler, GaussLegendre2, ImplicitMidpoint, Integrator, RadauIIA2, Rk4,
     SemiImplicitEuler, StormerVerlet, VariationalMidpoint, VelocityVerlet, Yoshida4,
@@ -33,7 +35,7 @@ fn every_integrator<T: Real, const N: usize, M: Mechanism<T, N>>(
     m: &M,
     start: State<T, N>,
 ) -> bool {
-    fn run<T: Real, const N: usize, M: Mechanism<T, N>, I: Integrator<T, N>>(
+    fn run<T: Real, const N: usize, M: Mechanism<T, N>, I: Integrator<T, N, M>>(
         mut integrator: I,
         m: &M,
         start: State<T, N>,
@@ -55,22 +57,49 @@ fn every_integrator<T: Real, const N: usize, M: Mechanism<T, N>>(
         & run(BackwardEuler::default(), m, start).is_ok()
         & run(GaussLegendre2::default(), m, start).is_ok()
         & run(RadauIIA2::default(), m, start).is_ok()
+        & run(VariationalMidpoint::default(), m, start).is_ok()
 }
 
-/// `STEPS` steps of the variational midpoint rule (which works on a Lagrangian).
-fn variational<T: Real, const N: usize, L: lagrange_integrators::LagrangianSystem<T, N>>(
-    sys: &L,
-    start: State<T, N>,
-) -> bool {
+/// `STEPS` steps of the variational midpoint rule in position-momentum form throughout (its
+/// `integrate`).
+fn variational<T: Real, const N: usize, M: Mechanism<T, N>>(m: &M, start: State<T, N>) -> bool {
     let dt = black_box(T::from_f64(1e-3));
     VariationalMidpoint::default()
         .integrate(
-            black_box(sys),
+            black_box(m),
             &black_box(start),
             dt,
             u64::from(black_box(STEPS)),
         )
         .is_ok()
+}
+
+/// A scene of pendulums that fall asleep, with every per-instance operation: `STEPS` frames,
+/// a wake by each event, a removal; `true` when every call succeeds.
+fn scene<T: Real>() -> Result<bool, Error> {
+    let v = |x: f64| black_box(T::from_f64(x));
+    let rule = Sleeps::new(v(1e-6), v(1e-3), black_box(4))?;
+    let mut bank: Bank<T, 1, 4, SimplePendulum<T>, StormerVerlet<T, 1>, Sleeps<T>> =
+        Bank::new(StormerVerlet::default(), rule)?;
+    let p = SimplePendulum::new(v(1.0), v(1.0), v(9.81), v(0.5))?;
+    let a = bank.add(p, State::at_rest([v(0.5)]))?;
+    let b = bank.add_asleep(p, [v(0.0)])?;
+    let mut scene = Scene::new(&mut bank, v(1.0 / 120.0), 4)?;
+    for _ in 0..black_box(STEPS) {
+        scene.advance(v(1.0 / 60.0))?;
+    }
+    let bank = scene.banks_mut();
+    bank.apply_impulse(b, &SVector::from([v(0.1)]))?;
+    bank.set_state(a, State::at_rest([v(0.2)]))?;
+    bank.wake(b)?;
+    bank.modify(a, |m| {
+        *m = SimplePendulum::new(v(1.0), v(2.0), v(9.81), v(0.5))?;
+        Ok(())
+    })?;
+    let drawn = bank.interpolated(a, v(0.5))?;
+    let energy = bank.energies(a)?.total();
+    bank.remove(b)?;
+    Ok(black_box(drawn.q[0] + energy).is_finite())
 }
 
 /// Every shipped mechanism, and the automatic path, in `T`; `true` when every run succeeds.
@@ -141,7 +170,8 @@ fn every_mechanism<T: Real>() -> Result<bool, Error> {
 fn main() -> ! {
     let f32_ok = matches!(every_mechanism::<f32>(), Ok(true));
     let f64_ok = matches!(every_mechanism::<f64>(), Ok(true));
-    exit(f32_ok && f64_ok)
+    let scenes_ok = matches!(scene::<f32>(), Ok(true)) && matches!(scene::<f64>(), Ok(true));
+    exit(f32_ok && f64_ok && scenes_ok)
 }
 
 #[exception]
