@@ -51,6 +51,10 @@ const REFRESH_RATE: f64 = 0.25;
 /// matrix, which restores Newton's quadratic convergence.
 const STALE_ITERATIONS: i32 = 4;
 
+/// Iterations Newton takes from where a fixed-point iteration gives way to it: a fixed point
+/// too slow to converge with this many iterations to spare switches.
+const NEWTON_ITERATIONS: u32 = 3;
+
 impl<T: Real> NewtonSettings<T> {
     /// Relative `tolerance` (at least `EPSILON`, below 1) and at most `max_iterations`
     /// iterations per step (1 to 1000).
@@ -357,7 +361,14 @@ where
             // A NaN rate counts as slow.
             let rate = size / prev;
             if fixed_point {
-                if exceeds(rate, slow) {
+                // Too slow, or steady but not fast enough to reach the tolerance within the
+                // iterations left less the few Newton would need (a heavily damped kick
+                // contracting by 0.25 needs 20 of them): Newton from here.
+                let left = settings
+                    .max_iterations
+                    .saturating_sub(iteration + NEWTON_ITERATIONS);
+                let left = i32::try_from(left).unwrap_or(i32::MAX);
+                if exceeds(rate, slow) || rate.powi(left) > settings.tolerance / size {
                     fixed_point = false;
                 }
             } else if age <= 1 && size <= floor && exceeds(rate, slow) {

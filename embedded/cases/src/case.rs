@@ -81,8 +81,9 @@ pub struct Case {
     pub method: &'static str,
     /// `"f32"` or `"f64"`.
     pub precision: &'static str,
-    /// Degrees of freedom.
-    pub dof: usize,
+    /// Words in its outcome: `1 + 2 N` for a mechanism's final state (`t`, `q`, `q'`), its
+    /// own count for a scripted case.
+    pub words: usize,
     runner: fn(u32) -> Result<Outcome, Error>,
 }
 
@@ -99,7 +100,7 @@ impl Case {
             system: S::NAME,
             method: I::NAME,
             precision: T::NAME,
-            dof: N,
+            words: 1 + 2 * N,
             runner: run::<T, N, S, I>,
         }
     }
@@ -116,25 +117,26 @@ impl Case {
             system: S::NAME,
             method: "variational midpoint",
             precision: T::NAME,
-            dof: N,
+            words: 1 + 2 * N,
             runner: run_variational::<T, N, S>,
         }
     }
 
-    /// A case run by `runner` of its own (a scripted scene: `steps` counts its frames).
+    /// A case run by `runner` of its own (a scripted scene: `steps` counts its frames), whose
+    /// outcome holds `words` words.
     #[must_use]
     pub const fn scripted(
         system: &'static str,
         method: &'static str,
         precision: &'static str,
-        dof: usize,
+        words: usize,
         runner: fn(u32) -> Result<Outcome, Error>,
     ) -> Self {
         Self {
             system,
             method,
             precision,
-            dof,
+            words,
             runner,
         }
     }

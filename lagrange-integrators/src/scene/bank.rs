@@ -8,13 +8,33 @@ use lagrange_core::nalgebra::SVector;
 use lagrange_core::{Controlled, Error, Mechanism, Real, State};
 
 /// A handle to an instance of a [`Bank`], given by [`Bank::add`]. It stays valid until the
-/// instance is removed; after that, and in any other bank, it names nothing
-/// ([`Error::NoSuchInstance`]), even when its slot has been given to a new instance.
+/// instance is removed; after that it names nothing ([`Error::NoSuchInstance`]), even when
+/// its index has been given to a new instance. Nor does it name anything in another bank
+/// (each bank made by [`Bank::new`] has a key of its own, where the target has 32-bit
+/// atomics; a clone of a bank keeps the key, and its handles name the clone's copies).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Id {
     index: u32,
     generation: u32,
+    bank: u32,
+}
+
+/// The key of the next bank made.
+#[cfg(target_has_atomic = "32")]
+static NEXT_BANK: core::sync::atomic::AtomicU32 = core::sync::atomic::AtomicU32::new(0);
+
+/// A key for a new bank: distinct from those of the last 2^32 banks made (0 for all of them
+/// on a target without 32-bit atomics, where handles then carry no bank).
+fn bank_key() -> u32 {
+    #[cfg(target_has_atomic = "32")]
+    {
+        NEXT_BANK.fetch_add(1, core::sync::atomic::Ordering::Relaxed)
+    }
+    #[cfg(not(target_has_atomic = "32"))]
+    {
+        0
+    }
 }
 
 impl Id {
@@ -181,6 +201,8 @@ pub struct Bank<T: Real, const N: usize, const K: usize, M, I, Z = NeverSleeps> 
     fresh: u32,
     time: T,
     steps: u64,
+    /// The key its handles carry.
+    key: u32,
 }
 
 impl<T, const N: usize, const K: usize, M, I, Z> Bank<T, N, K, M, I, Z>
@@ -213,6 +235,7 @@ where
             fresh: 0,
             time: T::zero(),
             steps: 0,
+            key: bank_key(),
         })
     }
 
@@ -255,7 +278,11 @@ where
             self.fresh += 1;
         }
         self.rouse(place);
-        Ok(Id { index, generation })
+        Ok(Id {
+            index,
+            generation,
+            bank: self.key,
+        })
     }
 
     /// Removes an instance, returning its mechanism and state. Its [`Id`] then names nothing.
@@ -474,7 +501,12 @@ where
         self.slots.iter().map(|slot| {
             let index = slot.id;
             let generation = self.entries.get(index as usize).map_or(0, |e| e.generation);
-            (Id { index, generation }, &slot.current)
+            let id = Id {
+                index,
+                generation,
+                bank: self.key,
+            };
+            (id, &slot.current)
         })
     }
 
@@ -640,7 +672,9 @@ where
     /// The place of the instance `id` names.
     fn place(&self, id: Id) -> Result<usize, Error> {
         match self.entries.get(id.index as usize) {
-            Some(e) if e.place != 0 && e.generation == id.generation => Ok(e.place as usize - 1),
+            Some(e) if e.place != 0 && e.generation == id.generation && id.bank == self.key => {
+                Ok(e.place as usize - 1)
+            }
             _ => Err(Error::NoSuchInstance),
         }
     }
