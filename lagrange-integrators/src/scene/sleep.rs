@@ -51,6 +51,14 @@ const DEFAULT_CHECK_INTERVAL: u32 = 8;
 /// Falling asleep sets its velocities to zero, which changes its energy by its kinetic
 /// energy: at most `kinetic`.
 ///
+/// How long it takes, measured (tests/tests/scene_sleep.rs, `f32` and `f64` alike): a 1 m,
+/// 1 kg pendulum damped at 3 N m s (decay rate 1.5/s) let go from 30 degrees at 120 Hz falls
+/// asleep under `Sleeps::new(1e-6, 1e-3, 60)` 5.73 s after release, 9.7e-5 rad from the
+/// bottom, its energy changed by 7.6e-12 J in falling asleep. The acceleration test decides:
+/// the swing must shrink until `g |sin th| <= 1e-3` at its turning points. An undamped one
+/// swinging from 30 degrees never sleeps (10^6 steps), not even under a kinetic threshold
+/// loose enough to pass at every turning point.
+///
 /// By default a driven mechanism never sleeps; [`Sleeps::even_when_driven`] lets the two
 /// thresholds alone decide (a cart held still by a constant push against a wall).
 ///
