@@ -4,8 +4,8 @@
 use crate::constraints::{Constrained, Constraints, Held};
 use crate::forces::{Forced, NoForce};
 use crate::{
-    central_difference_jacobian, solve_spd, Error, GeneralizedForce, Jacobian, Lagrangian, Real,
-    State,
+    central_difference_jacobian, solve_spd, Error, GeneralizedForce, Jacobian, Lagrangian, Lanes,
+    Real, State,
 };
 use nalgebra::{SMatrix, SVector};
 
@@ -118,6 +118,9 @@ pub trait Mechanism<T: Real, const N: usize>: Lagrangian<T, N> {
     ///
     /// # Errors
     /// As [`Mechanism::law`]; [`Error::NonFiniteState`] when they are not finite.
+    // Inlined into the integrators' stages: returned through memory, the accelerations of a
+    // mechanism stepped in lanes stall every load that reads them back.
+    #[inline(always)]
     fn acceleration(&self, state: &State<T, N>) -> Result<SVector<T, N>, Error> {
         self.acceleration_with(state, &NoForce)
     }
@@ -142,6 +145,7 @@ pub trait Mechanism<T: Real, const N: usize>: Lagrangian<T, N> {
     ///
     /// # Errors
     /// As [`Mechanism::acceleration`].
+    #[inline(always)]
     fn acceleration_with<F: GeneralizedForce<T, N>>(
         &self,
         state: &State<T, N>,
@@ -195,6 +199,15 @@ pub trait Mechanism<T: Real, const N: usize>: Lagrangian<T, N> {
         impulse: &SVector<T, N>,
     ) -> Result<SVector<T, N>, Error> {
         finite(self.solve_mass(state, impulse)?)
+    }
+
+    /// These instances of the type side by side, as one mechanism over [`Lanes`] (lane `i`
+    /// is `instances[i]`), where the type can gather its parameters (a plain struct of
+    /// scalars): what lets a scene step a bank `L` instances at a time, each lane bit for bit
+    /// its instance alone. `None` by default, and then a bank steps them one by one.
+    fn gather<const L: usize>(instances: [&Self; L]) -> Option<impl Mechanism<Lanes<T, L>, N>> {
+        let _ = instances;
+        None::<Ungathered>
     }
 
     /// This mechanism with `force` added to its generalized forces.
@@ -265,5 +278,33 @@ where
     match failure {
         Some(e) => Err(e),
         None => Ok((qdd, j)),
+    }
+}
+
+/// The mechanism of a type that gathers no lanes ([`Mechanism::gather`]'s default): a type with
+/// no value, so that none of its methods can be called.
+#[derive(Debug, Clone, Copy)]
+pub(crate) enum Ungathered {}
+
+impl<T: Real, const N: usize> Lagrangian<T, N> for Ungathered {
+    fn kinetic<S: crate::Scalar<Real = T>>(
+        &self,
+        _t: S,
+        _q: &SVector<S, N>,
+        _qd: &SVector<S, N>,
+    ) -> S {
+        match *self {}
+    }
+    fn potential<S: crate::Scalar<Real = T>>(&self, _t: S, _q: &SVector<S, N>) -> S {
+        match *self {}
+    }
+}
+
+impl<T: Real, const N: usize> Mechanism<T, N> for Ungathered {
+    fn mass_matrix(&self, _state: &State<T, N>) -> SMatrix<T, N, N> {
+        match *self {}
+    }
+    fn rhs(&self, _state: &State<T, N>) -> SVector<T, N> {
+        match *self {}
     }
 }

@@ -3,7 +3,7 @@
 
 use core::fmt;
 use lagrange_core::nalgebra::SVector;
-use lagrange_core::{Error, Mechanism, Real, State};
+use lagrange_core::{Error, Lanes, Mechanism, Real, State};
 
 /// What a step of a method costs, in evaluations of the mechanism's acceleration law, for
 /// every method alike: `fixed + per_iteration * iterations` accelerations and `jacobians`
@@ -161,6 +161,23 @@ pub trait Integrator<T: Real, const N: usize, M: Mechanism<T, N>>: Method {
     /// As [`Mechanism::acceleration`].
     fn law_acceleration(&self, mechanism: &M, state: &State<T, N>) -> Result<SVector<T, N>, Error> {
         mechanism.acceleration(state)
+    }
+
+    /// Steps `L` instances at once, side by side in lanes (their mechanisms gathered by
+    /// [`Mechanism::gather`]), each lane bit for bit what [`Integrator::step`] gives for its
+    /// instance alone: where the method keeps nothing between steps, `Some`; `None` by
+    /// default, and then the caller steps the instances one by one. The result is that of
+    /// every lane only if no comparison diverged across the lanes meanwhile
+    /// ([`lagrange_core::divergences`]): the caller reads the count before and after, and
+    /// steps the instances one by one otherwise (or on an error).
+    fn step_lanes<const L: usize, G: Mechanism<Lanes<T, L>, N>>(
+        &self,
+        mechanism: &G,
+        state: &State<Lanes<T, L>, N>,
+        dt: T,
+    ) -> Option<Result<State<Lanes<T, L>, N>, Error>> {
+        let _ = (mechanism, state, dt);
+        None
     }
 
     /// Takes `steps` steps of `dt` from `state` and returns the last state. The time of the

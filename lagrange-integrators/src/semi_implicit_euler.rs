@@ -2,7 +2,7 @@
 
 use crate::integrator::{check_step, finish, Cost};
 use crate::{Integrator, Method};
-use lagrange_core::{Error, Mechanism, Real, State};
+use lagrange_core::{Error, Lanes, Mechanism, Real, State};
 
 /// Semi-implicit Euler: `q'1 = q'0 + h q''(q0, q'0)`, then `q1 = q0 + h q'1`.
 ///
@@ -22,6 +22,21 @@ impl Method for SemiImplicitEuler {
 }
 
 impl<T: Real, const N: usize, M: Mechanism<T, N>> Integrator<T, N, M> for SemiImplicitEuler {
+    /// The same step over lanes: it keeps nothing between steps.
+    fn step_lanes<const L: usize, G: Mechanism<Lanes<T, L>, N>>(
+        &self,
+        mechanism: &G,
+        state: &State<Lanes<T, L>, N>,
+        dt: T,
+    ) -> Option<Result<State<Lanes<T, L>, N>, Error>> {
+        Some(Integrator::<Lanes<T, L>, N, G>::step(
+            &mut SemiImplicitEuler,
+            mechanism,
+            state,
+            Lanes::splat(dt),
+        ))
+    }
+
     fn step(&mut self, m: &M, s: &State<T, N>, dt: T) -> Result<State<T, N>, Error> {
         let h = check_step(s, dt)?;
         let qd = s.qd + m.acceleration(s)? * h;

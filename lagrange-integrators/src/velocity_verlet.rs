@@ -2,7 +2,7 @@
 
 use crate::integrator::{check_step, finish, Cost};
 use crate::{Integrator, Method};
-use lagrange_core::{Error, Mechanism, Real, State};
+use lagrange_core::{Error, Lanes, Mechanism, Real, State};
 
 /// Velocity Verlet in kick-drift-kick form:
 ///
@@ -32,6 +32,21 @@ impl Method for VelocityVerlet {
 }
 
 impl<T: Real, const N: usize, M: Mechanism<T, N>> Integrator<T, N, M> for VelocityVerlet {
+    /// The same step over lanes: it keeps nothing between steps.
+    fn step_lanes<const L: usize, G: Mechanism<Lanes<T, L>, N>>(
+        &self,
+        mechanism: &G,
+        state: &State<Lanes<T, L>, N>,
+        dt: T,
+    ) -> Option<Result<State<Lanes<T, L>, N>, Error>> {
+        Some(Integrator::<Lanes<T, L>, N, G>::step(
+            &mut VelocityVerlet,
+            mechanism,
+            state,
+            Lanes::splat(dt),
+        ))
+    }
+
     fn step(&mut self, m: &M, s: &State<T, N>, dt: T) -> Result<State<T, N>, Error> {
         let h = check_step(s, dt)?;
         let half = h * T::HALF;

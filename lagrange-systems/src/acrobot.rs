@@ -3,7 +3,8 @@
 use crate::small_solve::solve_sym2;
 use lagrange_core::nalgebra::{Matrix2, SVector, Vector2};
 use lagrange_core::{
-    validate, Controlled, Error, GeneralizedForce, Lagrangian, Mechanism, Real, Scalar, State,
+    validate, Controlled, Error, GeneralizedForce, Lagrangian, Lanes, Mechanism, Real, Scalar,
+    State,
 };
 
 /// Spong's acrobot: two rigid links in a vertical plane, the first hinged to a fixed pivot
@@ -208,6 +209,22 @@ impl<T: Real> Controlled<T> for Acrobot<T> {
 }
 
 impl<T: Real> Mechanism<T, 2> for Acrobot<T> {
+    /// Lane by lane: every parameter gathered.
+    fn gather<const L: usize>(instances: [&Self; L]) -> Option<impl Mechanism<Lanes<T, L>, 2>> {
+        let lanes = |field: fn(&Self) -> T| Lanes::gather(&instances, field);
+        Some(Acrobot {
+            m1: lanes(|m| m.m1),
+            m2: lanes(|m| m.m2),
+            l1: lanes(|m| m.l1),
+            l2: lanes(|m| m.l2),
+            lc1: lanes(|m| m.lc1),
+            lc2: lanes(|m| m.lc2),
+            i1: lanes(|m| m.i1),
+            i2: lanes(|m| m.i2),
+            gravity: lanes(|m| m.gravity),
+            torque: lanes(|m| m.torque),
+        })
+    }
     fn mass_matrix(&self, s: &State<T, 2>) -> Matrix2<T> {
         self.terms(s).0
     }

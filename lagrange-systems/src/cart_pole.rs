@@ -3,7 +3,8 @@
 use crate::small_solve::solve_sym2;
 use lagrange_core::nalgebra::{Matrix2, SVector, Vector2};
 use lagrange_core::{
-    validate, Controlled, Error, GeneralizedForce, Lagrangian, Mechanism, Real, Scalar, State,
+    validate, Controlled, Error, GeneralizedForce, Lagrangian, Lanes, Mechanism, Real, Scalar,
+    State,
 };
 
 /// The cart-pole: a cart of mass `M` on a frictionless horizontal track, driven by a horizontal
@@ -137,6 +138,17 @@ impl<T: Real> Controlled<T> for CartPole<T> {
 }
 
 impl<T: Real> Mechanism<T, 2> for CartPole<T> {
+    /// Lane by lane: every parameter gathered.
+    fn gather<const L: usize>(instances: [&Self; L]) -> Option<impl Mechanism<Lanes<T, L>, 2>> {
+        let lanes = |field: fn(&Self) -> T| Lanes::gather(&instances, field);
+        Some(CartPole {
+            cart_mass: lanes(|m| m.cart_mass),
+            pole_mass: lanes(|m| m.pole_mass),
+            pole_half_length: lanes(|m| m.pole_half_length),
+            gravity: lanes(|m| m.gravity),
+            force: lanes(|m| m.force),
+        })
+    }
     fn mass_matrix(&self, s: &State<T, 2>) -> Matrix2<T> {
         self.terms(s).0
     }

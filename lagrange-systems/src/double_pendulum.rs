@@ -3,7 +3,7 @@
 use crate::small_solve::solve_sym2_det;
 use lagrange_core::nalgebra::{Matrix2, SVector, Vector2};
 use lagrange_core::{
-    validate, Error, GeneralizedForce, Lagrangian, Mechanism, Real, Scalar, State,
+    validate, Error, GeneralizedForce, Lagrangian, Lanes, Mechanism, Real, Scalar, State,
 };
 
 /// Point masses `m1`, `m2` on massless rods `l1`, `l2`: the first hangs from a fixed pivot,
@@ -136,6 +136,25 @@ impl<T: Real> DoublePendulum<T> {
 }
 
 impl<T: Real> Mechanism<T, 2> for DoublePendulum<T> {
+    /// Lane by lane: every parameter gathered.
+    fn gather<const L: usize>(instances: [&Self; L]) -> Option<impl Mechanism<Lanes<T, L>, 2>> {
+        let lanes = |field: fn(&Self) -> T| Lanes::gather(&instances, field);
+        Some(DoublePendulum {
+            m1: lanes(|m| m.m1),
+            m2: lanes(|m| m.m2),
+            l1: lanes(|m| m.l1),
+            l2: lanes(|m| m.l2),
+            gravity: lanes(|m| m.gravity),
+            k: Coefficients {
+                m11: lanes(|m| m.k.m11),
+                m22: lanes(|m| m.k.m22),
+                coupling: lanes(|m| m.k.coupling),
+                weight1: lanes(|m| m.k.weight1),
+                weight2: lanes(|m| m.k.weight2),
+                det_scale: lanes(|m| m.k.det_scale),
+            },
+        })
+    }
     fn mass_matrix(&self, s: &State<T, 2>) -> Matrix2<T> {
         self.mass((s.q[0] - s.q[1]).cos())
     }

@@ -1,7 +1,7 @@
 //! [`FallingParticle`]: a point mass in uniform gravity.
 
 use lagrange_core::nalgebra::{Matrix1, SMatrix, SVector, Vector1};
-use lagrange_core::{validate, Error, Lagrangian, Mechanism, Real, Scalar, State};
+use lagrange_core::{validate, Error, Lagrangian, Lanes, Mechanism, Real, Scalar, State};
 
 /// A point mass `m` falling in uniform gravity `g` along -y.
 ///
@@ -52,6 +52,14 @@ impl<T: Real> FallingParticle<T> {
 }
 
 impl<T: Real> Mechanism<T, 1> for FallingParticle<T> {
+    /// Lane by lane: every parameter gathered.
+    fn gather<const L: usize>(instances: [&Self; L]) -> Option<impl Mechanism<Lanes<T, L>, 1>> {
+        let lanes = |field: fn(&Self) -> T| Lanes::gather(&instances, field);
+        Some(FallingParticle {
+            mass: lanes(|m| m.mass),
+            gravity: lanes(|m| m.gravity),
+        })
+    }
     fn mass_matrix(&self, _s: &State<T, 1>) -> SMatrix<T, 1, 1> {
         Matrix1::new(self.mass)
     }

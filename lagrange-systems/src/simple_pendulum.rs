@@ -2,7 +2,7 @@
 
 use lagrange_core::nalgebra::{Matrix1, SMatrix, SVector, Vector1};
 use lagrange_core::{
-    validate, Error, GeneralizedForce, Lagrangian, Mechanism, Real, Scalar, State,
+    validate, Error, GeneralizedForce, Lagrangian, Lanes, Mechanism, Real, Scalar, State,
 };
 
 /// A point mass `m` on a massless rod of length `l` about a fixed pivot, in gravity `g`, with
@@ -89,6 +89,19 @@ impl<T: Real> SimplePendulum<T> {
 }
 
 impl<T: Real> Mechanism<T, 1> for SimplePendulum<T> {
+    /// Lane by lane: every parameter gathered.
+    fn gather<const L: usize>(instances: [&Self; L]) -> Option<impl Mechanism<Lanes<T, L>, 1>> {
+        let lanes = |field: fn(&Self) -> T| Lanes::gather(&instances, field);
+        Some(SimplePendulum {
+            mass: lanes(|m| m.mass),
+            length: lanes(|m| m.length),
+            gravity: lanes(|m| m.gravity),
+            damping: lanes(|m| m.damping),
+            w2: lanes(|m| m.w2),
+            rate: lanes(|m| m.rate),
+            inv_inertia: lanes(|m| m.inv_inertia),
+        })
+    }
     fn mass_matrix(&self, _s: &State<T, 1>) -> SMatrix<T, 1, 1> {
         Matrix1::new(self.inertia())
     }
@@ -99,6 +112,9 @@ impl<T: Real> Mechanism<T, 1> for SimplePendulum<T> {
         Ok(b * self.inv_inertia)
     }
     /// The closed form.
+    // Inlined into the integrators' stages: returned through memory, the accelerations of
+    // pendulums stepped in lanes stall the loads that read them back.
+    #[inline(always)]
     fn law<F: GeneralizedForce<T, 1>>(
         &self,
         s: &State<T, 1>,

@@ -2,7 +2,7 @@
 
 use crate::small_solve::finite;
 use lagrange_core::nalgebra::{Matrix1, SMatrix, SVector, Vector1};
-use lagrange_core::{validate, Error, Lagrangian, Mechanism, Real, Scalar, State};
+use lagrange_core::{validate, Error, Lagrangian, Lanes, Mechanism, Real, Scalar, State};
 
 /// A mass `m` on a linear spring of stiffness `k` and a viscous damper `c`, no gravity.
 ///
@@ -64,6 +64,15 @@ impl<T: Real> SpringMassDamper<T> {
 }
 
 impl<T: Real> Mechanism<T, 1> for SpringMassDamper<T> {
+    /// Lane by lane: every parameter gathered.
+    fn gather<const L: usize>(instances: [&Self; L]) -> Option<impl Mechanism<Lanes<T, L>, 1>> {
+        let lanes = |field: fn(&Self) -> T| Lanes::gather(&instances, field);
+        Some(SpringMassDamper {
+            mass: lanes(|m| m.mass),
+            stiffness: lanes(|m| m.stiffness),
+            damping: lanes(|m| m.damping),
+        })
+    }
     fn mass_matrix(&self, _s: &State<T, 1>) -> SMatrix<T, 1, 1> {
         Matrix1::new(self.mass)
     }
