@@ -123,6 +123,14 @@ pub(super) fn real<T: Real>(x: f64) -> T {
     T::from_f64(x)
 }
 
+/// Zero for a finite `x`, NaN for an infinite or NaN one: added to a value, it makes that
+/// value NaN exactly where `x` is not finite, without a branch.
+#[inline(always)]
+#[allow(clippy::eq_op)] // `x - x` is the point: NaN exactly where `x` is not finite
+fn nan_unless_finite<T: Real>(x: T) -> T {
+    x - x
+}
+
 /// `sum_j w_j k_j` over the first `w.len()` stages with a non-zero weight.
 ///
 /// Always inlined: where `w` is a row of the pair's constant tableau at a constant index (the
@@ -333,16 +341,17 @@ where
         let (rtol, atol) = (self.settings.rtol(), self.settings.atol());
         let y0 = &self.state;
         // The weights 1 / (atol + rtol max(|y0|, |y1|)), divided once for both estimates.
-        // Each weight is poisoned by `b - b`, zero for a finite `b` and NaN otherwise, so that a
-        // new state that is not finite makes the error NaN and the step is rejected: the
-        // check rides on the weights, computed beside the estimate, instead of a test of
-        // `y1` whose branch changed how the whole step was compiled and cost a third of a
+        // Each weight is poisoned by `y1`'s component ([`nan_unless_finite`]), so that a new
+        // state that is not finite makes the error NaN and the step is rejected: the check
+        // rides on the weights, computed beside the estimate, instead of a test of `y1` whose
+        // branch changed how the whole step was compiled and cost a third of a
         // Dormand-Prince step of a Kepler orbit.
-        let weight = |a: T, b: T| (atol + rtol * a.abs().max(b.abs())).recip() + (b - b);
+        let weight =
+            |a: T, b: T| (atol + rtol * a.abs().max(b.abs())).recip() + nan_unless_finite(b);
         let wq = SVector::<T, N>::from_fn(|i, _| weight(y0.q[i], y1.q[i]));
         let wv = SVector::<T, N>::from_fn(|i, _| weight(y0.qd[i], y1.qd[i]));
         // The time too, on the factor `|h|`, which is known before the estimate.
-        let h = h.abs() + (y1.t - y1.t);
+        let h = h.abs() + nan_unless_finite(y1.t);
         let n = T::from_f64(2.0 * N as f64);
         let err5 = self.weighted_sum_sq(&P::E[..=P::FSAL], &wq, &wv);
         match P::E3 {
