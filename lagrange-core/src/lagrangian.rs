@@ -324,8 +324,7 @@ impl<T: Real, const N: usize, L: Lagrangian<T, N>> Mechanism<T, N> for EulerLagr
         s: &State<T, N>,
         extra: &F,
     ) -> Result<SVector<T, N>, Error> {
-        let q = self.lagrangian.non_conservative_force(s);
-        Ok(if F::IS_ZERO { q } else { q + extra.force(s) })
+        Ok(crate::free_law_force(&self.lagrangian, s, extra))
     }
 }
 

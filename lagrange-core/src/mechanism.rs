@@ -101,7 +101,9 @@ pub trait Mechanism<T: Real, const N: usize>: Lagrangian<T, N> {
     /// The generalized force the law applies besides `f`: `M q'' - f`, that is `Q + extra`
     /// for an unconstrained law, plus the constraint forces for a constrained one. The
     /// default evaluates exactly that (one law, one mass matrix, one `f`); a type may
-    /// override it with the same force in closed form.
+    /// override it with the same force in closed form ([`free_law_force`] for a free law).
+    ///
+    /// [`free_law_force`]: crate::free_law_force
     ///
     /// # Errors
     /// As [`Mechanism::law`].

@@ -1,7 +1,7 @@
 //! [`ImplicitRungeKutta`]: the one stepper behind implicit midpoint, Gauss-Legendre, backward
 //! Euler and Radau IIA, each given by its Butcher tableau ([`ImplicitTableau`]).
 
-use crate::integrator::{check_signed, check_step, finish, Cost, Work};
+use crate::integrator::{check_signed, check_step, finish, step_loop, Cost, Failure, Work};
 use crate::newton::{self, BlockMatrix, Blocks, NewtonProblem, NewtonSettings, Start};
 use crate::{Integrator, Method, MidpointTableau, SymmetricBase};
 use core::marker::PhantomData;
@@ -258,6 +258,19 @@ where
     fn step(&mut self, m: &Mech, s: &State<T, N>, dt: T) -> Result<State<T, N>, Error> {
         let h = check_step(s, dt)?;
         self.advance(m, s, h)
+    }
+
+    /// As the default, with `dt` and the start checked once rather than at every step (each
+    /// step's end is checked, so the next step's start is known finite).
+    fn integrate_with<F: FnMut(&State<T, N>)>(
+        &mut self,
+        m: &Mech,
+        state: &State<T, N>,
+        dt: T,
+        steps: u64,
+        observe: F,
+    ) -> Result<State<T, N>, Failure<T, N>> {
+        step_loop(state, dt, steps, |s| self.advance(m, s, dt), observe)
     }
 }
 

@@ -3,8 +3,8 @@
 use crate::small_solve::solve_sym2;
 use lagrange_core::nalgebra::{Matrix2, SVector, Vector2};
 use lagrange_core::{
-    validate, Controlled, Error, GeneralizedForce, Lagrangian, Lanes, Mechanism, Real, Scalar,
-    State,
+    free_law_force, validate, Controlled, Error, GeneralizedForce, Lagrangian, Lanes, Mechanism,
+    Real, Scalar, State,
 };
 
 /// Spong's acrobot: two rigid links in a vertical plane, the first hinged to a fixed pivot
@@ -245,6 +245,13 @@ impl<T: Real> Mechanism<T, 2> for Acrobot<T> {
             &mass,
             &extra.added_to(s, f + self.non_conservative_force(s)),
         )
+    }
+    fn law_force<F: GeneralizedForce<T, 2>>(
+        &self,
+        s: &State<T, 2>,
+        extra: &F,
+    ) -> Result<SVector<T, 2>, Error> {
+        Ok(free_law_force(self, s, extra))
     }
 }
 

@@ -1,7 +1,9 @@
 //! [`BeadOnRotatingHoop`]: a bead sliding on a vertical hoop driven to spin about the vertical.
 
 use lagrange_core::nalgebra::{Matrix1, SMatrix, SVector, Vector1};
-use lagrange_core::{validate, Error, Lagrangian, Mechanism, Real, Scalar, State};
+use lagrange_core::{
+    free_law_force, validate, Error, GeneralizedForce, Lagrangian, Mechanism, Real, Scalar, State,
+};
 
 /// A bead of mass `m` sliding without friction on a vertical hoop of radius `R` that is driven
 /// at constant angular speed `omega` about the vertical axis through its centre.
@@ -96,6 +98,13 @@ impl<T: Real> Mechanism<T, 1> for BeadOnRotatingHoop<T> {
     }
     fn solve_mass(&self, _s: &State<T, 1>, b: &SVector<T, 1>) -> Result<SVector<T, 1>, Error> {
         Ok(b / self.inertia())
+    }
+    fn law_force<F: GeneralizedForce<T, 1>>(
+        &self,
+        s: &State<T, 1>,
+        extra: &F,
+    ) -> Result<SVector<T, 1>, Error> {
+        Ok(free_law_force(self, s, extra))
     }
 }
 

@@ -3,7 +3,8 @@
 use crate::small_solve::solve_sym2_det;
 use lagrange_core::nalgebra::{Matrix2, SVector, Vector2};
 use lagrange_core::{
-    validate, Error, GeneralizedForce, Lagrangian, Lanes, Mechanism, Real, Scalar, State,
+    free_law_force, validate, Error, GeneralizedForce, Lagrangian, Lanes, Mechanism, Real, Scalar,
+    State,
 };
 
 /// Point masses `m1`, `m2` on massless rods `l1`, `l2`: the first hangs from a fixed pivot,
@@ -176,6 +177,13 @@ impl<T: Real> Mechanism<T, 2> for DoublePendulum<T> {
     ) -> Result<SVector<T, 2>, Error> {
         let (m, f, det) = self.terms(s);
         solve_sym2_det(&m, det, &extra.added_to(s, f))
+    }
+    fn law_force<F: GeneralizedForce<T, 2>>(
+        &self,
+        s: &State<T, 2>,
+        extra: &F,
+    ) -> Result<SVector<T, 2>, Error> {
+        Ok(free_law_force(self, s, extra))
     }
 }
 

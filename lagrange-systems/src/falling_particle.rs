@@ -1,7 +1,10 @@
 //! [`FallingParticle`]: a point mass in uniform gravity.
 
 use lagrange_core::nalgebra::{Matrix1, SMatrix, SVector, Vector1};
-use lagrange_core::{validate, Error, Lagrangian, Lanes, Mechanism, Real, Scalar, State};
+use lagrange_core::{
+    free_law_force, validate, Error, GeneralizedForce, Lagrangian, Lanes, Mechanism, Real, Scalar,
+    State,
+};
 
 /// A point mass `m` falling in uniform gravity `g` along -y.
 ///
@@ -68,6 +71,13 @@ impl<T: Real> Mechanism<T, 1> for FallingParticle<T> {
     }
     fn solve_mass(&self, _s: &State<T, 1>, b: &SVector<T, 1>) -> Result<SVector<T, 1>, Error> {
         Ok(b / self.mass)
+    }
+    fn law_force<F: GeneralizedForce<T, 1>>(
+        &self,
+        s: &State<T, 1>,
+        extra: &F,
+    ) -> Result<SVector<T, 1>, Error> {
+        Ok(free_law_force(self, s, extra))
     }
 }
 

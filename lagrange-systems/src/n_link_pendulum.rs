@@ -3,7 +3,7 @@
 use crate::small_solve::finite;
 use lagrange_core::nalgebra::{SMatrix, SVector};
 use lagrange_core::{
-    validate, Error, GeneralizedForce, Lagrangian, Mechanism, Real, Scalar, State,
+    free_law_force, validate, Error, GeneralizedForce, Lagrangian, Mechanism, Real, Scalar, State,
 };
 
 /// A planar chain of `N` point masses `m_j` on massless rods of lengths `l_j`: rod 1 hangs from
@@ -305,6 +305,13 @@ impl<T: Real, const N: usize> Mechanism<T, N> for NLinkPendulum<T, N> {
         } else {
             free + self.solve_mass(s, &extra.force(s))?
         })
+    }
+    fn law_force<F: GeneralizedForce<T, N>>(
+        &self,
+        s: &State<T, N>,
+        extra: &F,
+    ) -> Result<SVector<T, N>, Error> {
+        Ok(free_law_force(self, s, extra))
     }
 }
 

@@ -2,7 +2,8 @@
 
 use lagrange_core::nalgebra::{Matrix1, SMatrix, SVector, Vector1};
 use lagrange_core::{
-    validate, Error, GeneralizedForce, Lagrangian, Lanes, Mechanism, Real, Scalar, State,
+    free_law_force, validate, Error, GeneralizedForce, Lagrangian, Lanes, Mechanism, Real, Scalar,
+    State,
 };
 
 /// A point mass `m` on a massless rod of length `l` about a fixed pivot, in gravity `g`, with
@@ -126,6 +127,13 @@ impl<T: Real> Mechanism<T, 1> for SimplePendulum<T> {
         } else {
             free + extra.force(s) * self.inv_inertia
         })
+    }
+    fn law_force<F: GeneralizedForce<T, 1>>(
+        &self,
+        s: &State<T, 1>,
+        extra: &F,
+    ) -> Result<SVector<T, 1>, Error> {
+        Ok(free_law_force(self, s, extra))
     }
 }
 

@@ -2,7 +2,9 @@
 
 use crate::small_solve::solve_diagonal2;
 use lagrange_core::nalgebra::{Matrix2, SVector, Vector2};
-use lagrange_core::{validate, Error, Lagrangian, Mechanism, Real, Scalar, State};
+use lagrange_core::{
+    free_law_force, validate, Error, GeneralizedForce, Lagrangian, Mechanism, Real, Scalar, State,
+};
 
 /// What [`SphericalPendulum`] reports on the vertical axis.
 const ON_AXIS: &str = "sin(th) = 0: spherical pendulum on the vertical axis";
@@ -115,6 +117,13 @@ impl<T: Real> Mechanism<T, 2> for SphericalPendulum<T> {
         let sin = s.q[0].sin();
         let i = self.inertia();
         solve_diagonal2(s, [i, i * sin * sin], b, ON_AXIS)
+    }
+    fn law_force<F: GeneralizedForce<T, 2>>(
+        &self,
+        s: &State<T, 2>,
+        extra: &F,
+    ) -> Result<SVector<T, 2>, Error> {
+        Ok(free_law_force(self, s, extra))
     }
 }
 

@@ -2,7 +2,10 @@
 
 use crate::small_solve::finite;
 use lagrange_core::nalgebra::{Matrix1, SMatrix, SVector, Vector1};
-use lagrange_core::{validate, Error, Lagrangian, Lanes, Mechanism, Real, Scalar, State};
+use lagrange_core::{
+    free_law_force, validate, Error, GeneralizedForce, Lagrangian, Lanes, Mechanism, Real, Scalar,
+    State,
+};
 
 /// A mass `m` on a linear spring of stiffness `k` and a viscous damper `c`, no gravity.
 ///
@@ -81,6 +84,13 @@ impl<T: Real> Mechanism<T, 1> for SpringMassDamper<T> {
     }
     fn solve_mass(&self, _s: &State<T, 1>, b: &SVector<T, 1>) -> Result<SVector<T, 1>, Error> {
         finite(b / self.mass, Error::NonFiniteState)
+    }
+    fn law_force<F: GeneralizedForce<T, 1>>(
+        &self,
+        s: &State<T, 1>,
+        extra: &F,
+    ) -> Result<SVector<T, 1>, Error> {
+        Ok(free_law_force(self, s, extra))
     }
 }
 

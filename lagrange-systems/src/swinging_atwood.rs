@@ -2,7 +2,9 @@
 
 use crate::small_solve::{positive_radius, solve_diagonal2};
 use lagrange_core::nalgebra::{Matrix2, SVector, Vector2};
-use lagrange_core::{validate, Error, Lagrangian, Mechanism, Real, Scalar, State};
+use lagrange_core::{
+    free_law_force, validate, Error, GeneralizedForce, Lagrangian, Mechanism, Real, Scalar, State,
+};
 
 /// What [`SwingingAtwood`] reports at `r <= 0`.
 const AT_PULLEY: &str = "string length r <= 0: swinging mass at the pulley";
@@ -116,6 +118,15 @@ impl<T: Real> Mechanism<T, 2> for SwingingAtwood<T> {
             b,
             AT_PULLEY,
         )
+    }
+    fn law_force<F: GeneralizedForce<T, 2>>(
+        &self,
+        s: &State<T, 2>,
+        extra: &F,
+    ) -> Result<SVector<T, 2>, Error> {
+        // The law refuses r <= 0, and so does its force.
+        positive_radius(s, AT_PULLEY)?;
+        Ok(free_law_force(self, s, extra))
     }
 }
 
