@@ -18,8 +18,11 @@ use core::fmt;
 use core::ops::{Add, AddAssign, Div, DivAssign, Mul, MulAssign, Neg, Sub, SubAssign};
 use num_traits::{One, Zero};
 
-/// `L` values side by side (see the [module](self)): a [`Real`] whose every operation acts lane
-/// by lane.
+/// `L` values side by side: a [`Real`] whose every operation acts lane by lane, each lane with
+/// the bits the scalar operation gives. A comparison holds when it holds in every lane; where
+/// the lanes disagree it is false and counts a divergence ([`divergences`]), so that a caller
+/// stepping lanes can tell that one branch was taken for lanes that needed different ones, and
+/// step the instances one by one instead.
 ///
 /// ```
 /// use lagrange_core::{Lanes, Real, Scalar};
