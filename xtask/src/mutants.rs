@@ -116,8 +116,8 @@ const AREAS: [Area; 9] = [
     },
     Area {
         name: "impacts",
-        package: "lagrange-integrators",
-        files: &["lagrange-integrators/src/impacts/impulse.rs"],
+        package: "lagrange-core",
+        files: &["lagrange-core/src/constraints/contact/impulse.rs"],
         only: None,
         tests: &[
             "--test",
@@ -157,7 +157,14 @@ const AREAS: [Area; 9] = [
         package: "lagrange-core",
         files: &["lagrange-core/src/fast_trig.rs"],
         only: None,
-        tests: &["--test", "fast_trig", "--test", "fast_trig_pendulum"],
+        tests: &[
+            "--test",
+            "fast_trig",
+            "--test",
+            "fast_trig_pendulum",
+            "--test",
+            "lanes",
+        ],
     },
     Area {
         name: "systems-one",
