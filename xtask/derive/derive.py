@@ -423,9 +423,9 @@ class Derivation:
         self.driven = self.explicit_time or s.t in V.free_symbols or (
             self.Q is not None and any(s.t in e.free_symbols for e in self.Q)
         )
-        self.constant_mass = all(
-            not (e.free_symbols & s.state_symbols) for e in self.M
-        )
+        # The library's CONSTANT_MASS means more than a constant M: T must not depend on q or
+        # t at all (the automatic path then takes f = -dV/dq and never differentiates T).
+        self.constant_mass = not (T.free_symbols & (set(s.qs) | {s.t}))
         check_mass_matrix(self.M, s)
         if s.phi is not None:
             qv = sp.Matrix(s.qs)

@@ -36,7 +36,7 @@ const PROBE: &str = "import sympy, mpmath; \
 
 /// The committed mechanisms: spec, generated file (both relative to the workspace root).
 /// Each is generated with `--tests`.
-pub const GENERATED: [(&str, &str); 4] = [
+pub const GENERATED: [(&str, &str); 6] = [
     (
         "derive/specs/pendulum.py",
         "derive/generated/src/pendulum.rs",
@@ -48,6 +48,14 @@ pub const GENERATED: [(&str, &str); 4] = [
     (
         "derive/specs/spring_cart_pendulum.py",
         "derive/generated/src/spring_cart_pendulum.rs",
+    ),
+    (
+        "derive/specs/triple_pendulum.py",
+        "derive/generated/src/triple_pendulum.rs",
+    ),
+    (
+        "derive/specs/kapitza_pendulum.py",
+        "derive/generated/src/kapitza_pendulum.rs",
     ),
     (
         "derive/specs/cartesian_pendulum.py",

@@ -30,7 +30,8 @@ impl Venv<'_> {
         if self.ready(&python) {
             return Ok(python);
         }
-        println!(
+        // On stderr: `cargo xtask derive` without `--out` writes its code to stdout.
+        eprintln!(
             "{}: creating {} with {}",
             self.user,
             self.dir.display(),

@@ -1,6 +1,8 @@
 //! Generated against hand-derived: where `lagrange-systems` has a mechanism written by hand and
-//! `derive/specs/` the same one for SymPy, the two agree at random states (parameters away
-//! from the defaults), in `f64` and `f32`.
+//! `derive/specs/` the same one for SymPy (the pendulum, the double pendulum, the three-link
+//! chain, the Cartesian pendulum), the two agree at random states (parameters away from the
+//! defaults), in `f64` and `f32`: accelerations, mass matrices, right-hand sides, forces,
+//! energies, and for the constrained one its rows, constrained accelerations and multipliers.
 
 use lagrange_core::constraints::Constraints;
 use lagrange_core::{Constrained, Error, Mechanism, Real, State};
@@ -77,6 +79,23 @@ fn double_pendulum<T: Real>() -> Result<(), Error> {
     Ok(())
 }
 
+fn triple_pendulum<T: Real>() -> Result<(), Error> {
+    let m = [1.2, 0.8, 0.5].map(T::from_f64);
+    let l = [0.9, 1.1, 0.7].map(T::from_f64);
+    let g = T::from_f64(9.81);
+    let generated = generated::TriplePendulum::new(m[0], m[1], m[2], l[0], l[1], l[2], g)?;
+    let h = hand::NLinkPendulum::new(m, l, g)?;
+    let mut rng = Rng::new(4);
+    for _ in 0..STATES {
+        same_free(
+            &generated,
+            &h,
+            &random_state(&mut rng, (-4.0, 4.0), (-5.0, 5.0)),
+        )?;
+    }
+    Ok(())
+}
+
 fn cartesian_pendulum<T: Real>() -> Result<(), Error> {
     let p = [0.9, 1.4, 9.81].map(T::from_f64);
     let g = generated::CartesianPendulum::new(p[0], p[1], p[2])?;
@@ -127,4 +146,9 @@ fn cartesian_pendulum<T: Real>() -> Result<(), Error> {
     Ok(())
 }
 
-for_f32_and_f64!(pendulum, double_pendulum, cartesian_pendulum);
+for_f32_and_f64!(
+    pendulum,
+    double_pendulum,
+    triple_pendulum,
+    cartesian_pendulum
+);
