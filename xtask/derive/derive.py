@@ -423,6 +423,7 @@ class Derivation:
         self.driven = self.explicit_time or s.t in V.free_symbols or (
             self.Q is not None and any(s.t in e.free_symbols for e in self.Q)
         )
+        self.fixed_mass = all(not (e.free_symbols & s.state_symbols) for e in self.M)
         # The library's CONSTANT_MASS means more than a constant M: T must not depend on q or
         # t at all (the automatic path then takes f = -dV/dq and never differentiates T).
         self.constant_mass = not (T.free_symbols & (set(s.qs) | {s.t}))
@@ -956,7 +957,12 @@ class Generator:
         blocks = {}
         blocks["mass"] = self.block(m_entries, False)
         blocks["rhs"] = self.block(d.f, False)
-        blocks["law"] = self.block(m_entries + forces, False)
+        if d.fixed_mass:
+            # M^-1 (or its factor) is formed once by the constructor: the law needs f + Q.
+            blocks["law"] = self.block(forces, False)
+        else:
+            blocks["law"] = self.block(m_entries + forces, False)
+        self.m_entries = m_entries
         blocks["kinetic"] = self.block([d.T], True, vectors=("q", "qd"), time="t")
         blocks["potential"] = self.block([d.V], True, vectors=("q", None), time="t")
         if d.Q is not None:
@@ -1033,6 +1039,13 @@ class Generator:
             lines.append("(M and f are long: see mass_matrix and rhs)")
         return lines
 
+    def solve_text(self):
+        n = self.s.n
+        if self.d.fixed_mass:
+            how = "its inverse" if n <= 2 else "its Cholesky factor"
+            return f"`M` is constant: {how} formed once by the constructor"
+        return "closed form" if n <= 2 else "Cholesky"
+
     def struct(self):
         s = self.s
         o = self.out
@@ -1048,7 +1061,7 @@ class Generator:
         o.extend(doc_lines(wrap(
             f"Derived by SymPy from `{self.source}` (`cargo xtask derive`): the mass matrix "
             f"and the rest of the Euler-Lagrange equations in closed form, the linear solve "
-            f"numeric ({'closed form' if s.n <= 2 else 'Cholesky'}). Defaults ([`Default`]): "
+            f"numeric ({self.solve_text()}). Defaults ([`Default`]): "
             f"{params}."
         )))
         if self.d.phi is not None:
@@ -1067,6 +1080,14 @@ class Generator:
         for k, expr in self.consts.order:
             o.append(f"    /// `{self.pretty(expr)}`.")
             o.append(f"    {k.name}: T,")
+        n = s.n
+        if self.d.fixed_mass and n <= 2:
+            o.append("    /// `M^-1`, formed once (`M` is constant), or why `M` has none.")
+            o.append(f"    inverse: Result<SMatrix<T, {n}, {n}>, Error>,")
+        elif self.d.fixed_mass:
+            self.uses.add("Cholesky")
+            o.append("    /// The Cholesky factor of `M`, formed once (`M` is constant), or why `M` has none.")
+            o.append(f"    factor: Result<Cholesky<T, {n}>, Error>,")
         o.append("}")
         o.append("")
 
@@ -1102,13 +1123,26 @@ class Generator:
         if many:
             o.append("    #[allow(clippy::too_many_arguments)]")
         o.append(f"    fn from_valid({args}) -> Self {{")
-        emitter = Emitter(False, {p: p.name for p in s.param_symbols})
-        o.append("        Self {")
-        o.append(f"            {names},")
+        names_map = {p: p.name for p in s.param_symbols}
+        emitter = Emitter(False, dict(names_map))
         for k, expr in self.consts.order:
             code, _, _ = emitter.emit(expr)
-            o.append(f"            {k.name}: {code},")
-        o.append("        }")
+            o.append(f"        let {k.name} = {code};")
+        fields = [names] + [k.name for k, _ in self.consts.order]
+        if self.d.fixed_mass:
+            # The constant M from the same constants the mass matrix returns.
+            local = dict(names_map)
+            local.update({k: k.name for k, _ in self.consts.order})
+            mass = Block(Emitter(False, local), [self.consts.hoist(e) for e in self.m_entries], {})
+            matrix = self.matrix_from_upper(mass, 0)
+            for line in mass.lines:
+                o.append(f"        {line}")
+            o.append(f"        let mass = {matrix};")
+            if s.n <= 2:
+                fields.append("inverse: inverse(&mass)")
+            else:
+                fields.append("factor: Cholesky::factor(&mass)")
+        o.append(f"        Self {{ {', '.join(fields)} }}")
         o.append("    }")
         for p, _, kind, desc in s.params:
             o.append("")
@@ -1174,12 +1208,20 @@ class Generator:
         b = self.blocks
         o = self.out
         o.append(f"impl<T: Real> {s.name}<T> {{")
-        self.fn(
-            f"fn equations(&self, {{s}}: &State<T, {n}>) -> (SMatrix<T, {n}, {n}>, SVector<T, {n}>)",
-            b["law"],
-            f"({self.matrix_from_upper(b['law'], 0)}, {self.vector(b['law'], n * (n + 1) // 2, n)})",
-            doc="`M` and `f + Q`, their common subexpressions shared: what the law needs.",
-        )
+        if d.fixed_mass:
+            self.fn(
+                f"fn forces(&self, {{s}}: &State<T, {n}>) -> SVector<T, {n}>",
+                b["law"],
+                self.vector(b["law"], 0, n),
+                doc="`f + Q`: what the law needs besides the constant `M^-1`.",
+            )
+        else:
+            self.fn(
+                f"fn equations(&self, {{s}}: &State<T, {n}>) -> (SMatrix<T, {n}, {n}>, SVector<T, {n}>)",
+                b["law"],
+                f"({self.matrix_from_upper(b['law'], 0)}, {self.vector(b['law'], n * (n + 1) // 2, n)})",
+                doc="`M` and `f + Q`, their common subexpressions shared: what the law needs.",
+            )
         o.append("}")
         o.append("")
         o.append(f"impl<T: Real> Mechanism<T, {n}> for {s.name}<T> {{")
@@ -1195,15 +1237,27 @@ class Generator:
             self.vector(b["rhs"], 0, n),
         )
         o.append("")
-        o.append(f"    fn solve_mass(&self, s: &State<T, {n}>, b: &SVector<T, {n}>) -> Result<SVector<T, {n}>, Error> {{")
-        o.append("        solve(&self.mass_matrix(s), b)")
-        o.append("    }")
-        o.append("")
-        o.append("    /// `M^-1 (f + Q + extra)`, with `M` and `f + Q` formed together.")
-        o.append(f"    fn law<F: GeneralizedForce<T, {n}>>(&self, s: &State<T, {n}>, extra: &F) -> Result<SVector<T, {n}>, Error> {{")
-        o.append("        let (m, f) = self.equations(s);")
-        o.append("        solve(&m, &extra.added_to(s, f))")
-        o.append("    }")
+        if d.fixed_mass:
+            apply = "Ok(self.inverse? * b)" if n <= 2 else "Ok(self.factor?.solve(b))"
+            o.append("    /// With the constant `M`'s inverse (or factor) formed once.")
+            o.append(f"    fn solve_mass(&self, _s: &State<T, {n}>, b: &SVector<T, {n}>) -> Result<SVector<T, {n}>, Error> {{")
+            o.append(f"        {apply}")
+            o.append("    }")
+            o.append("")
+            o.append("    /// `M^-1 (f + Q + extra)`, `M^-1` formed once.")
+            o.append(f"    fn law<F: GeneralizedForce<T, {n}>>(&self, s: &State<T, {n}>, extra: &F) -> Result<SVector<T, {n}>, Error> {{")
+            o.append("        self.solve_mass(s, &extra.added_to(s, self.forces(s)))")
+            o.append("    }")
+        else:
+            o.append(f"    fn solve_mass(&self, s: &State<T, {n}>, b: &SVector<T, {n}>) -> Result<SVector<T, {n}>, Error> {{")
+            o.append("        solve(&self.mass_matrix(s), b)")
+            o.append("    }")
+            o.append("")
+            o.append("    /// `M^-1 (f + Q + extra)`, with `M` and `f + Q` formed together.")
+            o.append(f"    fn law<F: GeneralizedForce<T, {n}>>(&self, s: &State<T, {n}>, extra: &F) -> Result<SVector<T, {n}>, Error> {{")
+            o.append("        let (m, f) = self.equations(s);")
+            o.append("        solve(&m, &extra.added_to(s, f))")
+            o.append("    }")
         o.append("}")
         o.append("")
 
@@ -1295,6 +1349,20 @@ class Generator:
     def solver(self):
         n = self.s.n
         o = self.out
+        if self.d.fixed_mass and n >= 3:
+            return  # the Cholesky factor of lagrange_core does it
+        if self.d.fixed_mass:
+            o.append("/// `m^-1`, column by column, or why there is none (as [`solve`] would refuse `m`).")
+            o.append(f"fn inverse<T: Real>(m: &SMatrix<T, {n}, {n}>) -> Result<SMatrix<T, {n}, {n}>, Error> {{")
+            if n == 1:
+                o.append("    let c0 = solve(m, &SVector::from([T::one()]))?;")
+                o.append("    Ok(SMatrix::from([[c0[0]]]))")
+            else:
+                o.append("    let c0 = solve(m, &SVector::from([T::one(), T::zero()]))?;")
+                o.append("    let c1 = solve(m, &SVector::from([T::zero(), T::one()]))?;")
+                o.append("    Ok(SMatrix::from([[c0[0], c0[1]], [c1[0], c1[1]]]))")
+            o.append("}")
+            o.append("")
         if n == 1:
             o.extend([
                 "/// Solves `m x = b` (1x1), refusing a mass that is not positive as the Cholesky solve",

@@ -33,7 +33,8 @@ use lagrange_core::{
 ///
 /// Derived by SymPy from `derive/specs/cartesian_pendulum.py` (`cargo xtask derive`): the mass
 /// matrix and the rest of the Euler-Lagrange equations in closed form, the linear solve numeric
-/// (closed form). Defaults ([`Default`]): `m` = 1.0, `l` = 1.0, `g` = 9.81.
+/// (`M` is constant: its inverse formed once by the constructor). Defaults ([`Default`]): `m` =
+/// 1.0, `l` = 1.0, `g` = 9.81.
 ///
 /// As a [`Mechanism`] this is the free mechanism; as [`Constraints`] its 1 constraint row(s). The
 /// constrained mechanism is `Constrained::new(CartesianPendulum::default())`
@@ -56,6 +57,8 @@ pub struct CartesianPendulum<T: Real> {
     k3: T,
     /// `1/l`.
     k4: T,
+    /// `M^-1`, formed once (`M` is constant), or why `M` has none.
+    inverse: Result<SMatrix<T, 2, 2>, Error>,
 }
 
 impl<T: Real> CartesianPendulum<T> {
@@ -74,15 +77,22 @@ impl<T: Real> CartesianPendulum<T> {
 
     /// The mechanism of parameters already checked, its constants formed once.
     fn from_valid(m: T, l: T, g: T) -> Self {
+        let k0 = g * m;
+        let k1 = m * T::HALF;
+        let k2 = T::HALF / l;
+        let k3 = l * T::HALF;
+        let k4 = l.recip();
+        let mass = SMatrix::from([[m, T::zero()], [T::zero(), m]]);
         Self {
             m,
             l,
             g,
-            k0: g * m,
-            k1: m * T::HALF,
-            k2: T::HALF / l,
-            k3: l * T::HALF,
-            k4: l.recip(),
+            k0,
+            k1,
+            k2,
+            k3,
+            k4,
+            inverse: inverse(&mass),
         }
     }
 
@@ -113,12 +123,9 @@ impl<T: Real> Default for CartesianPendulum<T> {
 }
 
 impl<T: Real> CartesianPendulum<T> {
-    /// `M` and `f + Q`, their common subexpressions shared: what the law needs.
-    fn equations(&self, _s: &State<T, 2>) -> (SMatrix<T, 2, 2>, SVector<T, 2>) {
-        (
-            SMatrix::from([[self.m, T::zero()], [T::zero(), self.m]]),
-            SVector::from([T::zero(), -self.k0]),
-        )
+    /// `f + Q`: what the law needs besides the constant `M^-1`.
+    fn forces(&self, _s: &State<T, 2>) -> SVector<T, 2> {
+        SVector::from([T::zero(), -self.k0])
     }
 }
 
@@ -131,18 +138,18 @@ impl<T: Real> Mechanism<T, 2> for CartesianPendulum<T> {
         SVector::from([T::zero(), -self.k0])
     }
 
-    fn solve_mass(&self, s: &State<T, 2>, b: &SVector<T, 2>) -> Result<SVector<T, 2>, Error> {
-        solve(&self.mass_matrix(s), b)
+    /// With the constant `M`'s inverse (or factor) formed once.
+    fn solve_mass(&self, _s: &State<T, 2>, b: &SVector<T, 2>) -> Result<SVector<T, 2>, Error> {
+        Ok(self.inverse? * b)
     }
 
-    /// `M^-1 (f + Q + extra)`, with `M` and `f + Q` formed together.
+    /// `M^-1 (f + Q + extra)`, `M^-1` formed once.
     fn law<F: GeneralizedForce<T, 2>>(
         &self,
         s: &State<T, 2>,
         extra: &F,
     ) -> Result<SVector<T, 2>, Error> {
-        let (m, f) = self.equations(s);
-        solve(&m, &extra.added_to(s, f))
+        self.solve_mass(s, &extra.added_to(s, self.forces(s)))
     }
 }
 
@@ -188,6 +195,13 @@ impl<T: Real> HolonomicConstraints<T, 2, 1> for CartesianPendulum<T> {
         let y = q[1];
         SVector::from([(x * x) * self.k2 + (y * y) * self.k2 - self.k3])
     }
+}
+
+/// `m^-1`, column by column, or why there is none (as [`solve`] would refuse `m`).
+fn inverse<T: Real>(m: &SMatrix<T, 2, 2>) -> Result<SMatrix<T, 2, 2>, Error> {
+    let c0 = solve(m, &SVector::from([T::one(), T::zero()]))?;
+    let c1 = solve(m, &SVector::from([T::zero(), T::one()]))?;
+    Ok(SMatrix::from([[c0[0], c0[1]], [c1[0], c1[1]]]))
 }
 
 /// Solves the symmetric 2x2 system `m x = b` by its closed-form inverse, refusing a mass

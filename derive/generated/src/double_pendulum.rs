@@ -77,19 +77,26 @@ impl<T: Real> DoublePendulum<T> {
 
     /// The mechanism of parameters already checked, its constants formed once.
     fn from_valid(m1: T, m2: T, l1: T, l2: T, g: T) -> Self {
+        let k0 = (l1 * l1) * (m1 + m2);
+        let k1 = l1 * l2 * m2;
+        let k2 = m2 * (l2 * l2);
+        let k3 = g * l1 * (m1 + m2);
+        let k4 = g * l2 * m2;
+        let k5 = m2 * (l2 * l2) * T::HALF;
+        let k6 = (l1 * l1) * (m1 + m2) * T::HALF;
         Self {
             m1,
             m2,
             l1,
             l2,
             g,
-            k0: (l1 * l1) * (m1 + m2),
-            k1: l1 * l2 * m2,
-            k2: m2 * (l2 * l2),
-            k3: g * l1 * (m1 + m2),
-            k4: g * l2 * m2,
-            k5: m2 * (l2 * l2) * T::HALF,
-            k6: (l1 * l1) * (m1 + m2) * T::HALF,
+            k0,
+            k1,
+            k2,
+            k3,
+            k4,
+            k5,
+            k6,
         }
     }
 

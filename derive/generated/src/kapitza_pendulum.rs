@@ -29,8 +29,9 @@ use lagrange_core::{
 /// ```
 ///
 /// Derived by SymPy from `derive/specs/kapitza_pendulum.py` (`cargo xtask derive`): the mass matrix
-/// and the rest of the Euler-Lagrange equations in closed form, the linear solve numeric (closed
-/// form). Defaults ([`Default`]): `m` = 1.0, `l` = 1.0, `g` = 9.81, `a` = 0.05, `w` = 200.0.
+/// and the rest of the Euler-Lagrange equations in closed form, the linear solve numeric (`M` is
+/// constant: its inverse formed once by the constructor). Defaults ([`Default`]): `m` = 1.0, `l` =
+/// 1.0, `g` = 9.81, `a` = 0.05, `w` = 200.0.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct KapitzaPendulum<T: Real> {
     /// Bob mass, kg.
@@ -57,6 +58,8 @@ pub struct KapitzaPendulum<T: Real> {
     k5: T,
     /// `a*g*m`.
     k6: T,
+    /// `M^-1`, formed once (`M` is constant), or why `M` has none.
+    inverse: Result<SMatrix<T, 1, 1>, Error>,
 }
 
 impl<T: Real> KapitzaPendulum<T> {
@@ -78,19 +81,28 @@ impl<T: Real> KapitzaPendulum<T> {
 
     /// The mechanism of parameters already checked, its constants formed once.
     fn from_valid(m: T, l: T, g: T, a: T, w: T) -> Self {
+        let k0 = m * (l * l);
+        let k1 = g * l * m;
+        let k2 = a * l * m * (w * w);
+        let k3 = m * (l * l) * T::HALF;
+        let k4 = m * (a * a) * (w * w) * T::HALF;
+        let k5 = a * l * m * w;
+        let k6 = a * g * m;
+        let mass = SMatrix::from([[k0]]);
         Self {
             m,
             l,
             g,
             a,
             w,
-            k0: m * (l * l),
-            k1: g * l * m,
-            k2: a * l * m * (w * w),
-            k3: m * (l * l) * T::HALF,
-            k4: m * (a * a) * (w * w) * T::HALF,
-            k5: a * l * m * w,
-            k6: a * g * m,
+            k0,
+            k1,
+            k2,
+            k3,
+            k4,
+            k5,
+            k6,
+            inverse: inverse(&mass),
         }
     }
 
@@ -139,16 +151,13 @@ impl<T: Real> Default for KapitzaPendulum<T> {
 }
 
 impl<T: Real> KapitzaPendulum<T> {
-    /// `M` and `f + Q`, their common subexpressions shared: what the law needs.
-    fn equations(&self, s: &State<T, 1>) -> (SMatrix<T, 1, 1>, SVector<T, 1>) {
+    /// `f + Q`: what the law needs besides the constant `M^-1`.
+    fn forces(&self, s: &State<T, 1>) -> SVector<T, 1> {
         let th = s.q[0];
         let t = s.t;
         let cos0 = (t * self.w).cos();
         let sin_th = th.sin();
-        (
-            SMatrix::from([[self.k0]]),
-            SVector::from([-self.k1 * sin_th + cos0 * self.k2 * sin_th]),
-        )
+        SVector::from([-self.k1 * sin_th + cos0 * self.k2 * sin_th])
     }
 }
 
@@ -165,18 +174,18 @@ impl<T: Real> Mechanism<T, 1> for KapitzaPendulum<T> {
         SVector::from([-self.k1 * sin_th + cos0 * self.k2 * sin_th])
     }
 
-    fn solve_mass(&self, s: &State<T, 1>, b: &SVector<T, 1>) -> Result<SVector<T, 1>, Error> {
-        solve(&self.mass_matrix(s), b)
+    /// With the constant `M`'s inverse (or factor) formed once.
+    fn solve_mass(&self, _s: &State<T, 1>, b: &SVector<T, 1>) -> Result<SVector<T, 1>, Error> {
+        Ok(self.inverse? * b)
     }
 
-    /// `M^-1 (f + Q + extra)`, with `M` and `f + Q` formed together.
+    /// `M^-1 (f + Q + extra)`, `M^-1` formed once.
     fn law<F: GeneralizedForce<T, 1>>(
         &self,
         s: &State<T, 1>,
         extra: &F,
     ) -> Result<SVector<T, 1>, Error> {
-        let (m, f) = self.equations(s);
-        solve(&m, &extra.added_to(s, f))
+        self.solve_mass(s, &extra.added_to(s, self.forces(s)))
     }
 }
 
@@ -197,6 +206,12 @@ impl<T: Real> Lagrangian<T, 1> for KapitzaPendulum<T> {
         let cos_th = th.cos();
         cos0 * self.k6 - cos_th * self.k1
     }
+}
+
+/// `m^-1`, column by column, or why there is none (as [`solve`] would refuse `m`).
+fn inverse<T: Real>(m: &SMatrix<T, 1, 1>) -> Result<SMatrix<T, 1, 1>, Error> {
+    let c0 = solve(m, &SVector::from([T::one()]))?;
+    Ok(SMatrix::from([[c0[0]]]))
 }
 
 /// Solves `m x = b` (1x1), refusing a mass that is not positive as the Cholesky solve

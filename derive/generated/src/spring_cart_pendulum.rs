@@ -82,6 +82,13 @@ impl<T: Real> SpringCartPendulum<T> {
 
     /// The mechanism of parameters already checked, its constants formed once.
     fn from_valid(m_cart: T, m: T, k: T, c: T, l: T, g: T) -> Self {
+        let k0 = m + m_cart;
+        let k1 = l * m;
+        let k2 = m * (l * l);
+        let k3 = g * l * m;
+        let k4 = m * T::HALF + m_cart * T::HALF;
+        let k5 = m * (l * l) * T::HALF;
+        let k6 = k * T::HALF;
         Self {
             m_cart,
             m,
@@ -89,13 +96,13 @@ impl<T: Real> SpringCartPendulum<T> {
             c,
             l,
             g,
-            k0: m + m_cart,
-            k1: l * m,
-            k2: m * (l * l),
-            k3: g * l * m,
-            k4: m * T::HALF + m_cart * T::HALF,
-            k5: m * (l * l) * T::HALF,
-            k6: k * T::HALF,
+            k0,
+            k1,
+            k2,
+            k3,
+            k4,
+            k5,
+            k6,
         }
     }
 

@@ -95,6 +95,18 @@ impl<T: Real> TriplePendulum<T> {
 
     /// The mechanism of parameters already checked, its constants formed once.
     fn from_valid(m1: T, m2: T, m3: T, l1: T, l2: T, l3: T, g: T) -> Self {
+        let k0 = (l1 * l1) * (m1 + m2 + m3);
+        let k1 = l1 * l2 * (m2 + m3);
+        let k2 = l1 * l3 * m3;
+        let k3 = (l2 * l2) * (m2 + m3);
+        let k4 = l2 * l3 * m3;
+        let k5 = m3 * (l3 * l3);
+        let k6 = g * l1 * (m1 + m2 + m3);
+        let k7 = g * l2 * (m2 + m3);
+        let k8 = g * l3 * m3;
+        let k9 = m3 * (l3 * l3) * T::HALF;
+        let k10 = (l1 * l1) * (m1 + m2 + m3) * T::HALF;
+        let k11 = (l2 * l2) * (m2 + m3) * T::HALF;
         Self {
             m1,
             m2,
@@ -103,18 +115,18 @@ impl<T: Real> TriplePendulum<T> {
             l2,
             l3,
             g,
-            k0: (l1 * l1) * (m1 + m2 + m3),
-            k1: l1 * l2 * (m2 + m3),
-            k2: l1 * l3 * m3,
-            k3: (l2 * l2) * (m2 + m3),
-            k4: l2 * l3 * m3,
-            k5: m3 * (l3 * l3),
-            k6: g * l1 * (m1 + m2 + m3),
-            k7: g * l2 * (m2 + m3),
-            k8: g * l3 * m3,
-            k9: m3 * (l3 * l3) * T::HALF,
-            k10: (l1 * l1) * (m1 + m2 + m3) * T::HALF,
-            k11: (l2 * l2) * (m2 + m3) * T::HALF,
+            k0,
+            k1,
+            k2,
+            k3,
+            k4,
+            k5,
+            k6,
+            k7,
+            k8,
+            k9,
+            k10,
+            k11,
         }
     }
 
