@@ -163,7 +163,8 @@ class Spec:
         if not isinstance(self.name, str) or not re.match(r"^[A-Z][A-Za-z0-9]*$", self.name):
             raise SpecError(f"type name `{self.name}` is not a Rust type name in CamelCase")
         doc = ns.get("doc") or ns.get("__doc__") or f"The mechanism of `{stem}.py`."
-        self.doc = " ".join(str(doc).split()) if "\n\n" not in str(doc) else str(doc).strip()
+        # Paragraphs kept, each paragraph's lines joined (the output wraps them again).
+        self.doc = [" ".join(p.split()) for p in re.split(r"\n\s*\n", str(doc)) if p.strip()]
         self.simplify = bool(ns.get("simplify", True))
         for required in ("params", "q", "T", "V"):
             if required not in ns:
@@ -179,6 +180,8 @@ class Spec:
         self.V = self.plain(self.V_written, "V", velocities=False)
         self.Q_written = None
         self.Q = None
+        if ns.get("Q") is sp.Q:
+            del ns["Q"]  # SymPy's assumptions object, from `from sympy import *`: no forces
         if ns.get("Q") is not None:
             rows = self.as_list(ns["Q"], "Q")
             if len(rows) != self.n:
@@ -247,6 +250,11 @@ class Spec:
         self.q_names = [type(c).__name__ for c in self.q_functions]
         for name in self.q_names:
             check_name(name, "coordinate")
+        for name in self.q_names:
+            if name.endswith("_d") and name[:-2] in self.q_names:
+                raise SpecError(
+                    f"coordinate `{name}` has the name the velocity of `{name[:-2]}` gets"
+                )
         self.qs = [sp.Symbol(name) for name in self.q_names]
         self.qds = [sp.Symbol(name + "_d") for name in self.q_names]
         self.t = sp.Symbol("t")
@@ -263,8 +271,12 @@ class Spec:
             if not isinstance(sym, sp.Symbol):
                 raise SpecError(f"params key `{sym}` is not a symbol: make it with symbols(...)")
             check_name(sym.name, "parameter")
+            if sym.name == "t" or sym == self.time:
+                raise SpecError(f"parameter `{sym.name}` has the name of the time")
             if sym.name in self.q_names or sym.name in {d.name for d in self.qds}:
-                raise SpecError(f"parameter `{sym.name}` has the name of a coordinate")
+                raise SpecError(
+                    f"parameter `{sym.name}` has the name of a coordinate or of a velocity"
+                )
             if isinstance(spec, tuple):
                 if not 1 <= len(spec) <= 3:
                     raise SpecError(f"params[{sym}] must be (default, kind, description)")
@@ -343,9 +355,14 @@ class Spec:
             allowed.add(self.t)
         for sym in sorted(out.free_symbols - allowed, key=lambda s: s.name):
             if sym in self.qds:
+                why = (
+                    "the rows are holonomic, phi(q) = 0"
+                    if what.startswith("phi")
+                    else "velocity-dependent terms belong in T or Q"
+                )
                 raise SpecError(
                     f"{what} depends on the velocity {sym.name[:-2]}': it may depend on the "
-                    f"coordinates only (velocity-dependent terms belong in T or Q)"
+                    f"coordinates only ({why})"
                 )
             if sym == self.t:
                 raise SpecError(f"{what} depends on time t: constraint rows must not")
@@ -1049,7 +1066,10 @@ class Generator:
     def struct(self):
         s = self.s
         o = self.out
-        o.extend(doc_lines(wrap(s.doc)))
+        for i, paragraph in enumerate(s.doc):
+            if i:
+                o.append("///")
+            o.extend(doc_lines(wrap(paragraph)))
         o.append("///")
         o.append("/// ```text")
         o.extend(doc_lines("\n".join(self.formulas())))
