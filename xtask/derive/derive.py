@@ -1087,8 +1087,8 @@ class Generator:
         if self.d.phi is not None:
             o.append("///")
             o.extend(doc_lines(wrap(
-                f"As a [`Mechanism`] this is the free mechanism; as [`Constraints`] its "
-                f"{len(self.d.phi)} constraint row(s). The constrained mechanism is "
+                f"As a [`Mechanism`] this is the free mechanism; as [`Constraints`] it is "
+                f"the rows `phi` ({len(self.d.phi)}). The constrained mechanism is "
                 f"`Constrained::new({s.name}::default())` "
                 f"([`Constrained`](lagrange_core::Constrained))."
             )))
@@ -1197,7 +1197,7 @@ class Generator:
         o.append(f"{indent}    {result}")
         o.append(f"{indent}}}")
 
-    def vector(self, block, start, count, want="T", rows=None):
+    def vector(self, block, start, count, want="T"):
         entries = [block.output(start + i, want) for i in range(count)]
         return f"SVector::from([{', '.join(entries)}])"
 

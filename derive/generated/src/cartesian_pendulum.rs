@@ -36,7 +36,7 @@ use lagrange_core::{
 /// (`M` is constant: its inverse formed once by the constructor). Defaults ([`Default`]): `m` =
 /// 1.0, `l` = 1.0, `g` = 9.81.
 ///
-/// As a [`Mechanism`] this is the free mechanism; as [`Constraints`] its 1 constraint row(s). The
+/// As a [`Mechanism`] this is the free mechanism; as [`Constraints`] it is the rows `phi` (1). The
 /// constrained mechanism is `Constrained::new(CartesianPendulum::default())`
 /// ([`Constrained`](lagrange_core::Constrained)).
 #[derive(Debug, Clone, Copy, PartialEq)]
