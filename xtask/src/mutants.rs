@@ -354,6 +354,8 @@ pub fn run(args: &[String]) -> Result<(), String> {
             // anything (a mutant that fails tests that already fail is not killed by them).
             cmd::run(
                 cmd::cargo()
+                    .env("CARGO_PROFILE_DEV_DEBUG", "0")
+                    .env("CARGO_PROFILE_DEV_OPT_LEVEL", "1")
                     .args(["test", "--quiet", "-p", "lagrange-tests"])
                     .args(area.tests),
             )
@@ -375,6 +377,10 @@ pub fn run(args: &[String]) -> Result<(), String> {
 /// listing the mutants.
 fn mutants_command(area: &Area, out: &Path, o: &Options, list: bool) -> Command {
     let mut c = cmd::cargo();
+    // Mutants build in the dev profile: without debug information (a third of a link) and
+    // optimised a little, so that the tests of a mutant run in seconds, not a minute.
+    c.env("CARGO_PROFILE_DEV_DEBUG", "0")
+        .env("CARGO_PROFILE_DEV_OPT_LEVEL", "1");
     c.args(["mutants", "--package", area.package]);
     for f in area.files {
         c.args(["--file", f]);
