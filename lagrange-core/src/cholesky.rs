@@ -11,7 +11,8 @@ use nalgebra::{SMatrix, SVector};
 ///
 /// # Errors
 /// [`Error::SingularMassMatrix`] with the index of the failing pivot;
-/// [`Error::NonFiniteState`] when `m` holds NaN or infinity (a non-finite state).
+/// [`Error::NonFiniteState`] when `m` holds NaN or infinity (a non-finite state), or the
+/// solution is not finite (`b` not finite, or so large that `x` overflows).
 ///
 /// ```
 /// use lagrange_core::{solve_spd, Error};
@@ -66,5 +67,9 @@ pub fn solve_spd<T: Real, const N: usize>(
         }
         x[i] = s / l[(i, i)];
     }
-    Ok(x)
+    if x.iter().all(|v| v.is_finite()) {
+        Ok(x)
+    } else {
+        Err(Error::NonFiniteState)
+    }
 }

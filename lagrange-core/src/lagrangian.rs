@@ -268,6 +268,7 @@ impl<T: Real, const N: usize, L: Lagrangian<T, N>> Mechanism<T, N> for EulerLagr
         let r = residual_jacobian(&self.lagrangian, s, &qdd) - forces;
         let mut j = Jacobian::<T, N>::zeros();
         for k in 0..N {
+            // Each column solved is finite (solve_mass refuses anything else).
             let dq = self.solve_mass(s, &-r.wrt_q.column(k).into_owned())?;
             let dqd = self.solve_mass(s, &-r.wrt_qd.column(k).into_owned())?;
             j.wrt_q.set_column(k, &dq);
@@ -283,7 +284,7 @@ impl<T: Real, const N: usize, L: Lagrangian<T, N>> Mechanism<T, N> for EulerLagr
         extra: &F,
     ) -> Result<SVector<T, N>, Error> {
         let q = self.lagrangian.non_conservative_force(s);
-        Ok(if F::IS_ZERO { q } else { q + extra.force(s) })
+        finite(if F::IS_ZERO { q } else { q + extra.force(s) })
     }
 }
 

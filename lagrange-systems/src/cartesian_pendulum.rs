@@ -53,12 +53,27 @@ impl<T: Real> CartesianPendulum<T> {
     /// A bob of `mass` (kg, > 0) on a rod of `length` (m, > 0) in `gravity` (m/s^2, >= 0).
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] naming the first parameter out of range or not finite.
+    /// [`Error::InvalidParameter`] naming the first parameter out of range or not finite, or
+    /// the one most responsible when `1 / m`, the weight `m g`, `l^2` or `1 / (2 l)` leaves the
+    /// range of `T`.
     pub fn new(mass: T, length: T, gravity: T) -> Result<Self, Error> {
+        let mass = validate::positive("mass", mass)?;
+        let length = validate::positive("length", length)?;
+        let gravity = validate::non_negative("gravity", gravity)?;
+        validate::divisor(mass, &[("mass", mass, 1)])?;
+        validate::derived(
+            mass * gravity,
+            &[("mass", mass, 1), ("gravity", gravity, 1)],
+        )?;
+        // The rows divide by l and 2 l, and phi holds l^2.
+        let l = ("length", length, 1);
+        validate::divisor(length, &[l])?;
+        validate::divisor(T::TWO * length, &[l])?;
+        validate::derived(length * length, &[("length", length, 2)])?;
         Ok(Self {
-            mass: validate::positive("mass", mass)?,
-            length: validate::positive("length", length)?,
-            gravity: validate::non_negative("gravity", gravity)?,
+            mass,
+            length,
+            gravity,
         })
     }
 
@@ -104,7 +119,12 @@ impl<T: Real> Mechanism<T, 2> for CartesianPendulum<T> {
         Vector2::new(T::zero(), -self.mass * self.gravity)
     }
     fn solve_mass(&self, _s: &State<T, 2>, b: &Vector2<T>) -> Result<Vector2<T>, Error> {
-        Ok(b / self.mass)
+        let x = b / self.mass;
+        if x.iter().all(|v| v.is_finite()) {
+            Ok(x)
+        } else {
+            Err(Error::NonFiniteState)
+        }
     }
 }
 

@@ -60,12 +60,21 @@ impl<T: Real> SphericalPendulum<T> {
     /// A pendulum of `mass` (kg, > 0) and `length` (m, > 0) in `gravity` (m/s^2, >= 0).
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] naming the first parameter out of range or not finite.
+    /// [`Error::InvalidParameter`] naming the first parameter out of range or not finite, or
+    /// the one most responsible when `m l^2` (which the motion divides by) or `m g l` leaves
+    /// the range of `T`.
     pub fn new(mass: T, length: T, gravity: T) -> Result<Self, Error> {
+        let mass = validate::positive("mass", mass)?;
+        let length = validate::positive("length", length)?;
+        let gravity = validate::non_negative("gravity", gravity)?;
+        let m = ("mass", mass, 1);
+        validate::divisor(mass * length * length, &[m, ("length", length, 2)])?;
+        let g = ("gravity", gravity, 1);
+        validate::derived(mass * gravity * length, &[m, g, ("length", length, 1)])?;
         Ok(Self {
-            mass: validate::positive("mass", mass)?,
-            length: validate::positive("length", length)?,
-            gravity: validate::non_negative("gravity", gravity)?,
+            mass,
+            length,
+            gravity,
         })
     }
     /// Mass, kg.
