@@ -166,8 +166,31 @@ where
     /// [`Error::InvalidParameter`] `dt` unless positive and finite; [`Error::NonFiniteState`];
     /// [`Error::ConstraintViolated`] for a start state that violates a bilateral row or
     /// penetrates a contact beyond the projection's tolerance; [`Error::NoConvergence`] after
-    /// `4 C + 8` events in one step; the inner integrator's and the projection's errors.
+    /// `4 C + 8` events in one step; the inner integrator's and the projection's errors. A
+    /// step that fails leaves the stepper as it found it (resting set, impact count, the
+    /// state it continues from); `observe` has seen the impacts before the failure.
     pub fn step_observed<M, F>(
+        &mut self,
+        mechanism: &M,
+        state: &State<T, N>,
+        dt: T,
+        observe: F,
+    ) -> Result<State<T, N>, Error>
+    where
+        M: Mechanism<T, N>,
+        I: for<'a> Integrator<T, N, ActiveRows<'a, T, C, M, K>>,
+        F: FnMut(&Impact<T, N, C>),
+    {
+        let saved = (self.resting, self.impacts, self.last);
+        let result = self.step_events(mechanism, state, dt, observe);
+        if result.is_err() {
+            (self.resting, self.impacts, self.last) = saved;
+        }
+        result
+    }
+
+    /// The step of [`ContactStepper::step_observed`].
+    fn step_events<M, F>(
         &mut self,
         mechanism: &M,
         state: &State<T, N>,

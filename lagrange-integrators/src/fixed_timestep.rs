@@ -103,9 +103,11 @@ impl<T: Real, const N: usize, I> FixedTimestep<T, N, I> {
     /// fixed steps it pays for, up to the cap.
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] `frame_time` when negative or not finite (nothing changes);
-    /// the first error of a step, after which the current state is the last good one and the
-    /// failed step's time stays accumulated.
+    /// [`Error::InvalidParameter`] `frame_time` when negative or not finite; the first error
+    /// of a step. Either way the frame is refused whole: the states, the accumulated time and
+    /// the clock are as before the call (the integrator may have learnt from the frame's
+    /// successful steps, but it continues only from the state it returned, so the next frame
+    /// steps from the current state afresh).
     pub fn advance<M: Mechanism<T, N>>(
         &mut self,
         mechanism: &M,
@@ -115,6 +117,19 @@ impl<T: Real, const N: usize, I> FixedTimestep<T, N, I> {
         I: Integrator<T, N, M>,
     {
         let frame_time = validate::non_negative("frame_time", frame_time)?;
+        let saved = (self.accumulator, self.previous, self.current, self.clock);
+        let frame = self.frame(mechanism, frame_time);
+        if frame.is_err() {
+            (self.accumulator, self.previous, self.current, self.clock) = saved;
+        }
+        frame
+    }
+
+    /// The steps of [`FixedTimestep::advance`] for a valid `frame_time`.
+    fn frame<M: Mechanism<T, N>>(&mut self, mechanism: &M, frame_time: T) -> Result<Frame<T>, Error>
+    where
+        I: Integrator<T, N, M>,
+    {
         // A frame time so large that the sum overflows is as good as the largest: the cap
         // drops it anyway.
         self.accumulator = (self.accumulator + frame_time).min(T::MAX);

@@ -75,8 +75,18 @@ fn main() {
     ) else {
         panic!("double pendulum refused");
     };
-    rk4("rk4 step, pendulum f64", repeats, &p64, State::at_rest([0.5]));
-    rk4("rk4 step, pendulum f32", repeats, &p32, State::at_rest([0.5]));
+    rk4(
+        "rk4 step, pendulum f64",
+        repeats,
+        &p64,
+        State::at_rest([0.5]),
+    );
+    rk4(
+        "rk4 step, pendulum f32",
+        repeats,
+        &p32,
+        State::at_rest([0.5]),
+    );
     rk4(
         "rk4 step, double pendulum f64",
         repeats,
