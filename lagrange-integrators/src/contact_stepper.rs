@@ -6,8 +6,8 @@ use lagrange_core::constraints::contact::{
     drop_dependent_contacts, ActiveRows, ContactModel, Contacts, Impact, Impacts,
 };
 
-use crate::integrator::{check_step, continues};
-use crate::{Cost, Integrator, Method, Work};
+use crate::integrator::{check_step, continues, step_loop};
+use crate::{Cost, Failure, Integrator, Method, Work};
 use lagrange_core::constraints::Projection;
 use lagrange_core::nalgebra::SVector;
 use lagrange_core::{Error, Mechanism, Real, State};
@@ -375,5 +375,29 @@ where
     /// As [`ContactStepper::step_observed`].
     fn step(&mut self, mechanism: &M, state: &State<T, N>, dt: T) -> Result<State<T, N>, Error> {
         self.step_observed(mechanism, state, dt, |_| {})
+    }
+
+    /// As the default, and a run that fails leaves the stepper as it found it (resting set,
+    /// impact count, the state it continues from), like a step that fails.
+    fn integrate_with<F: FnMut(&State<T, N>)>(
+        &mut self,
+        mechanism: &M,
+        state: &State<T, N>,
+        dt: T,
+        steps: u64,
+        observe: F,
+    ) -> Result<State<T, N>, Failure<T, N>> {
+        let saved = (self.resting, self.impacts, self.last);
+        let result = step_loop(
+            state,
+            dt,
+            steps,
+            |s| self.step_observed(mechanism, s, dt, |_| {}),
+            observe,
+        );
+        if result.is_err() {
+            (self.resting, self.impacts, self.last) = saved;
+        }
+        result
     }
 }

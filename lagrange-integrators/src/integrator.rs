@@ -148,7 +148,8 @@ pub trait Integrator<T: Real, const N: usize, M: Mechanism<T, N>>: Method {
     /// [`Error::InvalidParameter`] `dt` when `dt` is not positive and finite;
     /// [`Error::StepSizeUnderflow`] when `state.t + dt` rounds to `state.t`;
     /// [`Error::NonFiniteState`] when `state` is not finite, or the new state is not (a step
-    /// past the stability limit); whatever the mechanism's law returns.
+    /// past the stability limit, or a time `state.t + dt` that overflows); whatever the
+    /// mechanism's law returns.
     fn step(&mut self, mechanism: &M, state: &State<T, N>, dt: T) -> Result<State<T, N>, Error>;
 
     /// Takes `steps` steps of `dt` from `state` and returns the last state. The time of the
@@ -253,19 +254,23 @@ pub(crate) fn step_loop<T: Real, const N: usize>(
     Ok(s)
 }
 
-/// `dt` when it is positive and finite and advances the time of `s`, which must be finite.
+/// `dt` when it is positive and finite and advances the time of `s`, which must be finite,
+/// to a finite time.
 pub(crate) fn check_step<T: Real, const N: usize>(s: &State<T, N>, dt: T) -> Result<T, Error> {
     let dt = check_dt(dt)?;
     s.check_finite()?;
     advances(s.t, dt).map(|()| dt)
 }
 
-/// `h` when it is finite and moves the time of `s` (either way), which must be finite: the
-/// check of a composition's signed substep.
+/// `h` when it is finite and moves the time of `s` (either way) to a finite time, `s` being
+/// finite: the check of a composition's signed substep ([`SymmetricBase::signed_step`],
+/// whose step is `h`).
+///
+/// [`SymmetricBase::signed_step`]: crate::SymmetricBase::signed_step
 pub(crate) fn check_signed<T: Real, const N: usize>(s: &State<T, N>, h: T) -> Result<T, Error> {
     if !h.is_finite() {
         return Err(Error::InvalidParameter {
-            name: "dt",
+            name: "h",
             reason: "must be finite",
         });
     }
@@ -285,11 +290,16 @@ pub(crate) fn check_dt<T: Real>(dt: T) -> Result<T, Error> {
     }
 }
 
-/// `Ok` when `t + dt` differs from `t`: a step that cannot move the clock is an error, not a
-/// silent no-op.
+/// `Ok` when `t + dt` differs from `t` and is finite: a step that cannot move the clock is an
+/// error, not a silent no-op ([`Error::StepSizeUnderflow`]), and one that would carry it past
+/// the largest finite time would end in a state that is not finite
+/// ([`Error::NonFiniteState`]).
 pub(crate) fn advances<T: Real>(t: T, dt: T) -> Result<(), Error> {
-    if t + dt == t {
+    let end = t + dt;
+    if end == t {
         Err(Error::StepSizeUnderflow)
+    } else if !end.is_finite() {
+        Err(Error::NonFiniteState)
     } else {
         Ok(())
     }

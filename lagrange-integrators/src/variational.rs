@@ -370,7 +370,9 @@ impl<T: Real, const N: usize> VariationalMidpoint<T, N> {
     ///
     /// # Errors
     /// [`Error::InvalidParameter`] `dt` when not positive and finite;
-    /// [`Error::NonFiniteState`] for a non-finite start or result; [`Error::NoConvergence`] or
+    /// [`Error::StepSizeUnderflow`] when `phase.t + dt` rounds to `phase.t`;
+    /// [`Error::NonFiniteState`] for a non-finite start or result (a time that overflows
+    /// too); [`Error::NoConvergence`] or
     /// [`Error::SingularJacobian`] from Newton on the discrete Euler-Lagrange equation.
     pub fn step_phase<M: Mechanism<T, N>>(
         &mut self,

@@ -13,7 +13,8 @@ pub trait SymmetricBase<T: Real, const N: usize, M: Mechanism<T, N>>: Integrator
     /// A step of `h`, which may be negative: a composition steps back in its middle substep.
     ///
     /// # Errors
-    /// [`Error::NonFiniteState`] for a non-finite `state` or result;
+    /// [`Error::InvalidParameter`] `h` when not finite; [`Error::NonFiniteState`] for a
+    /// non-finite `state` or result (a time `state.t + h` that overflows too);
     /// [`Error::StepSizeUnderflow`] when `state.t + h` rounds to `state.t` (`h = 0` too); as
     /// [`Integrator::step`] otherwise.
     fn signed_step(
@@ -114,7 +115,17 @@ where
         let mut next = *s;
         let mut work = Work::default();
         for w in YOSHIDA4_WEIGHTS {
-            next = self.base.signed_step(m, &next, dt * T::from_f64(w))?;
+            // A substep too large to be finite (`w dt` overflows) is this step's `dt` too large.
+            next = self
+                .base
+                .signed_step(m, &next, dt * T::from_f64(w))
+                .map_err(|e| match e {
+                    Error::InvalidParameter { .. } => Error::InvalidParameter {
+                        name: "dt",
+                        reason: "so large that a substep w dt overflows",
+                    },
+                    other => other,
+                })?;
             let done = self.base.last_step();
             work.evaluations += done.evaluations;
             work.jacobians += done.jacobians;
