@@ -6,7 +6,7 @@ use lagrange_core::constraints::contact::{
     drop_dependent_contacts, ActiveRows, ContactModel, Contacts, Impact, Impacts,
 };
 
-use crate::integrator::{check_step, continues, step_loop};
+use crate::integrator::{check_run_step, check_step, continues, step_loop};
 use crate::{Cost, Failure, Integrator, Method, Work};
 use lagrange_core::constraints::Projection;
 use lagrange_core::nalgebra::SVector;
@@ -181,28 +181,42 @@ where
         I: for<'a> Integrator<T, N, ActiveRows<'a, T, C, M, K>>,
         F: FnMut(&Impact<T, N, C>),
     {
+        self.transaction(|c| c.step_events(mechanism, state, dt, observe, false))
+    }
+
+    /// `f`, and the stepper as it was (resting set, impact count, the state it continues
+    /// from) when `f` fails.
+    fn transaction<V, E>(&mut self, f: impl FnOnce(&mut Self) -> Result<V, E>) -> Result<V, E> {
         let saved = (self.resting, self.impacts, self.last);
-        let result = self.step_events(mechanism, state, dt, observe);
+        let result = f(self);
         if result.is_err() {
             (self.resting, self.impacts, self.last) = saved;
         }
         result
     }
 
-    /// The step of [`ContactStepper::step_observed`].
+    /// The step of [`ContactStepper::step_observed`], or of a run (`run`: a `dt` below the
+    /// resolution of the time is taken). The inner integrator's steps are steps of a run
+    /// either way: what is left of `dt` after an impact and the bisection's trial lengths may
+    /// be far below the resolution of the time.
     fn step_events<M, F>(
         &mut self,
         mechanism: &M,
         state: &State<T, N>,
         dt: T,
         mut observe: F,
+        run: bool,
     ) -> Result<State<T, N>, Error>
     where
         M: Mechanism<T, N>,
         I: for<'a> Integrator<T, N, ActiveRows<'a, T, C, M, K>>,
         F: FnMut(&Impact<T, N, C>),
     {
-        let dt = check_step(state, dt)?;
+        let dt = if run {
+            check_run_step(state, dt)?
+        } else {
+            check_step(state, dt)?
+        };
         if !self.last.is_some_and(|last| continues(&last, state)) {
             self.start(state)?;
         }
@@ -211,7 +225,7 @@ where
         let mut remaining = dt;
         let mut events = 0;
         loop {
-            let trial = self.integrator.step(
+            let trial = self.integrator.run_step(
                 &active(
                     mechanism,
                     &self.contacts,
@@ -323,7 +337,7 @@ where
             if mid <= lo || mid >= hi {
                 break; // the bracket is at the resolution of T
             }
-            let trial = self.integrator.step(
+            let trial = self.integrator.run_step(
                 &active(
                     mechanism,
                     &self.contacts,
@@ -377,6 +391,16 @@ where
         self.step_observed(mechanism, state, dt, |_| {})
     }
 
+    /// A step of a run; see [`ContactStepper::step_observed`].
+    fn run_step(
+        &mut self,
+        mechanism: &M,
+        state: &State<T, N>,
+        dt: T,
+    ) -> Result<State<T, N>, Error> {
+        self.transaction(|c| c.step_events(mechanism, state, dt, |_| {}, true))
+    }
+
     /// As the default, and a run that fails leaves the stepper as it found it (resting set,
     /// impact count, the state it continues from), like a step that fails.
     fn integrate_with<F: FnMut(&State<T, N>)>(
@@ -387,17 +411,14 @@ where
         steps: u64,
         observe: F,
     ) -> Result<State<T, N>, Failure<T, N>> {
-        let saved = (self.resting, self.impacts, self.last);
-        let result = step_loop(
-            state,
-            dt,
-            steps,
-            |s| self.step_observed(mechanism, s, dt, |_| {}),
-            observe,
-        );
-        if result.is_err() {
-            (self.resting, self.impacts, self.last) = saved;
-        }
-        result
+        self.transaction(|c| {
+            step_loop(
+                state,
+                dt,
+                steps,
+                |s| c.step_events(mechanism, s, dt, |_| {}, true),
+                observe,
+            )
+        })
     }
 }

@@ -1,6 +1,6 @@
 //! Explicit (forward) Euler.
 
-use crate::integrator::{check_step, finish, Cost};
+use crate::integrator::{check_run_step, check_step, finish, Cost};
 use crate::{Integrator, Method};
 use lagrange_core::{Error, Mechanism, Real, State};
 
@@ -21,12 +21,24 @@ impl Method for ExplicitEuler {
 
 impl<T: Real, const N: usize, M: Mechanism<T, N>> Integrator<T, N, M> for ExplicitEuler {
     fn step(&mut self, m: &M, s: &State<T, N>, dt: T) -> Result<State<T, N>, Error> {
-        let h = check_step(s, dt)?;
-        let a = m.acceleration(s)?;
-        finish(State {
-            t: s.t + h,
-            q: s.q + s.qd * h,
-            qd: s.qd + a * h,
-        })
+        euler(m, s, check_step(s, dt)?)
     }
+
+    fn run_step(&mut self, m: &M, s: &State<T, N>, dt: T) -> Result<State<T, N>, Error> {
+        euler(m, s, check_run_step(s, dt)?)
+    }
+}
+
+/// One step of `h` (checked) from `s`.
+fn euler<T: Real, const N: usize, M: Mechanism<T, N>>(
+    m: &M,
+    s: &State<T, N>,
+    h: T,
+) -> Result<State<T, N>, Error> {
+    let a = m.acceleration(s)?;
+    finish(State {
+        t: s.t + h,
+        q: s.q + s.qd * h,
+        qd: s.qd + a * h,
+    })
 }

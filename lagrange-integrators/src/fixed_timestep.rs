@@ -135,7 +135,9 @@ impl<T: Real, const N: usize, I> FixedTimestep<T, N, I> {
         self.accumulator = (self.accumulator + frame_time).min(T::MAX);
         let mut steps = 0;
         while self.due() && steps < self.max_steps_per_frame {
-            let mut next = self.integrator.step(mechanism, &self.current, self.dt)?;
+            let mut next = self
+                .integrator
+                .run_step(mechanism, &self.current, self.dt)?;
             self.clock.tick(self.dt);
             next.t = self.clock.time();
             self.previous = self.current;

@@ -1,7 +1,9 @@
 //! [`ImplicitRungeKutta`]: the one stepper behind implicit midpoint, Gauss-Legendre, backward
 //! Euler and Radau IIA, each given by its Butcher tableau ([`ImplicitTableau`]).
 
-use crate::integrator::{check_signed, check_step, finish, Cost, Work};
+use crate::integrator::{
+    check_run_step, check_signed, check_signed_run, check_step, finish, Cost, Work,
+};
 use crate::newton::{self, BlockMatrix, Blocks, NewtonProblem, NewtonSettings, Start};
 use crate::{Integrator, Method, MidpointTableau, SymmetricBase};
 use core::marker::PhantomData;
@@ -259,6 +261,11 @@ where
         let h = check_step(s, dt)?;
         self.advance(m, s, h)
     }
+
+    fn run_step(&mut self, m: &Mech, s: &State<T, N>, dt: T) -> Result<State<T, N>, Error> {
+        let h = check_run_step(s, dt)?;
+        self.advance(m, s, h)
+    }
 }
 
 /// The implicit midpoint rule is symmetric and of order 2: a base for [`Yoshida4`](crate::Yoshida4).
@@ -270,6 +277,11 @@ where
 {
     fn signed_step(&mut self, m: &Mech, s: &State<T, N>, h: T) -> Result<State<T, N>, Error> {
         let h = check_signed(s, h)?;
+        self.advance(m, s, h)
+    }
+
+    fn signed_run_step(&mut self, m: &Mech, s: &State<T, N>, h: T) -> Result<State<T, N>, Error> {
+        let h = check_signed_run(s, h)?;
         self.advance(m, s, h)
     }
 }

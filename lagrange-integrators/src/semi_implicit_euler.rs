@@ -1,6 +1,6 @@
 //! Semi-implicit (symplectic) Euler.
 
-use crate::integrator::{check_step, finish, Cost};
+use crate::integrator::{check_run_step, check_step, finish, Cost};
 use crate::{Integrator, Method};
 use lagrange_core::{Error, Mechanism, Real, State};
 
@@ -23,12 +23,24 @@ impl Method for SemiImplicitEuler {
 
 impl<T: Real, const N: usize, M: Mechanism<T, N>> Integrator<T, N, M> for SemiImplicitEuler {
     fn step(&mut self, m: &M, s: &State<T, N>, dt: T) -> Result<State<T, N>, Error> {
-        let h = check_step(s, dt)?;
-        let qd = s.qd + m.acceleration(s)? * h;
-        finish(State {
-            t: s.t + h,
-            q: s.q + qd * h,
-            qd,
-        })
+        kick_drift(m, s, check_step(s, dt)?)
     }
+
+    fn run_step(&mut self, m: &M, s: &State<T, N>, dt: T) -> Result<State<T, N>, Error> {
+        kick_drift(m, s, check_run_step(s, dt)?)
+    }
+}
+
+/// One step of `h` (checked) from `s`.
+fn kick_drift<T: Real, const N: usize, M: Mechanism<T, N>>(
+    m: &M,
+    s: &State<T, N>,
+    h: T,
+) -> Result<State<T, N>, Error> {
+    let qd = s.qd + m.acceleration(s)? * h;
+    finish(State {
+        t: s.t + h,
+        q: s.q + qd * h,
+        qd,
+    })
 }

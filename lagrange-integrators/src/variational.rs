@@ -1,9 +1,12 @@
 //! [`VariationalMidpoint`]: the discrete Euler-Lagrange equations of the midpoint discrete
 //! Lagrangian, with discrete forces (Lagrange-d'Alembert), in position-momentum form.
 
-use crate::integrator::{check_signed, check_step, continues, Clock, Cost, Failure, Work};
+use crate::integrator::{
+    check_run, check_run_step, check_signed, check_signed_run, check_step, continues, Cost,
+    Failure, Work,
+};
 use crate::newton::{self, BlockMatrix, Blocks, NewtonProblem, NewtonSettings, Start};
-use crate::{Integrator, Method, SymmetricBase};
+use crate::{Clock, Integrator, Method, SymmetricBase};
 use lagrange_core::nalgebra::{SMatrix, SVector};
 use lagrange_core::{
     central_difference_jacobian, Dual, Error, Jacobian, Lagrangian, Mechanism, NoForce, Real,
@@ -381,6 +384,10 @@ impl<T: Real, const N: usize> VariationalMidpoint<T, N> {
         dt: T,
     ) -> Result<PhaseState<T, N>, Error> {
         let dt = crate::integrator::check_dt(dt)?;
+        if !phase.is_finite() {
+            return Err(Error::NonFiniteState);
+        }
+        crate::integrator::advances(phase.t, dt)?;
         let guess = self.guess(&phase.q, dt);
         self.step_from(m, phase, dt, guess)
     }
@@ -393,7 +400,8 @@ impl<T: Real, const N: usize> VariationalMidpoint<T, N> {
         }
     }
 
-    /// A step of `h` (either sign) from `phase` with the guess `q1`.
+    /// A step of `h` (either sign, checked by the caller: it may be below the resolution of
+    /// the time in a run) from `phase` with the guess `q1`.
     fn step_from<M: Mechanism<T, N>>(
         &mut self,
         m: &M,
@@ -404,7 +412,6 @@ impl<T: Real, const N: usize> VariationalMidpoint<T, N> {
         if !phase.is_finite() {
             return Err(Error::NonFiniteState);
         }
-        crate::integrator::advances(phase.t, h)?;
         let mut problem = DiscreteEulerLagrange {
             sys: m,
             start: phase,
@@ -484,6 +491,11 @@ impl<T: Real, const N: usize, M: Mechanism<T, N>> Integrator<T, N, M>
         self.advance(m, s, h)
     }
 
+    fn run_step(&mut self, m: &M, s: &State<T, N>, dt: T) -> Result<State<T, N>, Error> {
+        let h = check_run_step(s, dt)?;
+        self.advance(m, s, h)
+    }
+
     /// In position-momentum form throughout, converting to velocities only at the end (the
     /// default would convert after every step).
     fn integrate(
@@ -498,7 +510,7 @@ impl<T: Real, const N: usize, M: Mechanism<T, N>> Integrator<T, N, M>
             step,
             last: *last,
         };
-        let dt = check_step(state, dt).map_err(|e| fail(e, 0, state))?;
+        let dt = check_run(state, dt, steps).map_err(|e| fail(e, 0, state))?;
         if steps == 0 {
             return Ok(*state);
         }
@@ -538,6 +550,11 @@ impl<T: Real, const N: usize, M: Mechanism<T, N>> SymmetricBase<T, N, M>
 {
     fn signed_step(&mut self, m: &M, s: &State<T, N>, h: T) -> Result<State<T, N>, Error> {
         let h = check_signed(s, h)?;
+        self.advance(m, s, h)
+    }
+
+    fn signed_run_step(&mut self, m: &M, s: &State<T, N>, h: T) -> Result<State<T, N>, Error> {
+        let h = check_signed_run(s, h)?;
         self.advance(m, s, h)
     }
 }

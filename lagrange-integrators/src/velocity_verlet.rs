@@ -1,6 +1,6 @@
 //! Velocity Verlet (Stormer-Verlet, kick-drift-kick).
 
-use crate::integrator::{check_step, finish, Cost};
+use crate::integrator::{check_run_step, check_step, finish, Cost};
 use crate::{Integrator, Method};
 use lagrange_core::{Error, Mechanism, Real, State};
 
@@ -33,21 +33,33 @@ impl Method for VelocityVerlet {
 
 impl<T: Real, const N: usize, M: Mechanism<T, N>> Integrator<T, N, M> for VelocityVerlet {
     fn step(&mut self, m: &M, s: &State<T, N>, dt: T) -> Result<State<T, N>, Error> {
-        let h = check_step(s, dt)?;
-        let half = h * T::HALF;
-        let a0 = m.acceleration(s)?;
-        let v = s.qd + a0 * half;
-        let t = s.t + h;
-        let q = s.q + v * h;
-        let a1 = m.acceleration(&State {
-            t,
-            q,
-            qd: s.qd + a0 * h,
-        })?;
-        finish(State {
-            t,
-            q,
-            qd: v + a1 * half,
-        })
+        kick_drift_kick(m, s, check_step(s, dt)?)
     }
+
+    fn run_step(&mut self, m: &M, s: &State<T, N>, dt: T) -> Result<State<T, N>, Error> {
+        kick_drift_kick(m, s, check_run_step(s, dt)?)
+    }
+}
+
+/// One step of `h` (checked) from `s`.
+fn kick_drift_kick<T: Real, const N: usize, M: Mechanism<T, N>>(
+    m: &M,
+    s: &State<T, N>,
+    h: T,
+) -> Result<State<T, N>, Error> {
+    let half = h * T::HALF;
+    let a0 = m.acceleration(s)?;
+    let v = s.qd + a0 * half;
+    let t = s.t + h;
+    let q = s.q + v * h;
+    let a1 = m.acceleration(&State {
+        t,
+        q,
+        qd: s.qd + a0 * h,
+    })?;
+    finish(State {
+        t,
+        q,
+        qd: v + a1 * half,
+    })
 }

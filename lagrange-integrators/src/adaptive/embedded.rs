@@ -448,6 +448,12 @@ where
         self.stages.kv[0] = fv;
         let y0 = self.state;
         let mut h = self.h.min(self.settings.h_max()).min(T::MAX);
+        // A first trial below the resolution of the time (a large t) is raised to the
+        // smallest step that moves it: the error test decides whether that step is good.
+        // After a rejection it is not raised again.
+        if y0.t + h == y0.t {
+            h = h.max(y0.t.abs() * T::EPSILON).min(self.settings.h_max());
+        }
         let mut stretch = real::<T>(1.01);
         loop {
             // An end too far to be reached in one finite step (t_end - t overflows) is not

@@ -539,6 +539,56 @@ fn falling_contact<T: Real>(ctx: &mut Ctx) -> Verdict {
     )
 }
 
+/// The sine and cosine of `lagrange_core::fast_trig` (no error channel): finite for every
+/// finite argument, NaN otherwise, never a panic.
+fn fast_trig(ctx: &mut Ctx) -> Verdict {
+    let x = ctx.value::<f32>(Kind::Signed);
+    say!(ctx, "lagrange_core::fast_trig::sin_cos({})", lit(x));
+    let (s, c) = lagrange_core::fast_trig::sin_cos(x);
+    let (s1, c1) = (
+        lagrange_core::fast_trig::sin(x),
+        lagrange_core::fast_trig::cos(x),
+    );
+    if x.is_finite() && !(s.is_finite() && c.is_finite() && s.abs() <= 1.0 && c.abs() <= 1.0) {
+        return Verdict::Silent(format!("sin_cos({x:e}) = ({s}, {c})"));
+    }
+    if s.to_bits() != s1.to_bits() || c.to_bits() != c1.to_bits() {
+        return Verdict::Inconsistent(format!(
+            "sin_cos({x:e}) = ({s}, {c}), sin, cos = ({s1}, {c1})"
+        ));
+    }
+    Verdict::Ok
+}
+
+/// The exact clock of the runs (no error channel): a few ticks of drawn steps, never a
+/// panic; finite ticks from a finite start give a finite time within an ulp of the sum.
+fn clock<T: Real>(ctx: &mut Ctx) -> Verdict {
+    let t0 = ctx.value::<T>(Kind::Time);
+    let dt = ctx.value::<T>(Kind::Step);
+    let n = ctx.count().min(5000);
+    say!(
+        ctx,
+        "let mut c = Clock::new({}); for _ in 0..{n} {{ c.tick({}); }} c.time()",
+        lit(t0),
+        lit(dt)
+    );
+    let mut c = lagrange_integrators::Clock::new(t0);
+    for _ in 0..n {
+        c.tick(dt);
+    }
+    let t = c.time();
+    let exact = t0.to_f64() + n as f64 * dt.to_f64();
+    let representable = exact.abs() < T::MAX.to_f64() * 0.5;
+    if t0.is_finite() && dt.is_finite() && representable && T::EPSILON.to_f64() > 1e-10 {
+        // In f32 the sum in f64 is exact enough to judge an ulp.
+        let err = (t.to_f64() - exact).abs();
+        if !(err <= t.to_f64().abs().max(T::MIN_POSITIVE.to_f64()) * T::EPSILON.to_f64()) {
+            return Verdict::Inconsistent(format!("time {t:?} for {exact:e}"));
+        }
+    }
+    Verdict::Ok
+}
+
 /// The family.
 pub fn family() -> Family {
     let mut v: Vec<Entry> = Vec::new();
@@ -565,6 +615,12 @@ pub fn family() -> Family {
     entries!(v, 0.7, "Constrained<RollingDisk>", rolling_disk);
     entries!(v, 1.0, "contact laws (ActiveRows, Impacts)", contact_laws);
     entries!(v, 0.5, "Impacts of a falling particle", falling_contact);
+    entries!(v, 0.3, "Clock::tick/time", clock);
+    v.push(Entry {
+        name: "fast_trig::sin/cos/sin_cos f32".into(),
+        weight: 0.3,
+        run: fast_trig,
+    });
     Family {
         name: "core",
         entries: v,

@@ -232,10 +232,39 @@ where
     let s = state::<T, N>(ctx, "s");
     let dt = ctx.value::<T>(Kind::Step);
     let params: &[&str] = &["dt", "state", "steps"];
-    match ctx.pick(4) {
+    match ctx.pick(6) {
         0 => {
             say!(ctx, "a.step(&m, &s, {})", lit(dt));
             verdict(&a.step(m, &s, dt), params)
+        }
+        4 => {
+            say!(ctx, "a.run_step(&m, &s, {})", lit(dt));
+            verdict(&a.run_step(m, &s, dt), params)
+        }
+        5 => {
+            // A step of a run is a step, but for a dt below the resolution of the time.
+            let mut b = a.clone();
+            say!(ctx, "let mut b = a.clone();");
+            say!(ctx, "let one = a.step(&m, &s, {});", lit(dt));
+            let one = a.step(m, &s, dt);
+            say!(ctx, "let run = b.run_step(&m, &s, {});", lit(dt));
+            let run = b.run_step(m, &s, dt);
+            let v = verdict(&one, params);
+            if v.class().is_finding() {
+                return v;
+            }
+            let w = verdict(&run, params);
+            if w.class().is_finding() {
+                return w;
+            }
+            match (&one, &run) {
+                (Ok(x), Ok(y)) if same(x, y) => v,
+                (Err(e), Err(f)) if e == f => v,
+                // Below the resolution of the time a step is refused; the run's step is
+                // taken, and may fail for its own reasons (a step of 1e-45 s).
+                (Err(Error::StepSizeUnderflow), _) => w,
+                _ => Verdict::Inconsistent(format!("step {one:?}, run step {run:?}")),
+            }
         }
         1 => {
             let n = ctx.count().min(MAX_RUN);
