@@ -1,6 +1,6 @@
 //! Wall-clock timing of the hot paths that validation must not slow down, without criterion:
-//! RK4 steps of the pendulum and the double pendulum (f32 and f64), a DOP853 solve, and DOP853
-//! landings from a fixed-timestep loop. Each figure is the median of repeated whole runs.
+//! RK4 steps and runs of the pendulum and the double pendulum (f32 and f64), a DOP853 solve, and
+//! DOP853 landings from a fixed-timestep loop. Each figure is the median of repeated whole runs.
 //!
 //! `cargo run --release -p lagrange-tests --example step_timing [repeats]`
 //!
@@ -58,6 +58,23 @@ fn rk4<T: Real, M: Mechanism<T, N>, const N: usize>(
     report(name, "ns", times);
 }
 
+/// RK4 runs (`integrate`, the run's clock included) of `STEPS` steps from `start`.
+fn rk4_run<T: Real, M: Mechanism<T, N>, const N: usize>(
+    name: &str,
+    repeats: usize,
+    m: &M,
+    start: State<T, N>,
+) {
+    let dt = T::from_f64(1e-4);
+    let times = timed(repeats, STEPS as f64, || {
+        match Rk4.integrate(black_box(m), &start, dt, STEPS) {
+            Ok(end) => black_box(end),
+            Err(e) => panic!("{name}: {e}"),
+        };
+    });
+    report(name, "ns", times);
+}
+
 fn main() {
     let repeats = std::env::args()
         .nth(1)
@@ -95,6 +112,15 @@ fn main() {
     );
     rk4(
         "rk4 step, double pendulum f32",
+        repeats,
+        &d32,
+        State::at_rest([1.0, -0.5]),
+    );
+
+    rk4_run("rk4 integrate, pendulum f64", repeats, &p64, State::at_rest([0.5]));
+    rk4_run("rk4 integrate, pendulum f32", repeats, &p32, State::at_rest([0.5]));
+    rk4_run(
+        "rk4 integrate, double pendulum f32",
         repeats,
         &d32,
         State::at_rest([1.0, -0.5]),
