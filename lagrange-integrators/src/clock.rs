@@ -88,9 +88,22 @@ impl<T: Real> Clock<T> {
     #[inline]
     #[must_use]
     pub fn time(&self) -> T {
+        let t = self.time_at(T::one());
+        if t.is_finite() {
+            t
+        } else {
+            // `j dt` may overflow where the time does not (a huge step towards a time far on
+            // the other side of zero): the same at half scale, exact, doubled.
+            self.time_at(T::HALF) * T::TWO
+        }
+    }
+
+    /// The time now times `scale` (1 or 1/2: both exact).
+    #[inline(always)]
+    fn time_at(&self, scale: T) -> T {
         let j = self.j;
-        let (s, e) = two_sum(self.base.0, j * self.dt_hi);
-        s + (e + (j * self.dt_lo + self.base.1))
+        let (s, e) = two_sum(self.base.0 * scale, j * (self.dt_hi * scale));
+        s + (e + (j * (self.dt_lo * scale) + self.base.1 * scale))
     }
 
     /// The time of a clock started at `t` after `n` ticks of `dt`, without ticking.
@@ -119,34 +132,43 @@ impl<T: Real> Clock<T> {
 
     /// The time now as a float pair (before rounding).
     fn exact(&self) -> (T, T) {
-        let j = self.j;
-        let (s, e) = two_sum(self.base.0, j * self.dt_hi);
-        add((s, e), (j * self.dt_lo + self.base.1, T::zero()))
+        let pair = |scale: T| {
+            let j = self.j;
+            let (s, e) = two_sum(self.base.0 * scale, j * (self.dt_hi * scale));
+            add(
+                (s, e),
+                (j * (self.dt_lo * scale) + self.base.1 * scale, T::zero()),
+            )
+        };
+        doubled_if_needed(pair)
     }
 
     /// `origin + n dt` for the count `n`, a whole number of blocks, as a float pair: the
     /// `s`-bit digits of `n`, highest first, each times `dt_hi` and `dt_lo` exactly, scaled by
-    /// its power of two, summed in a pair.
+    /// its power of two, summed in a pair. (The base lies between the origin and the time
+    /// reached, so it is finite when they are, though `n dt` may not be.)
     #[cold]
     fn block_base(&self) -> (T, T) {
-        let s = split_bits::<T>();
-        let radix = T::from_f64(f64::from(1u32 << s));
-        let digits = 64u32.div_ceil(s);
-        let mut acc = (T::zero(), T::zero());
-        for i in (0..digits).rev() {
-            let d = (self.n >> (i * s)) & ((1u64 << s) - 1);
-            if d == 0 {
-                continue;
+        doubled_if_needed(|scale| {
+            let s = split_bits::<T>();
+            let radix = T::from_f64(f64::from(1u32 << s));
+            let digits = 64u32.div_ceil(s);
+            let mut acc = (T::zero(), T::zero());
+            for i in (0..digits).rev() {
+                let d = (self.n >> (i * s)) & ((1u64 << s) - 1);
+                if d == 0 {
+                    continue;
+                }
+                let mut power = scale;
+                for _ in 0..i {
+                    power *= radix;
+                }
+                let d = T::from_f64(d as f64);
+                acc = add(acc, (d * self.dt_hi * power, T::zero()));
+                acc = add(acc, (d * self.dt_lo * power, T::zero()));
             }
-            let mut scale = T::one();
-            for _ in 0..i {
-                scale *= radix;
-            }
-            let d = T::from_f64(d as f64);
-            acc = add(acc, (d * self.dt_hi * scale, T::zero()));
-            acc = add(acc, (d * self.dt_lo * scale, T::zero()));
-        }
-        add(self.origin, acc)
+            add((self.origin.0 * scale, self.origin.1 * scale), acc)
+        })
     }
 }
 
@@ -171,6 +193,18 @@ fn split<T: Real>(x: T) -> (T, T) {
         (hi, lo)
     } else {
         (x, T::zero())
+    }
+}
+
+/// `f(1)`, or `2 f(1/2)` when `f(1)` is not finite: a pair computed at half scale (exact) when
+/// an intermediate product overflows at full scale.
+fn doubled_if_needed<T: Real>(f: impl Fn(T) -> (T, T)) -> (T, T) {
+    let (hi, lo) = f(T::one());
+    if hi.is_finite() && lo.is_finite() {
+        (hi, lo)
+    } else {
+        let (hi, lo) = f(T::HALF);
+        (hi * T::TWO, lo * T::TWO)
     }
 }
 

@@ -140,6 +140,9 @@ impl<T: Real, const N: usize, I> FixedTimestep<T, N, I> {
                 .run_step(mechanism, &self.current, self.dt)?;
             self.clock.tick(self.dt);
             next.t = self.clock.time();
+            if !next.t.is_finite() {
+                return Err(Error::NonFiniteState);
+            }
             self.previous = self.current;
             self.current = next;
             self.accumulator -= self.dt;

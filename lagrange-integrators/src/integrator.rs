@@ -247,6 +247,9 @@ pub(crate) fn step_loop<T: Real, const N: usize>(
         let mut next = advance(&s).map_err(|e| fail(e, k, &s))?;
         clock.tick(dt);
         next.t = clock.time();
+        if !next.t.is_finite() {
+            return Err(fail(Error::NonFiniteState, k, &s));
+        }
         s = next;
         observe(&s);
     }

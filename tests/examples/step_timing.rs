@@ -117,8 +117,18 @@ fn main() {
         State::at_rest([1.0, -0.5]),
     );
 
-    rk4_run("rk4 integrate, pendulum f64", repeats, &p64, State::at_rest([0.5]));
-    rk4_run("rk4 integrate, pendulum f32", repeats, &p32, State::at_rest([0.5]));
+    rk4_run(
+        "rk4 integrate, pendulum f64",
+        repeats,
+        &p64,
+        State::at_rest([0.5]),
+    );
+    rk4_run(
+        "rk4 integrate, pendulum f32",
+        repeats,
+        &p32,
+        State::at_rest([0.5]),
+    );
     rk4_run(
         "rk4 integrate, double pendulum f32",
         repeats,

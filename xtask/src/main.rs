@@ -16,12 +16,15 @@
 //!   checks the library's against them.
 //! - `mutants`: mutation testing of the numerical core with `cargo-mutants`, a report per file
 //!   under `target/mutants/` (hours; not part of `ci`).
+//! - `fuzz [CALLS] [--seed S]`: the hostile-input campaign (`tests/tests/hostile`) in release,
+//!   10^7 calls by default (its 10^5-call run is part of `test` and `ci`).
 //! - `ci`: format check, clippy with `-D warnings`, the library crates' docs (warnings denied)
 //!   and packages, test, cross, qemu.
 
 mod cmd;
 mod cross;
 mod demo;
+mod fuzz;
 mod mutants;
 mod qemu;
 mod trig_fit;
@@ -37,11 +40,12 @@ fn main() -> ExitCode {
         "bench" => cmd::run(cmd::cargo().args(BENCH).args(std::env::args().skip(2))),
         "qemu" => qemu::run(),
         "mutants" => mutants::run(&std::env::args().skip(2).collect::<Vec<_>>()),
+        "fuzz" => fuzz::run(&std::env::args().skip(2).collect::<Vec<_>>()),
         "ci" => ci(),
         "trig-fit" => trig_fit::run(),
         _ => {
             eprintln!(
-                "usage: cargo xtask <demo | test | cross | bench | qemu | mutants | trig-fit | ci>"
+                "usage: cargo xtask <demo | test | cross | bench | qemu | mutants | fuzz | trig-fit | ci>"
             );
             return ExitCode::from(2);
         }

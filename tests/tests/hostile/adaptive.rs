@@ -221,6 +221,10 @@ where
         if v.class().is_finding() {
             return v;
         }
+        // The step size it will try next is finite (it may be zero before any step).
+        if !rk.step_size().is_finite() {
+            return Verdict::Silent(format!("step size {:?} after call {call}", rk.step_size()));
+        }
         if let Verdict::Error(e) = v {
             let after = observe(&rk);
             if after != before {

@@ -73,6 +73,10 @@ where
         if v.class().is_finding() {
             return v;
         }
+        // After a frame or a reset that succeeded, the state held is finite.
+        if v == Verdict::Ok && !(sim.current().is_finite() && sim.previous().is_finite()) {
+            return Verdict::Silent(observe(&sim));
+        }
         if let Verdict::Error(e) = v {
             let after = observe(&sim);
             if after != before {
