@@ -273,7 +273,12 @@ pub(crate) fn check_run<T: Real, const N: usize>(
 ) -> Result<T, Error> {
     let dt = check_dt(dt)?;
     s.check_finite()?;
-    let end = Clock::after(s.t, dt, steps.max(1));
+    // One step (or none) is checked as a step is; a longer run by its clock (within an ulp).
+    let end = if steps <= 1 {
+        s.t + dt
+    } else {
+        Clock::after(s.t, dt, steps)
+    };
     if end == s.t {
         Err(Error::StepSizeUnderflow)
     } else if !end.is_finite() {

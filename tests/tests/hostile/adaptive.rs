@@ -161,6 +161,10 @@ where
             }
             _ => state::<T, N>(ctx, "s"),
         };
+        if ctx.pick(8) == 0 {
+            say!(ctx, "rk.restart();");
+            rk.restart();
+        }
         let before = observe(&rk);
         let (v, out) = match ctx.pick(5) {
             0 => {

@@ -8,7 +8,7 @@ use crate::systems::exercise;
 use crate::values::Kind;
 use crate::{call, entries, say};
 use lagrange_core::constraints::contact::{
-    drop_dependent_contacts, ActiveRows, ContactModel, Impacts,
+    drop_dependent_contacts, ActiveRows, ContactModel, Contacts, Impacts,
 };
 use lagrange_core::constraints::{Constraints, Holonomic, HolonomicConstraints};
 use lagrange_core::nalgebra::{SMatrix, SVector, Vector1, Vector2};
@@ -78,6 +78,30 @@ impl<T: Real> HolonomicConstraints<T, 2, 2> for Box2<T> {
             q[1] - S::from_real(self.floor),
             S::from_real(self.wall) - q[0],
         )
+    }
+}
+
+/// A user's floor `y >= floor` under a point in the plane, with its tangent for friction.
+#[derive(Debug, Clone, Copy)]
+pub struct Floor<T> {
+    pub floor: T,
+}
+
+impl<T: Real> Constraints<T, 2, 1> for Floor<T> {
+    fn position_residual(&self, q: &SVector<T, 2>) -> SVector<T, 1> {
+        Vector1::new(q[1] - self.floor)
+    }
+    fn jacobian(&self, _q: &SVector<T, 2>) -> SMatrix<T, 1, 2> {
+        SMatrix::<T, 1, 2>::new(T::zero(), T::one())
+    }
+    fn velocity_product(&self, _q: &SVector<T, 2>, _qd: &SVector<T, 2>) -> SVector<T, 1> {
+        Vector1::zeros()
+    }
+}
+
+impl<T: Real> Contacts<T, 2, 1> for Floor<T> {
+    fn tangent_jacobian(&self, _q: &SVector<T, 2>) -> Option<SMatrix<T, 1, 2>> {
+        Some(SMatrix::<T, 1, 2>::new(T::one(), T::zero()))
     }
 }
 
@@ -508,6 +532,113 @@ fn contact_laws<T: Real>(ctx: &mut Ctx) -> Verdict {
     }
 }
 
+/// Friction: a point in the plane on a floor with a tangent, its resting and sliding law and
+/// its impacts with Coulomb impulses.
+fn friction<T: Real>(ctx: &mut Ctx) -> Verdict {
+    let [m, g] = ctx.values::<T, 2>(Kind::Signed);
+    let floor = ctx.value::<T>(Kind::Signed);
+    say!(
+        ctx,
+        "let m = EulerLagrange::new(Particle::<{}> {{ m: {}, g: {} }});",
+        ty::<T>(),
+        lit(m),
+        lit(g)
+    );
+    say!(ctx, "let k = Floor {{ floor: {} }};", lit(floor));
+    let mech = EulerLagrange::new(Particle { m, g });
+    let k = Floor { floor };
+    let model = match model::<T>(ctx) {
+        Ok(m) => m,
+        Err(v) => return v,
+    };
+    let s = state::<T, 2>(ctx, "s");
+    let mut resting = mask::<1>(ctx);
+    if ctx.pick(2) == 0 {
+        say!(
+            ctx,
+            "let rows = ActiveRows::new(&m, &k, &model, &[false], &{resting:?});"
+        );
+        let rows = ActiveRows::new(&mech, &k, &model, &[false], &resting);
+        say!(ctx, "rows.acceleration(&s)");
+        verdict(&rows.acceleration(&s), &["state"])
+    } else {
+        let struck = mask::<1>(ctx);
+        say!(
+            ctx,
+            "Impacts::new(&k, &model, [false]).impact(&m, &s, {struck:?}, &mut {resting:?})"
+        );
+        verdict(
+            &Impacts::new(&k, &model, [false]).impact(&mech, &s, struck, &mut resting),
+            &["state", "struck", "resting"],
+        )
+    }
+}
+
+/// Viscous damping as a wrapped force, with its exact Jacobian, on a double pendulum; and
+/// the projection onto some rows only, and a constrained solve with an extra force.
+fn damped_and_masked<T: Real>(ctx: &mut Ctx) -> Verdict {
+    match ctx.pick(3) {
+        0 => {
+            let [a, b] = ctx.values::<T, 2>(Kind::Param);
+            let c = ctx.values::<T, 2>(Kind::Param);
+            say!(ctx, "let m = DoublePendulum::<{}>::new({}, {}, 1.0, 1.0, 9.81)?.with_force(ViscousDamping::new({})?);", ty::<T>(), lit(a), lit(b), lits(&c));
+            let p = call!(
+                lagrange_systems::DoublePendulum::new(a, b, T::one(), T::one(), T::from_f64(9.81)),
+                &["m1", "m2", "l1", "l2", "gravity"]
+            );
+            let d = call!(ViscousDamping::new(c), &["coefficients"]);
+            exercise(ctx, &p.with_force(d))
+        }
+        1 => {
+            let lengths = ctx.values::<T, 4>(Kind::Param);
+            say!(
+                ctx,
+                "let c = Constrained::new(FourBarLinkage::<{}>::new({}, [1.0; 3], 9.81)?);",
+                ty::<T>(),
+                lits(&lengths)
+            );
+            let p = call!(
+                FourBarLinkage::new(lengths, [T::one(); 3], T::from_f64(9.81)),
+                &["lengths", "masses", "gravity"]
+            );
+            let c = Constrained::new(p);
+            let proj = match projection::<T>(ctx) {
+                Ok(p) => p,
+                Err(v) => return v,
+            };
+            let active = mask::<2>(ctx);
+            let s = state::<T, 3>(ctx, "s");
+            say!(ctx, "proj.project_rows(&c, &c, &s, &{active:?})");
+            verdict(
+                &proj.project_rows(&c, &c, &s, &active),
+                &["state", "active"],
+            )
+        }
+        _ => {
+            let [m, l, g] = ctx.values::<T, 3>(Kind::Param);
+            say!(
+                ctx,
+                "let c = Constrained::new(CartesianPendulum::<{}>::new({}, {}, {})?);",
+                ty::<T>(),
+                lit(m),
+                lit(l),
+                lit(g)
+            );
+            let c = Constrained::new(call!(
+                CartesianPendulum::new(m, l, g),
+                &["mass", "length", "gravity"]
+            ));
+            let s = state::<T, 2>(ctx, "s");
+            let (f, fs) = vector::<T, 2>(ctx, Kind::Signed);
+            say!(ctx, "c.solve_with(&s, &Input {{ value: {fs} }})");
+            verdict(
+                &c.solve_with(&s, &lagrange_core::Input { value: f }),
+                &["state", "extra"],
+            )
+        }
+    }
+}
+
 fn falling_contact<T: Real>(ctx: &mut Ctx) -> Verdict {
     let [m, g] = ctx.values::<T, 2>(Kind::Param);
     say!(
@@ -616,6 +747,13 @@ pub fn family() -> Family {
     entries!(v, 1.0, "contact laws (ActiveRows, Impacts)", contact_laws);
     entries!(v, 0.5, "Impacts of a falling particle", falling_contact);
     entries!(v, 0.3, "Clock::tick/time", clock);
+    entries!(v, 0.6, "friction (ActiveRows, Impacts)", friction);
+    entries!(
+        v,
+        0.6,
+        "ViscousDamping force, project_rows, solve_with",
+        damped_and_masked
+    );
     v.push(Entry {
         name: "fast_trig::sin/cos/sin_cos f32".into(),
         weight: 0.3,

@@ -3,13 +3,14 @@
 //! sequences of calls. After every error a driver's observable state must be as before.
 
 use crate::checks::{state, verdict};
-use crate::core::{Ground, Spring};
+use crate::core::{Floor, Ground, Particle, Spring};
 use crate::fixed_step::{cartesian, pendulum, rk4, setup, stormer, user_spring, Made};
 use crate::harness::{lit, ty, Ctx, Entry, Family, Verdict};
 use crate::values::Kind;
 use crate::{entries, say, tryv};
 use lagrange_core::constraints::{Constraints, Holonomic};
 use lagrange_core::{EulerLagrange, Mechanism, Projection, Real, State};
+use lagrange_integrators::StormerVerlet;
 use lagrange_integrators::{
     ContactModel, ContactStepper, DormandPrince54, FixedTimestep, Integrator, Projected,
 };
@@ -253,12 +254,95 @@ fn contact_stepper<T: Real>(ctx: &mut Ctx) -> Verdict {
     Verdict::Ok
 }
 
+/// A user's point in the plane (unvalidated mass and gravity) on a floor with friction, under
+/// a contact stepper over a symmetric method, and that stepper driven by a fixed-timestep
+/// loop.
+fn friction_stepper<T: Real>(ctx: &mut Ctx) -> Verdict {
+    let [m, g] = ctx.values::<T, 2>(Kind::Signed);
+    let floor = ctx.value::<T>(Kind::Signed);
+    say!(
+        ctx,
+        "let m = EulerLagrange::new(Particle::<{}> {{ m: {}, g: {} }});",
+        ty::<T>(),
+        lit(m),
+        lit(g)
+    );
+    let mech = EulerLagrange::new(Particle { m, g });
+    let [e, rest, tol] = [
+        ctx.value::<T>(Kind::Tolerance),
+        ctx.value::<T>(Kind::Step),
+        ctx.value::<T>(Kind::Tolerance),
+    ];
+    let mu = ctx.value::<T>(Kind::Param);
+    say!(
+        ctx,
+        "let model = ContactModel::<{}>::new({}, {}, {})?.with_friction({})?;",
+        ty::<T>(),
+        lit(e),
+        lit(rest),
+        lit(tol),
+        lit(mu)
+    );
+    let model = tryv!(setup(
+        ContactModel::new(e, rest, tol),
+        &["restitution", "rest_speed", "time_tolerance"]
+    ));
+    let model = tryv!(setup(model.with_friction(mu), &["friction"]));
+    let p = tryv!(projection::<T>(ctx));
+    say!(ctx, "let c = ContactStepper::new(StormerVerlet::default(), Floor {{ floor: {} }}, model, proj);", lit(floor));
+    let c = ContactStepper::<T, 2, 1, _, _>::new(
+        StormerVerlet::<T, 2>::default(),
+        Floor { floor },
+        model,
+        p,
+    );
+    let dt = ctx.value::<T>(Kind::Step);
+    let cap = u32::try_from(ctx.count()).unwrap_or(u32::MAX).min(16);
+    let start = state::<T, 2>(ctx, "s0");
+    say!(
+        ctx,
+        "let mut sim = FixedTimestep::new(c, {}, {cap}, s0)?;",
+        lit(dt)
+    );
+    let mut sim = match FixedTimestep::new(c, dt, cap, start) {
+        Ok(sim) => sim,
+        Err(e) => return crate::checks::refused(e, &["dt", "max_steps_per_frame", "start"]),
+    };
+    for call in 0..=ctx.pick(4) {
+        let before = observe(&sim);
+        let f = frame_time(ctx, dt);
+        say!(ctx, "sim.advance(&m, {})?;", lit(f));
+        let v = verdict(&sim.advance(&mech, f), &["frame_time"]);
+        if v.class().is_finding() {
+            return v;
+        }
+        if v == Verdict::Ok && !sim.current().is_finite() {
+            return Verdict::Silent(observe(&sim));
+        }
+        if let Verdict::Error(e) = v {
+            let after = observe(&sim);
+            if after != before {
+                return Verdict::Changed(format!(
+                    "call {call} failed with {e:?}: {before} -> {after}"
+                ));
+            }
+        }
+    }
+    Verdict::Ok
+}
+
 /// The family.
 pub fn family() -> Family {
     let mut v: Vec<Entry> = Vec::new();
     entries!(v, 1.0, "FixedTimestep::new/advance/reset", fixed_timestep);
     entries!(v, 0.6, "Projected<Rk4>", projected);
     entries!(v, 0.8, "ContactStepper<Rk4>", contact_stepper);
+    entries!(
+        v,
+        0.6,
+        "FixedTimestep<ContactStepper<StormerVerlet>> with friction",
+        friction_stepper
+    );
     Family {
         name: "drivers",
         entries: v,

@@ -109,6 +109,8 @@ enum Slot {
 /// (when shrinking), and the Rust lines of its reproducer (when recording).
 pub struct Ctx {
     rng: Rng,
+    /// How much more often than usual this call draws nasty values.
+    hostility: f64,
     replay: Vec<f64>,
     used: Vec<f64>,
     slots: Vec<Slot>,
@@ -116,9 +118,11 @@ pub struct Ctx {
 }
 
 impl Ctx {
-    fn new(rng: Rng, replay: Vec<f64>, script: Option<Arc<Mutex<Vec<String>>>>) -> Self {
+    fn new(mut rng: Rng, replay: Vec<f64>, script: Option<Arc<Mutex<Vec<String>>>>) -> Self {
+        let hostility = if rng.chance(0.25) { 4.0 } else { 1.0 };
         Self {
             rng,
+            hostility,
             replay,
             used: Vec::new(),
             slots: Vec::new(),
@@ -137,7 +141,7 @@ impl Ctx {
 
     /// A value of `T` for `kind`.
     pub fn value<T: Real>(&mut self, kind: Kind) -> T {
-        let drawn = values::draw::<T>(kind, &mut self.rng);
+        let drawn = values::draw::<T>(kind, &mut self.rng, self.hostility);
         let single = T::EPSILON.to_f64() > 1e-10;
         T::from_f64(self.slot(drawn, Slot::Float(single)))
     }

@@ -142,14 +142,15 @@ fn ordinary<T: Real>(kind: Kind, rng: &mut Rng) -> f64 {
 }
 
 /// A value for `kind`: ordinary most of the time (so that calls get past their checks),
-/// nasty otherwise.
-pub fn draw<T: Real>(kind: Kind, rng: &mut Rng) -> f64 {
+/// nasty otherwise; `hostility` multiplies the share of nasty values (a quarter of the calls
+/// draw four times as many).
+pub fn draw<T: Real>(kind: Kind, rng: &mut Rng, hostility: f64) -> f64 {
     let nasty_share = match kind {
         Kind::Param | Kind::Signed => 0.12,
         Kind::State | Kind::Time => 0.1,
         Kind::Step | Kind::Tolerance => 0.3,
     };
-    if rng.chance(nasty_share) {
+    if rng.chance((nasty_share * hostility).min(0.8)) {
         nasty::<T>(rng)
     } else {
         ordinary::<T>(kind, rng)
