@@ -20,7 +20,9 @@ pub trait GeneralizedForce<T: Real, const N: usize> {
     /// that a mechanism stepped without extra forces pays nothing for them.
     const IS_ZERO: bool = false;
 
-    /// The force at `state`.
+    /// The force at `state`. No error channel: a force of the library is NaN or infinite
+    /// only for a state that is or for one so extreme that it overflows; the laws refuse a
+    /// non-finite force, yours included ([`Error::NonFiniteState`]).
     fn force(&self, state: &State<T, N>) -> SVector<T, N>;
 
     /// `(dQ/dq, dQ/dq')` at `state`, for the Newton matrices of implicit integrators. The

@@ -59,16 +59,22 @@ pub trait Lagrangian<T: Real, const N: usize> {
     }
 
     /// Kinetic energy `T` at `state` (computed only when asked, never inside a step).
+    ///
+    /// No error channel: for a state that is not finite, or a state and parameters so extreme
+    /// that a term overflows, the result is NaN or an infinity (never a panic); check it with
+    /// `is_finite` where it matters.
     fn kinetic_energy(&self, state: &State<T, N>) -> T {
         self.kinetic(state.t, &state.q, &state.qd)
     }
 
-    /// Potential energy `V` at `state`.
+    /// Potential energy `V` at `state` (no error channel: NaN or an infinity for a state that
+    /// is not finite or so extreme that a term overflows, never a panic).
     fn potential_energy(&self, state: &State<T, N>) -> T {
         self.potential(state.t, &state.q)
     }
 
-    /// Total energy `T + V` at `state`.
+    /// Total energy `T + V` at `state` (no error channel: NaN or an infinity for a state that
+    /// is not finite or so extreme that a term overflows, never a panic).
     fn energy(&self, state: &State<T, N>) -> T {
         self.kinetic_energy(state) + self.potential_energy(state)
     }

@@ -45,9 +45,16 @@ use nalgebra::{SMatrix, SVector};
 pub trait Mechanism<T: Real, const N: usize>: Lagrangian<T, N> {
     /// The mass matrix `M = d2L/dq'2`, symmetric positive definite away from singular
     /// configurations.
+    ///
+    /// No error channel: for a state that is not finite or so extreme that an entry
+    /// overflows, entries are NaN or infinite (never a panic); the solves that use `M` refuse
+    /// them ([`Error::NonFiniteState`]).
     fn mass_matrix(&self, state: &State<T, N>) -> SMatrix<T, N, N>;
 
     /// The right-hand side `f` of `M q'' = f + Q`, without the generalized forces `Q`.
+    ///
+    /// No error channel: for a state that is not finite or so extreme that a term overflows,
+    /// components are NaN or infinite (never a panic); the law refuses them.
     fn rhs(&self, state: &State<T, N>) -> SVector<T, N>;
 
     /// Solves `M x = b` at `state`: a fixed-size Cholesky solve by default

@@ -183,7 +183,8 @@ impl<T: Real, const N: usize, I> FixedTimestep<T, N, I> {
 
     /// The state to draw: linear interpolation between the last two steps by
     /// [`FixedTimestep::alpha`] (it lags the simulation by up to one step, and never
-    /// extrapolates).
+    /// extrapolates). The two states are finite; only a difference between them that
+    /// overflows (states near `T::MAX`) makes it infinite.
     #[must_use]
     pub fn interpolated(&self) -> State<T, N> {
         let a = self.alpha();

@@ -321,7 +321,9 @@ impl<T: Real, const N: usize> VariationalMidpoint<T, N> {
         }
     }
 
-    /// The momenta `p = dL/dq'` at `state` (the continuous Legendre transform).
+    /// The momenta `p = dL/dq'` at `state` (the continuous Legendre transform). No error
+    /// channel: NaN or infinite for a state that is not finite or so extreme that it
+    /// overflows; [`VariationalMidpoint::step_phase`] refuses such a phase state.
     pub fn momentum<Sys: Lagrangian<T, N>>(&self, sys: &Sys, state: &State<T, N>) -> SVector<T, N> {
         directional(sys, state.t, &state.q, &state.qd, T::zero())
     }

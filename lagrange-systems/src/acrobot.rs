@@ -213,7 +213,8 @@ impl<T: Real> Acrobot<T> {
         self.torque = validate::finite("torque", torque)?;
         Ok(())
     }
-    /// Position `(x, y)` of the tip of link 2 relative to the pivot, m.
+    /// Position `(x, y)` of the tip of link 2 relative to the pivot, m. (No error channel: NaN
+    /// for angles that are not finite.)
     #[must_use]
     pub fn tip(&self, s: &State<T, 2>) -> (T, T) {
         let (s1, c1) = s.q[0].sin_cos();

@@ -90,6 +90,8 @@ impl<T: Real> BeadOnRotatingHoop<T> {
         self.gravity
     }
     /// The conserved Jacobi integral `m R^2 (th'^2 - omega^2 sin^2 th)/2 - m g R cos th`.
+    /// (No error channel: NaN or infinite for a state that is not finite or so extreme that
+    /// it overflows.)
     #[must_use]
     pub fn jacobi_integral(&self, s: &State<T, 1>) -> T {
         let sin = s.q[0].sin();

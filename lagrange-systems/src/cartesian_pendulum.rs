@@ -94,7 +94,8 @@ impl<T: Real> CartesianPendulum<T> {
     }
 
     /// The consistent state at time `t` of angle `th` from the downward vertical and angular
-    /// rate `thd`.
+    /// rate `thd`. (No error channel: not finite where an argument is not, or where `l thd`
+    /// overflows; check it with [`State::is_finite`].)
     #[must_use]
     pub fn state_from_angle(&self, t: T, th: T, thd: T) -> State<T, 2> {
         let (s, c) = th.sin_cos();
@@ -103,6 +104,8 @@ impl<T: Real> CartesianPendulum<T> {
     }
 
     /// The angle from the downward vertical and its rate, `(atan2(x, -y), (x y' - y x') / r^2)`.
+    /// (No error channel: the rate is NaN at the pivot, `r = 0`, and both are NaN or infinite
+    /// for a state that is not finite.)
     #[must_use]
     pub fn angle(&self, state: &State<T, 2>) -> (T, T) {
         let (x, y) = (state.q[0], state.q[1]);

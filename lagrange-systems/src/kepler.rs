@@ -66,7 +66,8 @@ impl<T: Real> Kepler<T> {
     pub fn mu(&self) -> T {
         self.mu
     }
-    /// The conserved angular momentum per unit mass, `h = r^2 phi'`.
+    /// The conserved angular momentum per unit mass, `h = r^2 phi'`. (No error channel: NaN
+    /// or infinite for a state that is not finite or so extreme that it overflows.)
     #[must_use]
     pub fn angular_momentum(&self, s: &State<T, 2>) -> T {
         s.q[0] * s.q[0] * s.qd[1]

@@ -184,6 +184,7 @@ impl<T: Real, const N: usize> NLinkPendulum<T, N> {
         self.gravity
     }
     /// Positions `(x, y)` of the masses relative to the pivot, m, from the pivot outwards.
+    /// (No error channel: NaN for angles that are not finite.)
     #[must_use]
     pub fn positions(&self, q: &SVector<T, N>) -> [(T, T); N] {
         let (sin, cos) = sin_cos(q);

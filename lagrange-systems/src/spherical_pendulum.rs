@@ -93,7 +93,9 @@ impl<T: Real> SphericalPendulum<T> {
         self.gravity
     }
     /// The conserved momentum conjugate to the azimuth, `p_phi = m l^2 sin^2 th phi'`
-    /// (kg m^2/s): the angular momentum about the vertical axis through the pivot.
+    /// (kg m^2/s): the angular momentum about the vertical axis through the pivot. (No error
+    /// channel: NaN or infinite for a state that is not finite or so extreme that it
+    /// overflows.)
     #[must_use]
     pub fn angular_momentum(&self, s: &State<T, 2>) -> T {
         let sin = s.q[0].sin();

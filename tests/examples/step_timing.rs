@@ -4,10 +4,10 @@
 //!
 //! `cargo run --release -p lagrange-tests --example step_timing [repeats]`
 //!
-//! It prints one line per case, `name  median ns/step  (min .. max)`: run it before and after a
+//! It prints one line per case, `name  median unit  (min .. max)`: run it before and after a
 //! change on the same machine, alternately, and compare the medians.
 
-use lagrange_core::{Mechanism, Real, State};
+use lagrange_core::{Error, Mechanism, Real, State};
 use lagrange_integrators::{AdaptiveSettings, DormandPrince853, Integrator, Rk4};
 use lagrange_systems::{DoublePendulum, SimplePendulum};
 use std::hint::black_box;
@@ -20,16 +20,19 @@ const STEPS: u64 = 2_000_000;
 const DEFAULT_REPEATS: usize = 15;
 
 /// `(median, min, max)` of `repeats` timings of `f`, each divided by `per` (ns per unit).
-fn timed(repeats: usize, per: f64, mut f: impl FnMut()) -> (f64, f64, f64) {
-    let mut ns: Vec<f64> = (0..repeats)
-        .map(|_| {
-            let start = Instant::now();
-            f();
-            start.elapsed().as_nanos() as f64 / per
-        })
-        .collect();
+fn timed(
+    repeats: usize,
+    per: f64,
+    mut f: impl FnMut() -> Result<(), Error>,
+) -> Result<(f64, f64, f64), Error> {
+    let mut ns = Vec::with_capacity(repeats);
+    for _ in 0..repeats.max(1) {
+        let start = Instant::now();
+        f()?;
+        ns.push(start.elapsed().as_nanos() as f64 / per);
+    }
     ns.sort_by(f64::total_cmp);
-    (ns[ns.len() / 2], ns[0], ns[ns.len() - 1])
+    Ok((ns[ns.len() / 2], ns[0], ns[ns.len() - 1]))
 }
 
 /// Prints one case in `unit`.
@@ -43,19 +46,18 @@ fn rk4<T: Real, M: Mechanism<T, N>, const N: usize>(
     repeats: usize,
     m: &M,
     start: State<T, N>,
-) {
+) -> Result<(), Error> {
     let dt = T::from_f64(1e-4);
     let times = timed(repeats, STEPS as f64, || {
         let mut s = start;
         for _ in 0..STEPS {
-            s = match Rk4.step(black_box(m), &s, dt) {
-                Ok(next) => next,
-                Err(e) => panic!("{name}: {e}"),
-            };
+            s = Rk4.step(black_box(m), &s, dt)?;
         }
         black_box(s);
-    });
+        Ok(())
+    })?;
     report(name, "ns", times);
+    Ok(())
 }
 
 /// RK4 runs (`integrate`, the run's clock included) of `STEPS` steps from `start`.
@@ -64,111 +66,91 @@ fn rk4_run<T: Real, M: Mechanism<T, N>, const N: usize>(
     repeats: usize,
     m: &M,
     start: State<T, N>,
-) {
+) -> Result<(), Error> {
     let dt = T::from_f64(1e-4);
     let times = timed(repeats, STEPS as f64, || {
-        match Rk4.integrate(black_box(m), &start, dt, STEPS) {
-            Ok(end) => black_box(end),
-            Err(e) => panic!("{name}: {e}"),
-        };
-    });
+        black_box(Rk4.integrate(black_box(m), &start, dt, STEPS)?);
+        Ok(())
+    })?;
     report(name, "ns", times);
+    Ok(())
 }
 
-fn main() {
+fn main() -> Result<(), Error> {
     let repeats = std::env::args()
         .nth(1)
         .and_then(|a| a.parse().ok())
         .unwrap_or(DEFAULT_REPEATS);
-    let (Ok(p64), Ok(p32)) = (
-        SimplePendulum::new(1.0_f64, 1.0, 9.81, 0.0),
-        SimplePendulum::new(1.0_f32, 1.0, 9.81, 0.0),
-    ) else {
-        panic!("pendulum refused");
-    };
-    let (Ok(d64), Ok(d32)) = (
-        DoublePendulum::new(1.0_f64, 1.0, 1.0, 1.0, 9.81),
-        DoublePendulum::new(1.0_f32, 1.0, 1.0, 1.0, 9.81),
-    ) else {
-        panic!("double pendulum refused");
-    };
+    let p64 = SimplePendulum::new(1.0_f64, 1.0, 9.81, 0.0)?;
+    let p32 = SimplePendulum::new(1.0_f32, 1.0, 9.81, 0.0)?;
+    let d64 = DoublePendulum::new(1.0_f64, 1.0, 1.0, 1.0, 9.81)?;
+    let d32 = DoublePendulum::new(1.0_f32, 1.0, 1.0, 1.0, 9.81)?;
     rk4(
         "rk4 step, pendulum f64",
         repeats,
         &p64,
         State::at_rest([0.5]),
-    );
+    )?;
     rk4(
         "rk4 step, pendulum f32",
         repeats,
         &p32,
         State::at_rest([0.5]),
-    );
+    )?;
+    let swing = [1.0, -0.5];
     rk4(
         "rk4 step, double pendulum f64",
         repeats,
         &d64,
-        State::at_rest([1.0, -0.5]),
-    );
+        State::at_rest(swing),
+    )?;
     rk4(
         "rk4 step, double pendulum f32",
         repeats,
         &d32,
         State::at_rest([1.0, -0.5]),
-    );
-
+    )?;
     rk4_run(
         "rk4 integrate, pendulum f64",
         repeats,
         &p64,
         State::at_rest([0.5]),
-    );
+    )?;
     rk4_run(
         "rk4 integrate, pendulum f32",
         repeats,
         &p32,
         State::at_rest([0.5]),
-    );
-    rk4_run(
-        "rk4 integrate, double pendulum f32",
-        repeats,
-        &d32,
-        State::at_rest([1.0, -0.5]),
-    );
+    )?;
+    let start = State::at_rest([1.0, -0.5]);
+    rk4_run("rk4 integrate, double pendulum f32", repeats, &d32, start)?;
 
     // A DOP853 solve: the chaotic double pendulum over 100 s at rtol = atol = 1e-10.
-    let Ok(settings) = AdaptiveSettings::new(1e-10, 1e-10) else {
-        panic!("settings refused");
-    };
+    let settings = AdaptiveSettings::new(1e-10, 1e-10)?;
     let start = State::at_rest([2.0, -1.0]);
     let solves = 20;
     let times = timed(repeats, f64::from(solves), || {
         for _ in 0..solves {
             let mut dop = DormandPrince853::new(settings);
-            match dop.integrate_to(black_box(&d64), &start, 100.0) {
-                Ok(end) => black_box(end),
-                Err(e) => panic!("dop853 solve: {e}"),
-            };
+            black_box(dop.integrate_to(black_box(&d64), &start, 100.0)?);
         }
-    });
+        Ok(())
+    })?;
     let us = (times.0 / 1e3, times.1 / 1e3, times.2 / 1e3);
     report("dop853 solve, double pendulum 100 s", "us", us);
 
     // DOP853 driven by a frame loop: landings at 1/120 s, most by dense output alone.
     let frames = 100_000u64;
-    let Ok(loose) = AdaptiveSettings::new(1e-8, 1e-8) else {
-        panic!("settings refused");
-    };
+    let loose = AdaptiveSettings::new(1e-8, 1e-8)?;
     let times = timed(repeats, frames as f64, || {
         let mut dop = DormandPrince853::new(loose);
         let mut s = State::at_rest([0.5, 0.2]);
         for _ in 0..frames {
-            s = match dop.step(black_box(&d64), &s, 1.0 / 120.0) {
-                Ok(next) => next,
-                Err(e) => panic!("dop853 landing: {e}"),
-            };
+            s = dop.step(black_box(&d64), &s, 1.0 / 120.0)?;
         }
         black_box(s);
-    });
+        Ok(())
+    })?;
     report("dop853 landing per frame, double pendulum", "ns", times);
+    Ok(())
 }

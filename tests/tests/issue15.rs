@@ -25,15 +25,21 @@ use std::time::Duration;
 /// How long a call that once hung may take here (it takes microseconds).
 const DEADLINE: Duration = Duration::from_secs(20);
 
-/// `f()` run on a thread of its own; a panic if it does not return within [`DEADLINE`].
+/// `f()` run on a thread of its own; a failed assertion if it does not return within
+/// [`DEADLINE`].
 fn within<R: Send + 'static>(what: &str, f: impl FnOnce() -> R + Send + 'static) -> R {
     let (tx, rx) = mpsc::channel();
     std::thread::spawn(move || {
         let _ = tx.send(f());
     });
-    match rx.recv_timeout(DEADLINE) {
+    let answer = rx.recv_timeout(DEADLINE);
+    assert!(
+        answer.is_ok(),
+        "{what}: no answer within {DEADLINE:?} (a hang)"
+    );
+    match answer {
         Ok(r) => r,
-        Err(_) => panic!("{what}: no answer within {DEADLINE:?} (a hang)"),
+        Err(_) => unreachable!(),
     }
 }
 
@@ -97,12 +103,13 @@ fn falling_particle_without_minimum_step<T: Real + Send>() -> Result<(), Error> 
     let mut dp = DormandPrince54::new(settings);
     let mut s = start;
     for _ in 0..3000 {
-        match dp.step(&m, &s, T::one()) {
-            Ok(next) => {
-                assert!(next.is_finite(), "{next:?}");
-                s = next;
-            }
-            Err(e) => panic!("a finite fall of 3000 s: {e}"),
+        let next = dp.step(&m, &s, T::one());
+        assert!(
+            matches!(next, Ok(n) if n.is_finite()),
+            "a finite fall of 3000 s: {next:?}"
+        );
+        if let Ok(n) = next {
+            s = n;
         }
     }
     // Far out the motion itself overflows (y = -g t^2 / 2 with t near T::MAX): an error.
@@ -338,7 +345,8 @@ fn user_nan_is_an_error<T: Real>() -> Result<(), Error> {
     let nan = T::from_f64(f64::NAN);
     let s = State::new(T::zero(), [T::HALF], [T::one()]);
     // A Lagrangian with a NaN stiffness or mass.
-    for m in [EulerLagrange::new(Stiff(nan))] {
+    {
+        let m = EulerLagrange::new(Stiff(nan));
         assert_eq!(m.acceleration(&s), Err(Error::NonFiniteState));
         assert_eq!(
             m.law(&s, &lagrange_core::NoForce),
@@ -389,7 +397,7 @@ impl<T: Real> HolonomicConstraints<T, 2, 1> for NanCircle<T> {
 #[test]
 fn exact_solutions_are_finite_or_errors() {
     let r = damped_oscillator(1.0, 4.0, 1.0, 1.0, 0.0, f64::MIN);
-    assert!(matches!(r, Err(_)), "{r:?}");
+    assert!(r.is_err(), "{r:?}");
     for (u, k) in [
         (f64::MAX, 0.5),
         (1e308, 0.9),
@@ -403,7 +411,8 @@ fn exact_solutions_are_finite_or_errors() {
             "{r:?}"
         );
     }
-    for (theta0, omega) in [(3.0, 1e-308), (3.141_592_653_589_79, 1.0), (1.0, 5e-324)] {
+    let near_pi = core::f64::consts::PI - 1e-14;
+    for (theta0, omega) in [(3.0, 1e-308), (near_pi, 1.0), (1.0, 5e-324)] {
         let r = pendulum_period(theta0, omega);
         assert!(matches!(r, Ok(p) if p.is_finite()) || r.is_err(), "{r:?}");
     }

@@ -713,7 +713,8 @@ fn clock<T: Real>(ctx: &mut Ctx) -> Verdict {
     if t0.is_finite() && dt.is_finite() && representable && T::EPSILON.to_f64() > 1e-10 {
         // In f32 the sum in f64 is exact enough to judge an ulp.
         let err = (t.to_f64() - exact).abs();
-        if !(err <= t.to_f64().abs().max(T::MIN_POSITIVE.to_f64()) * T::EPSILON.to_f64()) {
+        let ulp = t.to_f64().abs().max(T::MIN_POSITIVE.to_f64()) * T::EPSILON.to_f64();
+        if err.is_nan() || err > ulp {
             return Verdict::Inconsistent(format!("time {t:?} for {exact:e}"));
         }
     }
