@@ -721,6 +721,107 @@ fn clock<T: Real>(ctx: &mut Ctx) -> Verdict {
     Verdict::Ok
 }
 
+/// The functions without an error channel, at drawn values: the scalar and dual-number math,
+/// a user's constraint rows and residuals, central differences, and the text of every error.
+/// Never a panic; whatever they return is documented as possibly NaN or infinite.
+fn no_error_channel<T: Real>(ctx: &mut Ctx) -> Verdict {
+    let [x, y] = ctx.values::<T, 2>(Kind::Signed);
+    let n = i32::try_from(ctx.count()).unwrap_or(i32::MIN);
+    say!(ctx, "let (x, y) = ({}, {});", lit(x), lit(y));
+    match ctx.pick(4) {
+        0 => {
+            say!(
+                ctx,
+                "x.powi({n}); x.powf(y); x.atan2(y); x.asin(); x.acos(); x.ln(); ..."
+            );
+            let _ = (
+                x.powi(n),
+                x.powf(y),
+                x.atan2(y),
+                x.asin(),
+                x.acos(),
+                x.atan(),
+            );
+            let _ = (
+                x.ln(),
+                x.exp(),
+                x.sqrt(),
+                x.tan(),
+                x.floor(),
+                x.round(),
+                x.sin_cos(),
+            );
+            let _ = (x.recip(), x.abs(), x.max(y), x.min(y));
+        }
+        1 => {
+            say!(
+                ctx,
+                "let d = Dual::<{}, 2>::variable(x, 0) * Dual::variable(y, 1); ...",
+                ty::<T>()
+            );
+            let d =
+                lagrange_core::Dual::<T, 2>::variable(x, 0) * lagrange_core::Dual::variable(y, 1);
+            let _ = (
+                d.sin(),
+                d.cos(),
+                d.tan(),
+                d.sqrt(),
+                d.exp(),
+                d.ln(),
+                d.powi(n),
+            );
+            let _ = (d.abs(), d.atan2(d), d.recip(), d / (d + x), d - d * y + x);
+        }
+        2 => {
+            let r = ctx.value::<T>(Kind::Param);
+            let s = state::<T, 2>(ctx, "s");
+            say!(ctx, "let c = Holonomic::new(Circle {{ r: {} }}); c.jacobian(&s.q); c.velocity_product(&s.q, &s.qd); c.residual(&s)", lit(r));
+            let c = Holonomic::new(Circle { r });
+            let _ = (
+                c.jacobian(&s.q),
+                c.velocity_product(&s.q, &s.qd),
+                c.residual(&s),
+            );
+            say!(
+                ctx,
+                "central_difference_jacobian(&s, |s| c.position_residual(&s.q).push(...))"
+            );
+            let _ = lagrange_core::central_difference_jacobian(&s, |s: &State<T, 2>| {
+                let phi = c.position_residual(&s.q)[0];
+                SVector::<T, 2>::new(phi, phi * s.qd[0])
+            });
+        }
+        _ => {
+            let errors = [
+                lagrange_core::Error::NonFiniteState,
+                lagrange_core::Error::SingularMassMatrix { pivot: usize::MAX },
+                lagrange_core::Error::RedundantConstraints { row: 0 },
+                lagrange_core::Error::RedundantConstraints { row: usize::MAX },
+                lagrange_core::Error::ConstraintViolated { row: 3 },
+                lagrange_core::Error::TooManySteps { steps: u64::MAX },
+                lagrange_core::Error::NoConvergence {
+                    iterations: u32::MAX,
+                },
+                lagrange_core::Error::StepSizeUnderflow,
+                lagrange_core::Error::SingularJacobian,
+                lagrange_core::Error::Singularity { what: "here" },
+                lagrange_core::Error::InvalidParameter {
+                    name: "x",
+                    reason: "why",
+                },
+            ];
+            say!(ctx, "format!(\"{{}}\", error) for every error");
+            for e in errors {
+                let text = e.to_string();
+                if text.is_empty() {
+                    return Verdict::Inconsistent(format!("{e:?} has no text"));
+                }
+            }
+        }
+    }
+    Verdict::Ok
+}
+
 /// The family.
 pub fn family() -> Family {
     let mut v: Vec<Entry> = Vec::new();
@@ -748,6 +849,12 @@ pub fn family() -> Family {
     entries!(v, 1.0, "contact laws (ActiveRows, Impacts)", contact_laws);
     entries!(v, 0.5, "Impacts of a falling particle", falling_contact);
     entries!(v, 0.3, "Clock::tick/time", clock);
+    entries!(
+        v,
+        0.3,
+        "no error channel (math, duals, rows, differences, texts)",
+        no_error_channel
+    );
     entries!(v, 0.6, "friction (ActiveRows, Impacts)", friction);
     entries!(
         v,
