@@ -199,7 +199,7 @@ fn stabilizations<T: Real>(ctx: &mut Ctx) -> Verdict {
 /// A projection drawn.
 fn projection<T: Real>(ctx: &mut Ctx) -> Result<Projection<T>, Verdict> {
     let tol = ctx.value::<T>(Kind::Tolerance);
-    let n = u32::try_from(ctx.count()).unwrap_or(u32::MAX).min(1000);
+    let n = u32::try_from(ctx.count()).unwrap_or(u32::MAX);
     say!(
         ctx,
         "let proj = Projection::<{}>::new({}, {n})?;",

@@ -122,7 +122,7 @@ fn fixed_timestep<T: Real>(ctx: &mut Ctx) -> Verdict {
 /// A projection drawn (its tolerance may be invalid).
 fn projection<T: Real>(ctx: &mut Ctx) -> Result<Projection<T>, Verdict> {
     let tol = ctx.value::<T>(Kind::Tolerance);
-    let n = u32::try_from(ctx.count()).unwrap_or(u32::MAX).min(100);
+    let n = u32::try_from(ctx.count()).unwrap_or(u32::MAX);
     say!(
         ctx,
         "let proj = Projection::<{}>::new({}, {n})?;",
