@@ -4,7 +4,7 @@
 
 use crate::checks::{state, verdict};
 use crate::core::{Floor, Ground, Particle, Spring};
-use crate::fixed_step::{cartesian, pendulum, rk4, setup, stormer, user_spring, Made};
+use crate::fixed_step::{cartesian, pendulum, rk4, setup, stormer, user_spring, yoshida, Made};
 use crate::harness::{lit, ty, Ctx, Entry, Family, Verdict};
 use crate::values::Kind;
 use crate::{entries, say, tryv};
@@ -99,7 +99,11 @@ fn dopri<T: Real, const N: usize>(ctx: &mut Ctx) -> Made<DormandPrince54<T, N>> 
 }
 
 fn fixed_timestep<T: Real>(ctx: &mut Ctx) -> Verdict {
-    match ctx.pick(4) {
+    match ctx.pick(5) {
+        4 => {
+            let m = tryv!(pendulum::<T>(ctx));
+            frames(ctx, &m, yoshida::<T, 1>)
+        }
         0 => {
             let m = tryv!(pendulum::<T>(ctx));
             frames(ctx, &m, rk4::<T, 1>)

@@ -177,7 +177,7 @@ pub fn stormer<T: Real, const N: usize>(ctx: &mut Ctx) -> Made<StormerVerlet<T, 
         format!("StormerVerlet::<{}, {N}>::new({e})", ty::<T>()),
     ))
 }
-fn yoshida<T: Real, const N: usize>(ctx: &mut Ctx) -> Made<Yoshida4<StormerVerlet<T, N>>> {
+pub fn yoshida<T: Real, const N: usize>(ctx: &mut Ctx) -> Made<Yoshida4<StormerVerlet<T, N>>> {
     let (b, e) = stormer::<T, N>(ctx)?;
     Ok((Yoshida4::new(b), format!("Yoshida4::new({e})")))
 }
