@@ -272,10 +272,12 @@ pub struct Config {
     pub reproducers: usize,
 }
 
-/// Counts per class of one entry point.
+/// Counts per class of one entry point, and its slowest call.
 #[derive(Debug, Clone, Default)]
 pub struct Counts {
     pub by_class: [u64; 8],
+    /// The longest a call took, and which.
+    pub slowest: (Duration, u64),
 }
 
 impl Counts {
@@ -298,6 +300,9 @@ impl Counts {
     fn merge(&mut self, o: &Counts) {
         for (a, b) in self.by_class.iter_mut().zip(o.by_class) {
             *a += b;
+        }
+        if o.slowest.0 > self.slowest.0 {
+            self.slowest = o.slowest;
         }
     }
 }
@@ -565,7 +570,12 @@ fn work(
             );
             let rng = Rng::for_call(seed, entry_id, index);
             let mut ctx = Ctx::new(rng.clone(), Vec::new(), None);
+            let began = Instant::now();
             let verdict = guarded(entry.run, &mut ctx);
+            let took = began.elapsed();
+            if took > local.slowest.0 {
+                local.slowest = (took, index);
+            }
             let class = verdict.class();
             local.add(class);
             if class.is_finding() {
@@ -622,6 +632,7 @@ pub fn report(reports: &[FamilyReport], cfg: &Config) -> Counts {
         for c in CLASSES {
             let _ = write!(head, " {:>9}", c.heading());
         }
+        let _ = write!(head, " {:>12}", "slowest ms");
         println!("{head}");
         let mut fam = Counts::default();
         for (name, counts) in &r.entries {
@@ -629,6 +640,7 @@ pub fn report(reports: &[FamilyReport], cfg: &Config) -> Counts {
             for c in CLASSES {
                 let _ = write!(row, " {:>9}", counts.get(c));
             }
+            let _ = write!(row, " {:>12.3}", counts.slowest.0.as_secs_f64() * 1e3);
             println!("{row}");
             fam.merge(counts);
         }
@@ -636,6 +648,7 @@ pub fn report(reports: &[FamilyReport], cfg: &Config) -> Counts {
         for c in CLASSES {
             let _ = write!(row, " {:>9}", fam.get(c));
         }
+        let _ = write!(row, " {:>12.3}", fam.slowest.0.as_secs_f64() * 1e3);
         println!("{row}");
         all.merge(&fam);
     }
