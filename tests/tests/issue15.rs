@@ -221,7 +221,7 @@ fn a_step_that_cannot_advance_the_time_is_an_error() -> Result<(), Error> {
     Ok(())
 }
 
-/// The compensated clock: 10^7 ticks of 1/120 s in f32 end within an ulp of `n dt` (a plain
+/// The exact clock: 10^7 ticks of 1/120 s in f32 end within an ulp of `n dt` (a plain
 /// sum is off by thousands of ulps).
 #[test]
 fn the_clock_keeps_time() {
