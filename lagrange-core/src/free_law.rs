@@ -1,7 +1,8 @@
 //! [`free_law_force`]: the force an unconstrained law applies besides `f`, in closed form, for
 //! the [`Mechanism::law_force`] of a free mechanism.
 
-use crate::{GeneralizedForce, Lagrangian, Real, State};
+use crate::mechanism::finite;
+use crate::{Error, GeneralizedForce, Lagrangian, Real, State};
 use nalgebra::SVector;
 
 #[cfg(doc)]
@@ -22,6 +23,10 @@ use crate::{Constrained, Mechanism};
 /// ([`Constrained`] states its own). It does not evaluate the law, so it does not refuse a
 /// configuration the law refuses: an override that must (a radius at or below zero) checks
 /// that first.
+///
+/// # Errors
+/// [`Error::NonFiniteState`] when the force is not finite (a user's `Q` or `extra` that
+/// returns NaN).
 ///
 /// ```
 /// use lagrange_core::prelude::*;
@@ -53,7 +58,7 @@ use crate::{Constrained, Mechanism};
 ///         s: &State<f64, 1>,
 ///         extra: &F,
 ///     ) -> Result<SVector<f64, 1>, Error> {
-///         Ok(free_law_force(self, s, extra))
+///         free_law_force(self, s, extra)
 ///     }
 /// }
 ///
@@ -67,11 +72,11 @@ pub fn free_law_force<T, const N: usize, M, F>(
     mechanism: &M,
     state: &State<T, N>,
     extra: &F,
-) -> SVector<T, N>
+) -> Result<SVector<T, N>, Error>
 where
     T: Real,
     M: Lagrangian<T, N> + ?Sized,
     F: GeneralizedForce<T, N>,
 {
-    extra.added_to(state, mechanism.non_conservative_force(state))
+    finite(extra.added_to(state, mechanism.non_conservative_force(state)))
 }

@@ -45,9 +45,16 @@ use nalgebra::{SMatrix, SVector};
 pub trait Mechanism<T: Real, const N: usize>: Lagrangian<T, N> {
     /// The mass matrix `M = d2L/dq'2`, symmetric positive definite away from singular
     /// configurations.
+    ///
+    /// No error channel: for a state that is not finite or so extreme that an entry
+    /// overflows, entries are NaN or infinite (never a panic); the solves that use `M` refuse
+    /// them ([`Error::NonFiniteState`]).
     fn mass_matrix(&self, state: &State<T, N>) -> SMatrix<T, N, N>;
 
     /// The right-hand side `f` of `M q'' = f + Q`, without the generalized forces `Q`.
+    ///
+    /// No error channel: for a state that is not finite or so extreme that a term overflows,
+    /// components are NaN or infinite (never a panic); the law refuses them.
     fn rhs(&self, state: &State<T, N>) -> SVector<T, N>;
 
     /// Solves `M x = b` at `state`: a fixed-size Cholesky solve by default
@@ -66,6 +73,12 @@ pub trait Mechanism<T: Real, const N: usize>: Lagrangian<T, N> {
     /// hand-derived mechanism overrides it with its closed form, a constrained one adds its
     /// constraint forces. Call it through [`Mechanism::acceleration`] or
     /// [`Mechanism::acceleration_with`], which check the result.
+    ///
+    /// **Finite or an error.** Like every function of the library that returns a `Result`,
+    /// the library's laws (the default, every system's, every wrapper's) return `Ok` only
+    /// with finite accelerations, and [`Error::NonFiniteState`] where they would not be. A
+    /// law of your own should do the same; if it does not, [`Mechanism::acceleration`] still
+    /// refuses its non-finite result.
     ///
     /// [`solve_mass`]: Mechanism::solve_mass
     ///
@@ -89,7 +102,8 @@ pub trait Mechanism<T: Real, const N: usize>: Lagrangian<T, N> {
     /// this type states.
     ///
     /// # Errors
-    /// The first error of any evaluation of the law.
+    /// The first error of any evaluation of the law; [`Error::NonFiniteState`] when the
+    /// accelerations or the Jacobian are not finite.
     fn law_jacobian<F: GeneralizedForce<T, N>>(
         &self,
         state: &State<T, N>,
@@ -106,14 +120,14 @@ pub trait Mechanism<T: Real, const N: usize>: Lagrangian<T, N> {
     /// [`free_law_force`]: crate::free_law_force
     ///
     /// # Errors
-    /// As [`Mechanism::law`].
+    /// As [`Mechanism::law`]; [`Error::NonFiniteState`] when the force is not finite.
     fn law_force<F: GeneralizedForce<T, N>>(
         &self,
         state: &State<T, N>,
         extra: &F,
     ) -> Result<SVector<T, N>, Error> {
         let qdd = self.law(state, extra)?;
-        Ok(self.mass_matrix(state) * qdd - self.rhs(state))
+        finite(self.mass_matrix(state) * qdd - self.rhs(state))
     }
 
     /// The generalized accelerations `q''` (the law with no extra force).
@@ -165,12 +179,7 @@ pub trait Mechanism<T: Real, const N: usize>: Lagrangian<T, N> {
         &self,
         state: &State<T, N>,
     ) -> Result<(SVector<T, N>, Jacobian<T, N>), Error> {
-        let (qdd, j) = self.law_jacobian(state, &NoForce)?;
-        if j.is_finite() {
-            Ok((finite(qdd)?, j))
-        } else {
-            Err(Error::NonFiniteState)
-        }
+        finite_jacobian(self.law_jacobian(state, &NoForce)?)
     }
 
     /// The change of velocities `dq'` that a generalized impulse `p` (a force integrated over
@@ -253,12 +262,24 @@ pub(crate) fn finite<T: Real, const N: usize>(v: SVector<T, N>) -> Result<SVecto
     }
 }
 
+/// `(qdd, j)` when both are finite, else [`Error::NonFiniteState`]: what a wrapper checks
+/// before passing on an inner law's Jacobian.
+pub(crate) fn finite_jacobian<T: Real, const N: usize>(
+    (qdd, j): (SVector<T, N>, Jacobian<T, N>),
+) -> Result<(SVector<T, N>, Jacobian<T, N>), Error> {
+    if j.is_finite() {
+        Ok((finite(qdd)?, j))
+    } else {
+        Err(Error::NonFiniteState)
+    }
+}
+
 /// The law of `mechanism` at `state` with `extra`, and its Jacobian by central differences of
 /// the law: the default of [`Mechanism::law_jacobian`].
 ///
 /// # Errors
 /// The first error of any evaluation of the law; [`Error::NonFiniteState`] when the
-/// accelerations are not finite.
+/// accelerations or the Jacobian are not finite.
 pub fn jacobian_by_differences<T, const N: usize, M, F>(
     mechanism: &M,
     state: &State<T, N>,
@@ -279,7 +300,8 @@ where
     });
     match failure {
         Some(e) => Err(e),
-        None => Ok((qdd, j)),
+        None if j.is_finite() => Ok((qdd, j)),
+        None => Err(Error::NonFiniteState),
     }
 }
 

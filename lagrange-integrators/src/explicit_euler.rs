@@ -1,6 +1,6 @@
 //! Explicit (forward) Euler.
 
-use crate::integrator::{check_step, finish, step_loop, Cost, Failure};
+use crate::integrator::{check_run_step, check_step, finish, step_loop, Cost, Failure};
 use crate::{Integrator, Method};
 use lagrange_core::{Error, Lanes, Mechanism, Real, State};
 
@@ -27,7 +27,7 @@ impl<T: Real, const N: usize, M: Mechanism<T, N>> Integrator<T, N, M> for Explic
         state: &State<Lanes<T, L>, N>,
         dt: T,
     ) -> Option<Result<State<Lanes<T, L>, N>, Error>> {
-        Some(Integrator::<Lanes<T, L>, N, G>::step(
+        Some(Integrator::<Lanes<T, L>, N, G>::run_step(
             &mut ExplicitEuler,
             mechanism,
             state,
@@ -38,6 +38,10 @@ impl<T: Real, const N: usize, M: Mechanism<T, N>> Integrator<T, N, M> for Explic
     fn step(&mut self, m: &M, s: &State<T, N>, dt: T) -> Result<State<T, N>, Error> {
         let h = check_step(s, dt)?;
         advance(m, s, h)
+    }
+
+    fn run_step(&mut self, m: &M, s: &State<T, N>, dt: T) -> Result<State<T, N>, Error> {
+        advance(m, s, check_run_step(s, dt)?)
     }
 
     /// As the default, with `dt` and the start checked once rather than at every step (each

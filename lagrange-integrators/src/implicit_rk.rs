@@ -1,7 +1,10 @@
 //! [`ImplicitRungeKutta`]: the one stepper behind implicit midpoint, Gauss-Legendre, backward
 //! Euler and Radau IIA, each given by its Butcher tableau ([`ImplicitTableau`]).
 
-use crate::integrator::{check_signed, check_step, finish, step_loop, Cost, Failure, Work};
+use crate::integrator::{
+    check_run_step, check_signed, check_signed_run, check_step, finish, step_loop, Cost, Failure,
+    Work,
+};
 use crate::newton::{self, BlockMatrix, Blocks, NewtonProblem, NewtonSettings, Start};
 use crate::{Integrator, Method, MidpointTableau, SymmetricBase};
 use core::marker::PhantomData;
@@ -260,6 +263,11 @@ where
         self.advance(m, s, h)
     }
 
+    fn run_step(&mut self, m: &Mech, s: &State<T, N>, dt: T) -> Result<State<T, N>, Error> {
+        let h = check_run_step(s, dt)?;
+        self.advance(m, s, h)
+    }
+
     /// As the default, with `dt` and the start checked once rather than at every step (each
     /// step's end is checked, so the next step's start is known finite).
     fn integrate_with<F: FnMut(&State<T, N>)>(
@@ -283,6 +291,11 @@ where
 {
     fn signed_step(&mut self, m: &Mech, s: &State<T, N>, h: T) -> Result<State<T, N>, Error> {
         let h = check_signed(s, h)?;
+        self.advance(m, s, h)
+    }
+
+    fn signed_run_step(&mut self, m: &Mech, s: &State<T, N>, h: T) -> Result<State<T, N>, Error> {
+        let h = check_signed_run(s, h)?;
         self.advance(m, s, h)
     }
 }

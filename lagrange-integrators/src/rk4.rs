@@ -1,6 +1,6 @@
 //! The classical fourth-order Runge-Kutta method.
 
-use crate::integrator::{check_step, finish, step_loop, Cost, Failure};
+use crate::integrator::{check_run_step, check_step, finish, step_loop, Cost, Failure};
 use crate::{Integrator, Method};
 use lagrange_core::{Error, Lanes, Mechanism, Real, State};
 
@@ -37,7 +37,7 @@ impl<T: Real, const N: usize, M: Mechanism<T, N>> Integrator<T, N, M> for Rk4 {
         state: &State<Lanes<T, L>, N>,
         dt: T,
     ) -> Option<Result<State<Lanes<T, L>, N>, Error>> {
-        Some(Integrator::<Lanes<T, L>, N, G>::step(
+        Some(Integrator::<Lanes<T, L>, N, G>::run_step(
             &mut Rk4,
             mechanism,
             state,
@@ -47,6 +47,11 @@ impl<T: Real, const N: usize, M: Mechanism<T, N>> Integrator<T, N, M> for Rk4 {
 
     fn step(&mut self, m: &M, s: &State<T, N>, dt: T) -> Result<State<T, N>, Error> {
         let h = check_step(s, dt)?;
+        finish(stages(m, s, h)?)
+    }
+
+    fn run_step(&mut self, m: &M, s: &State<T, N>, dt: T) -> Result<State<T, N>, Error> {
+        let h = check_run_step(s, dt)?;
         finish(stages(m, s, h)?)
     }
 

@@ -68,22 +68,34 @@ impl<T: Real> DoublePendulum<T> {
     /// Masses `m1`, `m2` (kg, > 0), rod lengths `l1`, `l2` (m, > 0), `gravity` (m/s^2, >= 0).
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] naming the first parameter out of range or not finite.
+    /// [`Error::InvalidParameter`] naming the first parameter out of range or not finite, or
+    /// the one most responsible when a quantity formed from them leaves the range of `T`
+    /// (the entries of `M`, the weights `(m1 + m2) g l1` and `m2 g l2`, and `det M`, which
+    /// the motion divides by, at its smallest and largest).
     pub fn new(m1: T, m2: T, l1: T, l2: T, gravity: T) -> Result<Self, Error> {
         let m1 = validate::positive("m1", m1)?;
         let m2 = validate::positive("m2", m2)?;
         let l1 = validate::positive("l1", l1)?;
         let l2 = validate::positive("l2", l2)?;
         let gravity = validate::non_negative("gravity", gravity)?;
-        let mu = m1 + m2;
+        let f = |name, x, power| (name, x, power);
+        let (a1, a2, g) = (f("m1", m1, 1), f("m2", m2, 1), f("gravity", gravity, 1));
+        let mu = validate::derived(m1 + m2, &[a1, a2])?;
         let k = Coefficients {
-            m11: mu * l1 * l1,
-            m22: m2 * l2 * l2,
-            coupling: m2 * l1 * l2,
-            weight1: mu * gravity * l1,
-            weight2: m2 * gravity * l2,
-            det_scale: m2 * l1 * l1 * l2 * l2,
+            m11: validate::divisor(mu * l1 * l1, &[a1, a2, f("l1", l1, 2)])?,
+            m22: validate::divisor(m2 * l2 * l2, &[a2, f("l2", l2, 2)])?,
+            coupling: validate::derived(m2 * l1 * l2, &[a2, f("l1", l1, 1), f("l2", l2, 1)])?,
+            weight1: validate::derived(mu * gravity * l1, &[a1, a2, g, f("l1", l1, 1)])?,
+            weight2: validate::derived(m2 * gravity * l2, &[a2, g, f("l2", l2, 1)])?,
+            det_scale: validate::derived(
+                m2 * l1 * l1 * l2 * l2,
+                &[a2, f("l1", l1, 2), f("l2", l2, 2)],
+            )?,
         };
+        // det M = det_scale (m1 + m2 sin^2): from det_scale m1 (sin = 0) to det_scale mu.
+        let det = [a2, f("l1", l1, 2), f("l2", l2, 2)];
+        validate::divisor(k.det_scale * m1, &[det[0], det[1], det[2], a1])?;
+        validate::derived(k.det_scale * mu, &[det[0], det[1], det[2], a1, a2])?;
         Ok(Self {
             m1,
             m2,
@@ -183,7 +195,7 @@ impl<T: Real> Mechanism<T, 2> for DoublePendulum<T> {
         s: &State<T, 2>,
         extra: &F,
     ) -> Result<SVector<T, 2>, Error> {
-        Ok(free_law_force(self, s, extra))
+        free_law_force(self, s, extra)
     }
 }
 

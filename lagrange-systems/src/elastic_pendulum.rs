@@ -58,13 +58,23 @@ impl<T: Real> ElasticPendulum<T> {
     /// in `gravity` (m/s^2, >= 0).
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] naming the first parameter out of range or not finite.
+    /// [`Error::InvalidParameter`] naming the first parameter out of range or not finite, or
+    /// the one most responsible when `1 / m` or the weight `m g` overflows.
     pub fn new(mass: T, stiffness: T, rest_length: T, gravity: T) -> Result<Self, Error> {
+        let mass = validate::positive("mass", mass)?;
+        let stiffness = validate::positive("stiffness", stiffness)?;
+        let rest_length = validate::non_negative("rest_length", rest_length)?;
+        let gravity = validate::non_negative("gravity", gravity)?;
+        validate::divisor(mass, &[("mass", mass, 1)])?;
+        validate::derived(
+            mass * gravity,
+            &[("mass", mass, 1), ("gravity", gravity, 1)],
+        )?;
         Ok(Self {
-            mass: validate::positive("mass", mass)?,
-            stiffness: validate::positive("stiffness", stiffness)?,
-            rest_length: validate::non_negative("rest_length", rest_length)?,
-            gravity: validate::non_negative("gravity", gravity)?,
+            mass,
+            stiffness,
+            rest_length,
+            gravity,
         })
     }
     /// Mass, kg.
@@ -115,7 +125,7 @@ impl<T: Real> Mechanism<T, 2> for ElasticPendulum<T> {
     ) -> Result<SVector<T, 2>, Error> {
         // The law refuses r <= 0, and so does its force.
         positive_radius(s, SPRING_COLLAPSED)?;
-        Ok(free_law_force(self, s, extra))
+        free_law_force(self, s, extra)
     }
 }
 

@@ -68,7 +68,8 @@ impl<T: Real> Kepler<T> {
     pub fn mu(&self) -> T {
         self.mu
     }
-    /// The conserved angular momentum per unit mass, `h = r^2 phi'`.
+    /// The conserved angular momentum per unit mass, `h = r^2 phi'`. (No error channel: NaN
+    /// or infinite for a state that is not finite or so extreme that it overflows.)
     #[must_use]
     pub fn angular_momentum(&self, s: &State<T, 2>) -> T {
         s.q[0] * s.q[0] * s.qd[1]
@@ -96,7 +97,7 @@ impl<T: Real> Mechanism<T, 2> for Kepler<T> {
     ) -> Result<SVector<T, 2>, Error> {
         // The law refuses r <= 0, and so does its force.
         positive_radius(s, AT_CENTRE)?;
-        Ok(free_law_force(self, s, extra))
+        free_law_force(self, s, extra)
     }
 }
 

@@ -41,12 +41,17 @@ impl<T: Real> SpringMassDamper<T> {
     /// A `mass` (kg, > 0) on a spring of `stiffness` (N/m, >= 0) with `damping` (N s/m, >= 0).
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] naming the first parameter out of range or not finite.
+    /// [`Error::InvalidParameter`] naming the first parameter out of range or not finite, or
+    /// `mass` when `1 / m` overflows.
     pub fn new(mass: T, stiffness: T, damping: T) -> Result<Self, Error> {
+        let mass = validate::positive("mass", mass)?;
+        let stiffness = validate::non_negative("stiffness", stiffness)?;
+        let damping = validate::non_negative("damping", damping)?;
+        validate::divisor(mass, &[("mass", mass, 1)])?;
         Ok(Self {
-            mass: validate::positive("mass", mass)?,
-            stiffness: validate::non_negative("stiffness", stiffness)?,
-            damping: validate::non_negative("damping", damping)?,
+            mass,
+            stiffness,
+            damping,
         })
     }
     /// Mass, kg.
@@ -90,7 +95,7 @@ impl<T: Real> Mechanism<T, 1> for SpringMassDamper<T> {
         s: &State<T, 1>,
         extra: &F,
     ) -> Result<SVector<T, 1>, Error> {
-        Ok(free_law_force(self, s, extra))
+        free_law_force(self, s, extra)
     }
 }
 

@@ -106,7 +106,7 @@ where
                 reason: "steps no lanes",
             })??;
         for (i, (s, (m, _))) in alone.iter_mut().zip(&built).enumerate() {
-            *s = integrator.clone().step(m, s, dt)?;
+            *s = integrator.clone().run_step(m, s, dt)?;
             let lane = (side.t.0[i], side.q.map(|x| x.0[i]), side.qd.map(|x| x.0[i]));
             assert!(
                 lane.0 == s.t && lane.1 == s.q && lane.2 == s.qd,

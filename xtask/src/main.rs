@@ -22,6 +22,8 @@
 //!   ones under `derive/generated/` and checks that bad specs are refused.
 //! - `mutants`: mutation testing of the numerical core with `cargo-mutants`, a report per file
 //!   under `target/mutants/` (hours; not part of `ci`).
+//! - `fuzz [CALLS] [--seed S]`: the hostile-input campaign (`tests/tests/hostile`) in release,
+//!   10^7 calls by default (its 10^5-call run is part of `test` and `ci`).
 //! - `ci`: format check, clippy with `-D warnings`, the library crates' docs (warnings denied)
 //!   and packages, test, `derive --check`, cross, qemu.
 
@@ -29,6 +31,7 @@ mod cmd;
 mod cross;
 mod demo;
 mod derive;
+mod fuzz;
 mod mutants;
 mod qemu;
 mod trig_fit;
@@ -46,11 +49,12 @@ fn main() -> ExitCode {
         "qemu" => qemu::run(),
         "mutants" => mutants::run(&std::env::args().skip(2).collect::<Vec<_>>()),
         "derive" => derive::run(&std::env::args().skip(2).collect::<Vec<_>>()),
+        "fuzz" => fuzz::run(&std::env::args().skip(2).collect::<Vec<_>>()),
         "ci" => ci(),
         "trig-fit" => trig_fit::run(),
         _ => {
             eprintln!(
-                "usage: cargo xtask <demo | test | cross | bench | qemu | derive | mutants | trig-fit | ci>"
+                "usage: cargo xtask <demo | test | cross | bench | qemu | derive | mutants | fuzz | trig-fit | ci>"
             );
             return ExitCode::from(2);
         }

@@ -101,7 +101,7 @@ impl<T: Real, const N: usize, M: Mechanism<T, N>, I: Integrator<T, N, M>> Slot<T
     /// then untouched and the error kept).
     #[inline(always)]
     fn advance(&mut self, dt: T, t: T) -> bool {
-        match self.integrator.step(&self.mechanism, &self.current, dt) {
+        match self.integrator.run_step(&self.mechanism, &self.current, dt) {
             Ok(mut next) => {
                 next.t = t;
                 self.previous = self.current;
