@@ -405,7 +405,12 @@ fn mutants_command(area: &Area, out: &Path, o: &Options, list: bool) -> Command 
     if o.iterate {
         c.arg("--iterate");
     }
-    c.arg("--").args(area.tests);
+    // As cargo arguments, not test arguments: cargo-mutants' build phase then builds only
+    // the area's test binaries (with `-- --test ..` it built all sixty of lagrange-tests for
+    // every mutant, most of a mutant's time).
+    for a in area.tests {
+        c.arg(format!("--cargo-arg={a}"));
+    }
     c
 }
 
