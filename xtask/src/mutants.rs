@@ -124,6 +124,8 @@ const AREAS: [Area; 9] = [
         only: None,
         tests: &[
             "--test",
+            "impact_law",
+            "--test",
             "bouncing_ball",
             "--test",
             "double_pendulum_floor",

@@ -1,0 +1,162 @@
+//! The impact law ([`Impacts::impact`]) on a body whose two contacts are coupled through its
+//! mass matrix: which rows take an impulse, which let go, which rest afterwards, and the
+//! friction impulse of a body heavier than one kilogram. Each case has a closed-form answer,
+//! worked out in its docs; the bounds are rounding (a few ulps of velocities of order 1).
+
+use lagrange_core::constraints::contact::Impacts;
+use lagrange_core::nalgebra::{Matrix2, SMatrix, SVector, Vector2};
+use lagrange_core::{Constraints, Error, EulerLagrange, Lagrangian, Scalar, State};
+use lagrange_integrators::{ContactModel, Contacts};
+
+/// Rounding of velocities of order 1 after a 2x2 solve.
+const ROUNDING: f64 = 1e-14;
+
+/// A point in a corner with the mass matrix `[[m, c], [c, m]]` (a sheared body: a push along
+/// one coordinate moves the other), no forces.
+struct Sheared {
+    m: f64,
+    c: f64,
+}
+
+impl Lagrangian<f64, 2> for Sheared {
+    fn kinetic<S: Scalar<Real = f64>>(&self, _t: S, _q: &SVector<S, 2>, v: &SVector<S, 2>) -> S {
+        let (m, c) = (S::from_f64(self.m), S::from_f64(self.c));
+        (m * (v[0] * v[0] + v[1] * v[1]) + c * v[0] * v[1] * S::from_f64(2.0)) * S::from_f64(0.5)
+    }
+    fn potential<S: Scalar<Real = f64>>(&self, _t: S, _q: &SVector<S, 2>) -> S {
+        S::from_f64(0.0)
+    }
+}
+
+/// The walls `q0 >= 0` (row 0, sliding along q1) and `q1 >= 0` (row 1, sliding along q0).
+struct Corner;
+
+impl Constraints<f64, 2, 2> for Corner {
+    fn position_residual(&self, q: &Vector2<f64>) -> Vector2<f64> {
+        *q
+    }
+    fn jacobian(&self, _q: &Vector2<f64>) -> SMatrix<f64, 2, 2> {
+        Matrix2::identity()
+    }
+    fn velocity_product(&self, _q: &Vector2<f64>, _qd: &Vector2<f64>) -> Vector2<f64> {
+        Vector2::zeros()
+    }
+}
+
+impl Contacts<f64, 2, 2> for Corner {
+    fn tangent_jacobian(&self, _q: &Vector2<f64>) -> Option<SMatrix<f64, 2, 2>> {
+        Some(Matrix2::new(0.0, 1.0, 1.0, 0.0))
+    }
+}
+
+/// The impact at the corner from `qd`, with `struck` and `resting` rows: the velocities after
+/// and the resting rows after.
+fn impact(
+    body: Sheared,
+    model: &ContactModel<f64>,
+    qd: [f64; 2],
+    struck: [bool; 2],
+    mut resting: [bool; 2],
+) -> Result<(Vector2<f64>, [bool; 2]), Error> {
+    let body = EulerLagrange::new(body);
+    let s = State::new(0.0, [0.0, 0.0], qd);
+    let (after, _) =
+        Impacts::new(&Corner, model, [false; 2]).impact(&body, &s, struck, &mut resting)?;
+    let gain = body.kinetic_energy(&after) - body.kinetic_energy(&s);
+    assert!(gain <= ROUNDING, "the impact added {gain:e} J");
+    Ok((after.qd, resting))
+}
+
+fn plastic() -> Result<ContactModel<f64>, Error> {
+    ContactModel::new(0.0, 1e-3, 1e-10)
+}
+
+/// Row 1 strikes at 1 m/s while row 0 rests. With `M = [[2, -1], [-1, 2]]` both rows held
+/// would need `p = M (0, 1) = (-1, 2)`: row 0 would pull, so it lets go and row 1 alone
+/// stops: `p1 = 1 / (M^-1)_11 = 1.5`, `q'+ = (0, -1) + M^-1 (0, 1) 1.5 = (0.5, 0)`. The body
+/// leaves the wall of row 0, which no longer rests.
+#[test]
+fn a_resting_row_that_would_pull_lets_go() -> Result<(), Error> {
+    let body = Sheared { m: 2.0, c: -1.0 };
+    let (after, resting) = impact(body, &plastic()?, [0.0, -1.0], [false, true], [true, false])?;
+    assert!(
+        (after - Vector2::new(0.5, 0.0)).amax() < ROUNDING,
+        "{after}"
+    );
+    assert_eq!(resting, [false, true]);
+    Ok(())
+}
+
+/// With `M = [[2, 1], [1, 2]]` the resting row pushes (`p = M (0, 1) = (1, 2)`), so both stay
+/// held and the body stops. A resting row drifting into its wall at 0.01 m/s is stopped too:
+/// `w+ = 0` on every held row, `p = M (0.01, 1)`.
+#[test]
+fn held_rows_end_at_rest() -> Result<(), Error> {
+    for drift in [0.0, -0.01] {
+        let body = Sheared { m: 2.0, c: 1.0 };
+        let (after, resting) = impact(
+            body,
+            &plastic()?,
+            [drift, -1.0],
+            [false, true],
+            [true, false],
+        )?;
+        assert!(after.amax() < ROUNDING, "drift {drift}: {after}");
+        assert_eq!(resting, [true, true]);
+    }
+    Ok(())
+}
+
+/// A diagonal mass matrix: the rows do not couple. Row 1 strikes fast enough to rebound at
+/// e = 0.5; row 0 is struck at exactly zero speed (it crossed by acceleration alone) or
+/// rests already. Row 0 takes no impulse (exactly zero), comes to rest (or stays resting),
+/// and row 1 rebounds at half its speed: `q'+ = (0, 1)`.
+#[test]
+fn a_row_at_zero_speed_rests_beside_a_rebound() -> Result<(), Error> {
+    let bouncy = ContactModel::new(0.5, 1e-3, 1e-10)?;
+    for (struck, resting) in [
+        ([true, true], [false, false]),
+        ([false, true], [true, false]),
+    ] {
+        let body = Sheared { m: 1.0, c: 0.0 };
+        let (after, resting) = impact(body, &bouncy, [0.0, -2.0], struck, resting)?;
+        assert!(
+            (after - Vector2::new(0.0, 1.0)).amax() < ROUNDING,
+            "{after}"
+        );
+        assert_eq!(resting, [true, false], "struck {struck:?}");
+    }
+    Ok(())
+}
+
+/// Friction on a body of 2 kg sliding at 0.1 m/s along row 1's wall as it strikes at 1 m/s
+/// (plastic, mu = 1): the normal impulse is `2 * 1 = 2` N s, the impulse that stops the
+/// sliding `0.1 / (1/2) = 0.2` N s is within `mu * 2`, so the body stops dead.
+#[test]
+fn friction_stops_a_heavy_body_by_its_mass() -> Result<(), Error> {
+    let model = plastic()?.with_friction(1.0)?;
+    let body = Sheared { m: 2.0, c: 0.0 };
+    let (after, resting) = impact(body, &model, [0.1, -1.0], [false, true], [false, false])?;
+    assert!(after.amax() < ROUNDING, "{after}");
+    assert_eq!(resting, [false, true]);
+    Ok(())
+}
+
+/// Friction on a sheared body (`M = [[2, -1], [-1, 2]]`, `M^-1 = [[2, 1], [1, 2]] / 3`)
+/// striking row 1 at 1 m/s while sliding at 0.5 m/s, plastic, mu = 0.3. The normal impulse
+/// `1 / (2/3) = 1.5` gives `q' = (1, 0)`. The impulse that would stop the sliding,
+/// `1 / (2/3) = 1.5`, is capped at `0.3 * 1.5 = 0.45`: `q' = (1, 0) - 0.45 (2, 1) / 3 =
+/// (0.7, -0.15)`, which would push into the wall: the projection back onto the resting row
+/// adds `0.15 (1, 2) / 2`, `q'+ = (0.775, 0)`.
+#[test]
+fn friction_keeps_a_resting_row_at_rest() -> Result<(), Error> {
+    let model = plastic()?.with_friction(0.3)?;
+    let body = Sheared { m: 2.0, c: -1.0 };
+    let (after, resting) = impact(body, &model, [0.5, -1.0], [false, true], [false, false])?;
+    assert!(
+        (after - Vector2::new(0.775, 0.0)).amax() < ROUNDING,
+        "{after}"
+    );
+    assert_eq!(resting, [false, true]);
+    Ok(())
+}
