@@ -22,7 +22,14 @@ fn thrown() -> State<f64, N> {
     let mut qd = [0.0; N];
     q[1] = 1.6;
     q[2] = 0.6;
-    for (k, spread) in [(4, -1.0), (6, 1.0), (8, -0.4), (9, 0.5), (10, 0.4), (11, -0.5)] {
+    for (k, spread) in [
+        (4, -1.0),
+        (6, 1.0),
+        (8, -0.4),
+        (9, 0.5),
+        (10, 0.4),
+        (11, -0.5),
+    ] {
         q[k] = spread;
     }
     qd[0] = 2.0;
@@ -95,8 +102,20 @@ fn main() -> Result<(), Error> {
     let ragdoll = ns_per_step(Rk4, &doll, &start, DT, steps);
     let dense = ns_per_step(Rk4, &Dense(doll), &start, DT, steps);
     let with_contacts = ns_per_step(stepper(), &doll, &start, DT, (6.0 / DT) as u64);
-    let c10 = ns_per_step(Rk4, &chain10, &State::new(0.0, [0.3; 10], [0.0; 10]), DT, steps);
-    let c12 = ns_per_step(Rk4, &chain12, &State::new(0.0, [0.3; 12], [0.0; 12]), DT, steps);
+    let c10 = ns_per_step(
+        Rk4,
+        &chain10,
+        &State::new(0.0, [0.3; 10], [0.0; 10]),
+        DT,
+        steps,
+    );
+    let c12 = ns_per_step(
+        Rk4,
+        &chain12,
+        &State::new(0.0, [0.3; 12], [0.0; 12]),
+        DT,
+        steps,
+    );
     println!("\nCost per RK4 step (f64, 4 accelerations), ns:");
     println!("  ragdoll, articulated-body recursion      {ragdoll:>8.0}");
     println!("  ragdoll, mass matrix + dense Cholesky    {dense:>8.0}");

@@ -1,6 +1,8 @@
 //! [`Ragdoll`]: a planar ragdoll, a tree of ten rigid links on a free torso, whose
 //! accelerations come from the articulated-body recursion in `O(links)`.
 
+use core::cmp::Ordering;
+
 use lagrange_core::nalgebra::{SMatrix, SVector};
 use lagrange_core::{
     free_law_force, validate, Error, GeneralizedForce, Lagrangian, Mechanism, Real, Scalar, State,
@@ -251,11 +253,11 @@ fn solve3<T: Real>(m: &M3<T>, b: &V3<T>) -> Result<V3<T>, Error> {
     for i in 0..3 {
         for j in 0..=i {
             let mut sum = m[i][j];
-            for k in 0..j {
-                sum -= l[i][k] * l[j][k];
+            for (a, b) in l[i].iter().zip(&l[j]).take(j) {
+                sum -= *a * *b;
             }
             if i == j {
-                if !(sum > T::zero()) {
+                if sum.partial_cmp(&T::zero()) != Some(Ordering::Greater) {
                     return Err(Error::SingularMassMatrix { pivot: i });
                 }
                 l[i][i] = sum.sqrt();
@@ -389,9 +391,7 @@ impl<T: Real> Ragdoll<T> {
 
     /// The world position of a point fixed on a link.
     pub(crate) fn world_point(&self, q: &SVector<T, RAGDOLL_COORDINATES>, mark: Mark<T>) -> [T; 2] {
-        let [px, py] = self
-            .pose(q)
-            .point(mark.link, mark.along, mark.across);
+        let [px, py] = self.pose(q).point(mark.link, mark.along, mark.across);
         [px + q[0], py + q[1]]
     }
 
@@ -444,11 +444,7 @@ impl<T: Real> Ragdoll<T> {
 
     /// Velocities, motion subspaces and bias accelerations of every link at `state` (the
     /// first pass of both recursions), with the links' spatial inertias.
-    fn outward(
-        &self,
-        pose: &Pose<T>,
-        qd: &SVector<T, RAGDOLL_COORDINATES>,
-    ) -> Outward<T> {
+    fn outward(&self, pose: &Pose<T>, qd: &SVector<T, RAGDOLL_COORDINATES>) -> Outward<T> {
         let mut out = Outward {
             v: [[T::zero(); 3]; RAGDOLL_LINKS],
             s: [[T::zero(); 3]; RAGDOLL_LINKS],
@@ -483,9 +479,17 @@ impl<T: Real> Ragdoll<T> {
         let mut ia = out.inertia;
         let mut pa: [V3<T>; RAGDOLL_LINKS] = core::array::from_fn(|k| {
             let iv = mul(&out.inertia[k], &out.v[k]);
-            let gravity = [-self.mass[k] * g * pose.com[k][0], T::zero(), -self.mass[k] * g];
+            let gravity = [
+                -self.mass[k] * g * pose.com[k][0],
+                T::zero(),
+                -self.mass[k] * g,
+            ];
             let bias = cross_force(&out.v[k], &iv);
-            [bias[0] - gravity[0], bias[1] - gravity[1], bias[2] - gravity[2]]
+            [
+                bias[0] - gravity[0],
+                bias[1] - gravity[1],
+                bias[2] - gravity[2],
+            ]
         });
         let mut u_vec = [[T::zero(); 3]; RAGDOLL_LINKS];
         let mut inv_d = [T::zero(); RAGDOLL_LINKS];
@@ -494,7 +498,7 @@ impl<T: Real> Ragdoll<T> {
             let s = &out.s[k];
             let uk = mul(&ia[k], s);
             let d = dot(s, &uk);
-            if !(d > T::zero()) {
+            if d.partial_cmp(&T::zero()) != Some(Ordering::Greater) {
                 return Err(if d.is_finite() {
                     Error::SingularMassMatrix { pivot: k + 2 }
                 } else {

@@ -66,7 +66,7 @@ impl<T: Real> RagdollContacts<T> {
         for [lower, upper] in limits {
             validate::finite("limits", lower)?;
             validate::finite("limits", upper)?;
-            if !(lower < upper) {
+            if lower.partial_cmp(&upper) != Some(core::cmp::Ordering::Less) {
                 return Err(Error::InvalidParameter {
                     name: "limits",
                     reason: "each lower bound must be below its upper bound",
@@ -108,7 +108,11 @@ impl<T: Real> RagdollContacts<T> {
     /// # Errors
     /// As [`RagdollContacts::new`].
     pub fn adult(ragdoll: &Ragdoll<T>, floor: T) -> Result<Self, Error> {
-        Self::new(ragdoll, floor, ADULT_JOINT_LIMITS.map(|l| l.map(T::from_f64)))
+        Self::new(
+            ragdoll,
+            floor,
+            ADULT_JOINT_LIMITS.map(|l| l.map(T::from_f64)),
+        )
     }
 
     /// The floor's height, m.
@@ -189,7 +193,11 @@ impl<T: Real> Constraints<T, N, RAGDOLL_CONTACTS> for RagdollContacts<T> {
 
     /// `y_p''` at `q'' = 0`: `-sum w_k^2 r_k` over the links from the point to the torso,
     /// `r_k` the stretch of link `k` on the way; zero for the limits (linear in `q`).
-    fn velocity_product(&self, q: &SVector<T, N>, qd: &SVector<T, N>) -> SVector<T, RAGDOLL_CONTACTS> {
+    fn velocity_product(
+        &self,
+        q: &SVector<T, N>,
+        qd: &SVector<T, N>,
+    ) -> SVector<T, RAGDOLL_CONTACTS> {
         let pose = self.ragdoll.pose(q);
         let mut w = [T::zero(); RAGDOLL_LINKS];
         w[0] = qd[2];

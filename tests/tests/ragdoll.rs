@@ -82,7 +82,10 @@ fn agrees_with_its_lagrangian<T: Real>() -> Result<(), Error> {
             random_state,
         )?);
     }
-    println!("ragdoll ({}): worst relative difference {worst}", core::any::type_name::<T>());
+    println!(
+        "ragdoll ({}): worst relative difference {worst}",
+        core::any::type_name::<T>()
+    );
     Ok(())
 }
 
@@ -116,7 +119,14 @@ fn thrown<T: Real>() -> State<T, N> {
     let mut qd = [T::zero(); N];
     q[1] = T::from_f64(1.6);
     q[2] = T::from_f64(0.6);
-    for (k, spread) in [(4, -1.0), (6, 1.0), (8, -0.4), (9, 0.5), (10, 0.4), (11, -0.5)] {
+    for (k, spread) in [
+        (4, -1.0),
+        (6, 1.0),
+        (8, -0.4),
+        (9, 0.5),
+        (10, 0.4),
+        (11, -0.5),
+    ] {
         q[k] = T::from_f64(spread);
     }
     qd[0] = T::from_f64(2.0);
@@ -160,7 +170,8 @@ fn never_gains_energy_at_an_impact<T: Real>() -> Result<(), Error> {
     let mut s = thrown::<T>();
     let e0 = doll.energy(&s).to_f64();
     let dt = T::from_f64(1.0 / 240.0);
-    let (mut gain, mut deepest, mut highest) = (f64::NEG_INFINITY, f64::INFINITY, f64::NEG_INFINITY);
+    let (mut gain, mut deepest, mut highest) =
+        (f64::NEG_INFINITY, f64::INFINITY, f64::NEG_INFINITY);
     for _ in 0..(6 * 240) {
         s = stepper.step_observed(&doll, &s, dt, |impact| {
             let k0 = doll.kinetic_energy(&impact.state_before()).to_f64();

@@ -1,12 +1,13 @@
 //! `cargo xtask demo`: runs the examples of `examples/`, optimised, one after the other: the
 //! origin's pendulum with every integrator, the chaotic double pendulum's energy, your own
-//! mechanism, every standard mechanism, constraints, impacts and a game loop. Their figures go
+//! mechanism, every standard mechanism, constraints, impacts, a game loop and
+//! a ragdoll thrown onto a floor (with its cost per step beside a chain's). Their figures go
 //! to `target/lagrange-demo/`.
 
 use crate::cmd;
 
 /// The examples, in the order the demo runs them.
-const EXAMPLES: [&str; 7] = [
+const EXAMPLES: [&str; 8] = [
     "origin_pendulum",
     "double_pendulum_energy",
     "own_mechanism",
@@ -14,6 +15,7 @@ const EXAMPLES: [&str; 7] = [
     "four_bar",
     "impacts",
     "game_loop",
+    "ragdoll",
 ];
 
 /// Runs every example; reports every failure at the end.

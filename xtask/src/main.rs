@@ -18,15 +18,20 @@
 //!   checks the library's against them.
 //! - `mutants`: mutation testing of the numerical core with `cargo-mutants`, a report per file
 //!   under `target/mutants/` (hours; not part of `ci`).
+//! - `web`: the interactive page, the library compiled to WebAssembly, written to
+//!   `target/lagrange-web/` and served on 127.0.0.1 (`--no-serve`: build only; `--test`: drive
+//!   it in headless Chromium and compare its scenario's bits with the host's and QEMU's).
 //! - `ci`: format check, clippy with `-D warnings`, the library crates' docs (warnings denied)
-//!   and packages, test, cross, qemu.
+//!   and packages, test, cross, qemu, web --test.
 
+mod cdp;
 mod cmd;
 mod cross;
 mod demo;
 mod mutants;
 mod qemu;
 mod trig_fit;
+mod web;
 
 use std::process::ExitCode;
 
@@ -39,11 +44,12 @@ fn main() -> ExitCode {
         "bench" => bench(&std::env::args().skip(2).collect::<Vec<_>>()),
         "qemu" => qemu::run(),
         "mutants" => mutants::run(&std::env::args().skip(2).collect::<Vec<_>>()),
+        "web" => web::run(&std::env::args().skip(2).collect::<Vec<_>>()),
         "ci" => ci(),
         "trig-fit" => trig_fit::run(),
         _ => {
             eprintln!(
-                "usage: cargo xtask <demo | test | cross | bench | qemu | mutants | trig-fit | ci>"
+                "usage: cargo xtask <demo | test | cross | bench | qemu | web | mutants | trig-fit | ci>"
             );
             return ExitCode::from(2);
         }
@@ -165,6 +171,7 @@ fn ci() -> Result<(), String> {
         cmd::run_all(&LONG_TEST),
         cross::run(),
         qemu::run(),
+        web::run(&["--test".to_string()]),
     ]
     .into_iter()
     .filter_map(Result::err)
