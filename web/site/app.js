@@ -440,11 +440,33 @@ window.lagrangeBadInput = function badInput() {
   return JSON.stringify(results);
 };
 
+// Where point `k` of panel `p`'s main instance is on the screen (CSS pixels), for the test's
+// mouse.
+window.lagrangeScreenPoint = function screenPoint(p, k) {
+  const ui = state.panels[p];
+  const at = points(p).main[k];
+  const t = transform(p);
+  const r = ui.canvas.getBoundingClientRect();
+  return JSON.stringify([r.left + t.x(at[0]) * r.width / ui.canvas.width,
+    r.top + t.y(at[1]) * r.height / ui.canvas.height]);
+};
+
+// Chooses as a user would: `select` (an id, or panel p's integrator picker) set to `value`.
+window.lagrangeChoose = function choose(p, value) {
+  const select = p < 0 ? document.getElementById('precision') : state.panels[p].method;
+  select.value = String(value);
+  select.dispatchEvent(new Event('change'));
+  return 'ok';
+};
+
 window.lagrangeProbe = function probe() {
   return JSON.stringify({
     ready: state.ready === true,
     frames: state.frames,
     times: state.panels.map((_, p) => ex().lg_time(p)),
+    statuses: state.panels.map((ui) => ui.status),
+    double: state.double,
+    methods: state.panels.map((ui) => Number(ui.method.value)),
     scenario: state.scenario,
     nonFinite: state.nonFinite,
   });

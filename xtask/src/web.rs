@@ -316,6 +316,8 @@ fn drive(
         png.len() / 1024
     );
 
+    failures.extend(interact(browser)?);
+
     // Bad input: the library's errors shown, the instances reset, nothing non-finite drawn,
     // and the page still running.
     let bad = Json::parse(&browser.eval("window.lagrangeBadInput()")?)?;
@@ -352,6 +354,86 @@ fn drive(
         })
         .collect();
     Ok((failures, lines))
+}
+
+/// The ragdoll's panel on the page.
+const RAGDOLL_PANEL: usize = 6;
+
+/// A point of the ragdoll to grab: the top of its head.
+const HEAD_TOP: usize = 3;
+
+/// The user's part: the ragdoll, once asleep, grabbed with the mouse and thrown (it wakes);
+/// the precision switched to `f32` and an integrator picked (the page goes on). The failures.
+fn interact(browser: &mut Browser) -> Result<Vec<String>, String> {
+    let mut failures = Vec::new();
+    let status = |browser: &mut Browser| -> Result<Option<f64>, String> {
+        Ok(probe(browser)?
+            .get("statuses")
+            .items()
+            .get(RAGDOLL_PANEL)
+            .and_then(Json::num))
+    };
+    let deadline = Instant::now() + Duration::from_secs(20);
+    while status(browser)? != Some(1.0) && Instant::now() < deadline {
+        browser.idle(Duration::from_millis(250));
+    }
+    if status(browser)? == Some(1.0) {
+        let at = Json::parse(&browser.eval(&format!(
+            "window.lagrangeScreenPoint({RAGDOLL_PANEL}, {HEAD_TOP})"
+        ))?)?;
+        let (Some(x), Some(y)) = (
+            at.items().first().and_then(Json::num),
+            at.items().get(1).and_then(Json::num),
+        ) else {
+            return Err(format!("no screen point for the ragdoll's head: {at:?}"));
+        };
+        let mouse = |browser: &mut Browser, kind: &str, x: f64, y: f64| {
+            browser.call(
+                "Input.dispatchMouseEvent",
+                &format!(
+                    r#"{{"type":"{kind}","x":{x},"y":{y},"button":"left","buttons":1,"clickCount":1}}"#
+                ),
+            )
+        };
+        mouse(browser, "mousePressed", x, y)?;
+        for k in 1..=8 {
+            let k = f64::from(k);
+            mouse(browser, "mouseMoved", x + 6.0 * k, y - 10.0 * k)?;
+            browser.idle(Duration::from_millis(30));
+        }
+        mouse(browser, "mouseReleased", x + 48.0, y - 80.0)?;
+        browser.idle(Duration::from_millis(100));
+        let woken = status(browser)?;
+        println!(
+            "page: the asleep ragdoll grabbed by the head and thrown: status {woken:?} (0 awake)"
+        );
+        if woken != Some(0.0) {
+            failures.push(format!(
+                "a drag did not wake the asleep ragdoll (status {woken:?})"
+            ));
+        }
+    } else {
+        failures.push("the thrown ragdoll did not fall asleep on the page within 20 s".into());
+    }
+    browser.eval("window.lagrangeChoose(-1, 0)")?;
+    browser.eval("window.lagrangeChoose(0, 1)")?;
+    let before = probe(browser)?;
+    browser.idle(Duration::from_secs(1));
+    let after = probe(browser)?;
+    let frames = |s: &Json| s.get("frames").num().unwrap_or(0.0);
+    let switched = after.get("double") == &Json::Bool(false)
+        && after.get("methods").items().first().and_then(Json::num) == Some(1.0);
+    println!(
+        "page: switched to f32 and Stormer-Verlet for the pendulum: {}, {} frames in 1 s after",
+        if switched { "done" } else { "NOT done" },
+        frames(&after) - frames(&before)
+    );
+    if !switched || frames(&after) - frames(&before) < 5.0 {
+        failures.push(format!(
+            "switching precision or integrator failed: {after:?}"
+        ));
+    }
+    Ok(failures)
 }
 
 /// Compares the page's scenario with the host's and the firmware's; the failures.
