@@ -370,8 +370,8 @@ function drawPlot(p) {
   g.stroke();
   g.fillStyle = '#555';
   g.font = `${10 * px}px ui-monospace, monospace`;
-  g.fillText(`relative energy error, last ${PLOT_SECONDS} s: now ${s[s.length - 1][1].toExponential(2)}, ` +
-    `scale ±${span.toExponential(1)}`, 4 * px, 11 * px);
+  g.fillText(`(E - E0)/E0, last ${PLOT_SECONDS} s: ${s[s.length - 1][1].toExponential(2)}`, 4 * px, 11 * px);
+  g.fillText(`±${span.toExponential(1)}`, 4 * px, h - 4 * px);
 }
 
 function frame(now) {
