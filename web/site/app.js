@@ -35,7 +35,7 @@ window.lagrange = state;
 
 function ex() { return state.wasm.exports; }
 
-function text(len) {
+function text(len = ex().lg_text_len()) {
   const bytes = new Uint8Array(ex().memory.buffer, ex().lg_text(), len);
   return new TextDecoder().decode(bytes);
 }
@@ -117,7 +117,7 @@ function buildPanels(names) {
       samples: [], view: { ...VIEWS[p] }, status: 0 };
     state.panels.push(ui);
     method.addEventListener('change', () => {
-      if (ex().lg_set_method(p, Number(method.value)) !== 0) showError(p, text(64));
+      if (ex().lg_set_method(p, Number(method.value)) !== 0) showError(p, text());
       refreshDt(p);
     });
     reset.addEventListener('click', () => { ex().lg_reset(p); refreshDt(p); });
@@ -393,7 +393,7 @@ function frame(now) {
     drawPanel(p);
     drawPlot(p);
     ui.info.textContent = `${METHODS[Number(ui.method.value)]}, dt ${ex().lg_dt(p).toPrecision(3)} s, ` +
-      `${state.double ? 'f64' : 'f32'}`;
+      `${state.double ? 'f64' : 'f32'}${p === 1 && !state.double ? ' (twin: the next f32, 2.4e-7 rad away)' : ''}`;
     if (ui.errorUntil && now > ui.errorUntil) { ui.error.textContent = ''; ui.errorUntil = 0; }
   });
   state.frames++;
@@ -403,7 +403,7 @@ function frame(now) {
 function init(double) {
   state.double = double;
   const n = ex().lg_init(double ? 1 : 0);
-  if (n === 0) throw new Error(`the page's mechanisms did not build: ${text(256)}`);
+  if (n === 0) throw new Error(`the page's mechanisms did not build: ${text()}`);
   state.panels.forEach((ui, p) => { ui.view = { ...VIEWS[p] }; refreshDt(p); });
 }
 

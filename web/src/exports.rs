@@ -101,6 +101,12 @@ pub extern "C" fn lg_text() -> usize {
     PAGE.with_borrow(|page| page.text.as_ptr() as usize)
 }
 
+/// The length in bytes of the text at [`lg_text`].
+#[no_mangle]
+pub extern "C" fn lg_text_len() -> u32 {
+    PAGE.with_borrow(|page| u32::try_from(page.text.len()).unwrap_or(0))
+}
+
 /// Panel `panel`'s relative energy error.
 #[no_mangle]
 pub extern "C" fn lg_energy_error(panel: u32) -> f64 {

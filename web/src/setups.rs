@@ -151,6 +151,17 @@ pub fn thrown<T: Real>() -> State<T, RAGDOLL_COORDINATES> {
     State::new(T::zero(), q, qd)
 }
 
+/// The twin's first angle: 1e-9 rad beyond `th`, or in `f32`, where `th + 1e-9` rounds to
+/// `th`, the next `f32` above it (2.4e-7 rad beyond 2.2).
+pub fn twin_angle<T: Real>(th: T) -> T {
+    let twin = th + T::from_f64(1e-9);
+    if twin == th {
+        th * (T::one() + T::EPSILON)
+    } else {
+        twin
+    }
+}
+
 /// `tol_f32` in f32, `tol_f64` in f64.
 fn pick<T: Real>(tol_f32: f64, tol_f64: f64) -> T {
     T::from_f64(if T::EPSILON.to_f64() > 1e-10 {
@@ -236,7 +247,7 @@ pub fn make<T: Real>(kind: usize, method: usize) -> Result<Box<dyn Panel>, Error
             let mechanism =
                 DoublePendulum::new(T::one(), T::one(), T::one(), T::one(), T::from_f64(G))?;
             let start = State::at_rest([T::from_f64(2.2), T::from_f64(2.6)]);
-            let twin = State::at_rest([T::from_f64(2.2 + 1e-9), T::from_f64(2.6)]);
+            let twin = State::at_rest([twin_angle(T::from_f64(2.2)), T::from_f64(2.6)]);
             by_method!(method, T, 2, |i| boxed(Recipe {
                 mechanism,
                 start,

@@ -5,7 +5,7 @@
 use lagrange_cases::{scripted, STEPS};
 use lagrange_web::page::Page;
 use lagrange_web::scenario;
-use lagrange_web::setups::{make, KINDS, METHODS};
+use lagrange_web::setups::{make, twin_angle, KINDS, METHODS};
 
 /// Every panel in both precisions and every integrator: a third of a second of frames, finite points,
 /// a small energy error for the conservative ones.
@@ -77,4 +77,13 @@ fn scenario_is_the_lockstep_case() -> Result<(), lagrange_core::Error> {
     let digest = scenario::digest(&scenario::words(true)?);
     assert!(text.ends_with(&format!("digest={digest:016x}")), "{text}");
     Ok(())
+}
+
+/// The chaotic twin starts 1e-9 rad away in `f64`, one `f32` away in `f32`: never on top.
+#[test]
+fn the_twin_is_apart() {
+    assert!((twin_angle(2.2_f64) - 2.2 - 1e-9).abs() < 1e-15);
+    let twin = twin_angle(2.2_f32);
+    assert!(twin > 2.2_f32);
+    assert_eq!(twin, f32::from_bits(2.2_f32.to_bits() + 1));
 }
