@@ -114,7 +114,8 @@ function buildPanels(names) {
     const info = el('div', { className: 'info' }, box);
     const error = el('div', { className: 'error' }, box);
     const ui = { canvas, plot, method, dtRange, dtText, info, error, errorUntil: 0,
-      samples: [], view: { ...VIEWS[p] }, status: 0 };
+      samples: [], view: { ...VIEWS[p] }, status: 0,
+      cost: { ms: 0, steps: 0, since: 0, shown: '' } };
     state.panels.push(ui);
     method.addEventListener('change', () => {
       if (ex().lg_set_method(p, Number(method.value)) !== 0) showError(p, text());
@@ -380,7 +381,16 @@ function frame(now) {
   if (!state.paused) {
     holdDrag();
     state.panels.forEach((ui, p) => {
+      const before = ex().lg_time(p);
+      const start = performance.now();
       ui.status = ex().lg_advance(p, elapsed);
+      ui.cost.ms += performance.now() - start;
+      const steps = Math.round((ex().lg_time(p) - before) / ex().lg_dt(p));
+      if (steps > 0) ui.cost.steps += steps;
+      if (now - ui.cost.since > 1000) {
+        ui.cost.shown = ui.cost.steps > 0 ? `, ${(1000 * ui.cost.ms / ui.cost.steps).toFixed(1)} µs/step` : '';
+        Object.assign(ui.cost, { ms: 0, steps: 0, since: now });
+      }
       checkError(p);
       const e = ex().lg_energy_error(p);
       const tt = ex().lg_time(p);
@@ -393,7 +403,7 @@ function frame(now) {
     drawPanel(p);
     drawPlot(p);
     ui.info.textContent = `${METHODS[Number(ui.method.value)]}, dt ${ex().lg_dt(p).toPrecision(3)} s, ` +
-      `${state.double ? 'f64' : 'f32'}${p === 1 && !state.double ? ' (twin: the next f32, 2.4e-7 rad away)' : ''}`;
+      `${state.double ? 'f64' : 'f32'}${ui.cost.shown}${p === 1 && !state.double ? ' (twin: the next f32, 2.4e-7 rad away)' : ''}`;
     if (ui.errorUntil && now > ui.errorUntil) { ui.error.textContent = ''; ui.errorUntil = 0; }
   });
   state.frames++;

@@ -356,7 +356,7 @@ pub fn make<T: Real>(kind: usize, method: usize) -> Result<Box<dyn Panel>, Error
         6 => {
             let mechanism = Ragdoll::new(RagdollBody::adult())?;
             let model =
-                ContactModel::new(T::from_f64(0.3), T::from_f64(0.3), pick::<T>(1e-4, 1e-7))?
+                ContactModel::new(T::from_f64(0.3), T::from_f64(0.3), pick::<T>(1e-4, 1e-5))?
                     .with_friction(T::from_f64(0.8))?;
             let projection = Projection::new(pick::<T>(1e-4, 1e-9), 8)?;
             let contacts = RagdollContacts::adult(&mechanism, T::zero())?;
@@ -366,7 +366,7 @@ pub fn make<T: Real>(kind: usize, method: usize) -> Result<Box<dyn Panel>, Error
                 twin: None,
                 integrator: ContactStepper::new(i, contacts, model, projection),
                 sleep: sleeps(1e-3, 1e-2)?,
-                dt: 1.0 / 240.0,
+                dt: 1.0 / 120.0,
                 energy_scale: 70.0 * G,
                 points: ragdoll_points,
                 exact: None,

@@ -306,17 +306,7 @@ fn drive(
     if stuck > 0 || times(&second).is_empty() {
         failures.push(format!("{stuck} scenes did not advance in 2 s"));
     }
-    let shot = browser.call("Page.captureScreenshot", r#"{"format":"png"}"#)?;
-    let png = base64(shot.get("data").str().ok_or("no screenshot data")?)?;
-    let path = site.join("screenshot.png");
-    std::fs::write(&path, &png).map_err(|e| format!("{}: {e}", path.display()))?;
-    println!(
-        "page: screenshot {} ({} KiB)",
-        path.display(),
-        png.len() / 1024
-    );
-
-    failures.extend(interact(browser)?);
+    failures.extend(interact(browser, site)?);
 
     // Bad input: the library's errors shown, the instances reset, nothing non-finite drawn,
     // and the page still running.
@@ -356,6 +346,20 @@ fn drive(
     Ok((failures, lines))
 }
 
+/// Saves the page's screenshot to `site/screenshot.png`.
+fn screenshot(browser: &mut Browser, site: &Path) -> Result<(), String> {
+    let shot = browser.call("Page.captureScreenshot", r#"{"format":"png"}"#)?;
+    let png = base64(shot.get("data").str().ok_or("no screenshot data")?)?;
+    let path = site.join("screenshot.png");
+    std::fs::write(&path, &png).map_err(|e| format!("{}: {e}", path.display()))?;
+    println!(
+        "page: screenshot {} ({} KiB)",
+        path.display(),
+        png.len() / 1024
+    );
+    Ok(())
+}
+
 /// The ragdoll's panel on the page.
 const RAGDOLL_PANEL: usize = 6;
 
@@ -364,7 +368,7 @@ const HEAD_TOP: usize = 3;
 
 /// The user's part: the ragdoll, once asleep, grabbed with the mouse and thrown (it wakes);
 /// the precision switched to `f32` and an integrator picked (the page goes on). The failures.
-fn interact(browser: &mut Browser) -> Result<Vec<String>, String> {
+fn interact(browser: &mut Browser, site: &Path) -> Result<Vec<String>, String> {
     let mut failures = Vec::new();
     let status = |browser: &mut Browser| -> Result<Option<f64>, String> {
         Ok(probe(browser)?
@@ -377,6 +381,8 @@ fn interact(browser: &mut Browser) -> Result<Vec<String>, String> {
     while status(browser)? != Some(1.0) && Instant::now() < deadline {
         browser.idle(Duration::from_millis(250));
     }
+    // The picture: everything moving but the ragdoll, asleep on the floor (drawn grey).
+    screenshot(browser, site)?;
     if status(browser)? == Some(1.0) {
         let at = Json::parse(&browser.eval(&format!(
             "window.lagrangeScreenPoint({RAGDOLL_PANEL}, {HEAD_TOP})"
