@@ -387,7 +387,7 @@ function frame(now) {
       ui.cost.ms += performance.now() - start;
       const steps = Math.round((ex().lg_time(p) - before) / ex().lg_dt(p));
       if (steps > 0) ui.cost.steps += steps;
-      if (now - ui.cost.since > 1000) {
+      if (now - ui.cost.since > 5000) {
         ui.cost.shown = ui.cost.steps > 0 ? `, ${(1000 * ui.cost.ms / ui.cost.steps).toFixed(1)} µs/step` : '';
         Object.assign(ui.cost, { ms: 0, steps: 0, since: now });
       }
