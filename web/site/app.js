@@ -475,6 +475,7 @@ window.lagrangeProbe = function probe() {
     frames: state.frames,
     times: state.panels.map((_, p) => ex().lg_time(p)),
     statuses: state.panels.map((ui) => ui.status),
+    cartX: points(4).main[0]?.[0] ?? null,
     double: state.double,
     methods: state.panels.map((ui) => Number(ui.method.value)),
     scenario: state.scenario,

@@ -421,6 +421,29 @@ fn interact(browser: &mut Browser, site: &Path) -> Result<Vec<String>, String> {
     } else {
         failures.push("the thrown ragdoll did not fall asleep on the page within 20 s".into());
     }
+    // The cart pushed right with the arrow key for half a second.
+    let cart = |browser: &mut Browser| -> Result<f64, String> {
+        Ok(probe(browser)?.get("cartX").num().unwrap_or(f64::NAN))
+    };
+    let key = |browser: &mut Browser, kind: &str| {
+        browser.call(
+            "Input.dispatchKeyEvent",
+            &format!(
+                r#"{{"type":"{kind}","key":"ArrowRight","code":"ArrowRight","windowsVirtualKeyCode":39}}"#
+            ),
+        )
+    };
+    let from = cart(browser)?;
+    key(browser, "rawKeyDown")?;
+    browser.idle(Duration::from_millis(500));
+    key(browser, "keyUp")?;
+    let to = cart(browser)?;
+    println!("page: the arrow key pushed the cart from x = {from:.3} m to {to:.3} m");
+    if to.is_nan() || from.is_nan() || to - from < 0.2 {
+        failures.push(format!(
+            "the arrow key did not push the cart: x {from} -> {to}"
+        ));
+    }
     browser.eval("window.lagrangeChoose(-1, 0)")?;
     browser.eval("window.lagrangeChoose(0, 1)")?;
     let before = probe(browser)?;
