@@ -516,3 +516,41 @@ impl Browser {
         let _ = self.child.wait();
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::{base64, quote, Json};
+
+    #[test]
+    fn json_reads_what_chromium_writes() -> Result<(), String> {
+        let text = r#"{"id":7,"result":{"result":{"type":"string","value":"a\"b\\c\u00e9\ud83d\ude00\n"}},
+            "list":[1,-2.5e3,true,false,null,{}],"sessionId":"S"}"#;
+        let v = Json::parse(text)?;
+        assert_eq!(v.get("id").num(), Some(7.0));
+        assert_eq!(
+            v.get("result").get("result").get("value").str(),
+            Some("a\"b\\c\u{e9}\u{1f600}\n")
+        );
+        let list = v.get("list").items();
+        assert_eq!(list.len(), 6);
+        assert_eq!(list[1].num(), Some(-2500.0));
+        assert_eq!(list[2], Json::Bool(true));
+        assert_eq!(v.get("missing"), &Json::Null);
+        assert!(Json::parse("{\"a\":1} x").is_err());
+        assert!(Json::parse("[1,").is_err());
+        let quoted = quote("say \"hi\"\n\\");
+        assert_eq!(Json::parse(&quoted)?.str(), Some("say \"hi\"\n\\"));
+        Ok(())
+    }
+
+    #[test]
+    fn base64_decodes() -> Result<(), String> {
+        assert_eq!(base64("")?, b"");
+        assert_eq!(base64("Zg==")?, b"f");
+        assert_eq!(base64("Zm8=")?, b"fo");
+        assert_eq!(base64("Zm9v")?, b"foo");
+        assert_eq!(base64("iVBORw0KGgo=")?, b"\x89PNG\r\n\x1a\n");
+        assert!(base64("Zm9v!").is_err());
+        Ok(())
+    }
+}
