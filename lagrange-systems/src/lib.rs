@@ -20,6 +20,7 @@
 //! | [`Acrobot`] | `[th1, th2]`, th2 relative to link 1 | m1, m2, l1, l2, lc1, lc2, i1, i2, gravity; input torque |
 //! | [`SwingingAtwood`] | `[r, th]` | big_mass, small_mass, gravity |
 //! | [`Kepler`] | `[r, phi]` | mu |
+//! | [`Ragdoll`] | `[x, y, th, 9 joints]`: torso centre and angle, joints relative | [`RagdollBody`]: ten segments, shoulder and hip widths, gravity, joint damping (`O(links)` accelerations; contacts: [`RagdollContacts`]) |
 //!
 //! Constrained mechanisms (Lagrange multipliers, see
 //! [`lagrange_core::constraints`]): each also implements
@@ -58,6 +59,8 @@ mod falling_particle;
 mod four_bar_linkage;
 mod kepler;
 mod n_link_pendulum;
+mod ragdoll;
+mod ragdoll_contacts;
 mod rolling_disk;
 mod simple_pendulum;
 mod small_solve;
@@ -78,6 +81,10 @@ pub use cart_pole::CartPole;
 pub use elastic_pendulum::ElasticPendulum;
 pub use kepler::Kepler;
 pub use n_link_pendulum::NLinkPendulum;
+pub use ragdoll::{Ragdoll, RagdollBody, Segment, RAGDOLL_COORDINATES, RAGDOLL_LINKS};
+pub use ragdoll_contacts::{
+    RagdollContacts, ADULT_JOINT_LIMITS, RAGDOLL_CONTACTS, RAGDOLL_FLOOR_POINTS,
+};
 pub use spherical_pendulum::SphericalPendulum;
 pub use spring_mass_damper::SpringMassDamper;
 pub use swinging_atwood::SwingingAtwood;

@@ -78,6 +78,12 @@ pub fn run() -> Result<(), String> {
 /// Without a working `rustup` (a toolchain from a distribution, say) it warns and goes on:
 /// the builds then show whether the target is there.
 pub(crate) fn ensure_target() -> Result<(), String> {
+    ensure_rustup_target(TARGET)
+}
+
+/// Runs `rustup target add TARGET` when `rustup target list --installed` lacks it (a warning
+/// only without a working `rustup`).
+pub(crate) fn ensure_rustup_target(target: &str) -> Result<(), String> {
     let mut list = Command::new("rustup");
     list.args(["target", "list", "--installed"]);
     println!("$ {}", shown(&list));
@@ -85,20 +91,20 @@ pub(crate) fn ensure_target() -> Result<(), String> {
         Ok(out) if out.status.success() => String::from_utf8_lossy(&out.stdout).into_owned(),
         Ok(out) => {
             println!(
-                "warning: `rustup target list` failed ({}); not installing {TARGET}",
+                "warning: `rustup target list` failed ({}); not installing {target}",
                 out.status
             );
             return Ok(());
         }
         Err(e) => {
-            println!("warning: could not run rustup ({e}); not installing {TARGET}");
+            println!("warning: could not run rustup ({e}); not installing {target}");
             return Ok(());
         }
     };
-    if installed.lines().any(|line| line.trim() == TARGET) {
+    if installed.lines().any(|line| line.trim() == target) {
         Ok(())
     } else {
-        cmd::run(Command::new("rustup").args(["target", "add", TARGET]))
+        cmd::run(Command::new("rustup").args(["target", "add", target]))
     }
 }
 

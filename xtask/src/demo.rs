@@ -1,7 +1,8 @@
 //! `cargo xtask demo`: runs the examples of `examples/`, optimised, one after the other: the
 //! origin's pendulum with every integrator, the chaotic double pendulum's energy, your own
 //! mechanism, every standard mechanism, a mechanism SymPy derived (`cargo xtask derive`),
-//! constraints, impacts and a game loop. Their figures go to `target/lagrange-demo/`.
+//! constraints, impacts, a game loop and a ragdoll thrown onto a floor (with its cost per step
+//! beside a chain's). Their figures go to `target/lagrange-demo/`.
 
 use crate::cmd;
 
@@ -15,6 +16,7 @@ const EXAMPLES: [&str; 8] = [
     "four_bar",
     "impacts",
     "game_loop",
+    "ragdoll",
 ];
 
 /// Runs every example; reports every failure at the end.

@@ -24,9 +24,13 @@
 //!   under `target/mutants/` (hours; not part of `ci`).
 //! - `fuzz [CALLS] [--seed S]`: the hostile-input campaign (`tests/tests/hostile`) in release,
 //!   10^7 calls by default (its 10^5-call run is part of `test` and `ci`).
+//! - `web`: the interactive page, the library compiled to WebAssembly, written to
+//!   `target/lagrange-web/` and served on 127.0.0.1 (`--no-serve`: build only; `--test`: drive
+//!   it in headless Chromium and compare its scenario's bits with the host's and QEMU's).
 //! - `ci`: format check, clippy with `-D warnings`, the library crates' docs (warnings denied)
-//!   and packages, test, `derive --check`, cross, qemu.
+//!   and packages, test, `derive --check`, cross, qemu, web --test.
 
+mod cdp;
 mod cmd;
 mod cross;
 mod demo;
@@ -36,6 +40,7 @@ mod mutants;
 mod qemu;
 mod trig_fit;
 mod venv;
+mod web;
 
 use std::process::ExitCode;
 
@@ -50,11 +55,12 @@ fn main() -> ExitCode {
         "mutants" => mutants::run(&std::env::args().skip(2).collect::<Vec<_>>()),
         "derive" => derive::run(&std::env::args().skip(2).collect::<Vec<_>>()),
         "fuzz" => fuzz::run(&std::env::args().skip(2).collect::<Vec<_>>()),
+        "web" => web::run(&std::env::args().skip(2).collect::<Vec<_>>()),
         "ci" => ci(),
         "trig-fit" => trig_fit::run(),
         _ => {
             eprintln!(
-                "usage: cargo xtask <demo | test | cross | bench | qemu | derive | mutants | fuzz | trig-fit | ci>"
+                "usage: cargo xtask <demo | test | cross | bench | qemu | derive | web | mutants | fuzz | trig-fit | ci>"
             );
             return ExitCode::from(2);
         }
@@ -177,6 +183,7 @@ fn ci() -> Result<(), String> {
         derive::check(),
         cross::run(),
         qemu::run(),
+        web::run(&["--test".to_string()]),
     ]
     .into_iter()
     .filter_map(Result::err)

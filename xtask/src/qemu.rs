@@ -137,8 +137,39 @@ pub fn run() -> Result<(), String> {
     }
 }
 
+/// The final-state words the firmware reports under QEMU for every lockstep case, by case
+/// id (`None`: the case returned an error): the lockstep image built (a no-op when `qemu`
+/// built it already), run and its log decoded. For `cargo xtask web --test`.
+pub fn lockstep_states() -> Result<BTreeMap<usize, Option<Vec<u64>>>, String> {
+    let tools = [cross::ensure_target(), ensure_qemu(), ensure_defmt_print()];
+    tools.into_iter().collect::<Result<Vec<()>, String>>()?;
+    let decoder = defmt_print()?;
+    let elf = build(&["--bin", "lockstep"])?.join("lockstep");
+    let log = decode(&elf, &decoder)?;
+    if !log.done {
+        return Err("the firmware log ends before `done`".into());
+    }
+    Ok(log.states)
+}
+
+/// Runs the lockstep image under QEMU and decodes and parses its log.
+fn decode(elf: &Path, decoder: &Path) -> Result<Log, String> {
+    let raw = run_in_qemu(elf)?;
+    let (status, decoded) = run_captured(
+        Command::new(decoder)
+            .arg("-e")
+            .arg(elf)
+            .args(["--log-format", "{s}", "stdin"]),
+        raw,
+    )?;
+    if !status.success() {
+        return Err(format!("{DEFMT_PRINT} failed ({status})"));
+    }
+    parse_log(&String::from_utf8_lossy(&decoded))
+}
+
 /// Runs `program --version`-like `args` quietly; `true` when it starts and succeeds.
-fn works(program: &Path, args: &[&str]) -> bool {
+pub(crate) fn works(program: &Path, args: &[&str]) -> bool {
     Command::new(program)
         .args(args)
         .stdout(Stdio::null())
@@ -436,19 +467,7 @@ fn instructions_per_tick(calibration: Option<(u64, u64)>) -> Result<u64, String>
 /// Runs the lockstep image, decodes its log, compares with the host and prints the table;
 /// the list of failed checks.
 fn lockstep(elf: &Path, decoder: &Path) -> Result<Vec<String>, String> {
-    let raw = run_in_qemu(elf)?;
-    let (status, decoded) = run_captured(
-        Command::new(decoder)
-            .arg("-e")
-            .arg(elf)
-            .args(["--log-format", "{s}", "stdin"]),
-        raw,
-    )?;
-    if !status.success() {
-        return Err(format!("{DEFMT_PRINT} failed ({status})"));
-    }
-    let text = String::from_utf8_lossy(&decoded);
-    let log = parse_log(&text)?;
+    let log = decode(elf, decoder)?;
     let mut failures = Vec::new();
     if log.header != Some((CASES.len(), STEPS)) {
         failures.push(format!(

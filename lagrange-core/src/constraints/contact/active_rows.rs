@@ -99,15 +99,19 @@ impl<'a, T: Real, const C: usize, M, K> ActiveRows<'a, T, C, M, K> {
                     solved = self.solve_rows(state, &(Borrowed(extra), friction), &active)?;
                 }
             }
-            let mut dropped = false;
-            for (i, on) in active.iter_mut().enumerate() {
-                if *on && self.unilateral[i] && solved.multipliers[i] < T::zero() {
-                    *on = false;
-                    dropped = true;
+            // The row that pulls hardest lets go, alone, and the rest is solved again: rows
+            // that pulled only because of it stay (dropping every pulling row at once lets
+            // many resting contacts, a ragdoll's, go and strike again at once).
+            let mut pulling: Option<(usize, T)> = None;
+            for (i, on) in active.iter().enumerate() {
+                let pulls = *on && self.unilateral[i] && solved.multipliers[i] < T::zero();
+                if pulls && pulling.is_none_or(|(_, m)| solved.multipliers[i] < m) {
+                    pulling = Some((i, solved.multipliers[i]));
                 }
             }
-            if !dropped {
-                return Ok((solved, active));
+            match pulling {
+                Some((i, _)) => active[i] = false,
+                None => return Ok((solved, active)),
             }
         }
     }

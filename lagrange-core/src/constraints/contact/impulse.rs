@@ -89,7 +89,10 @@ impl<'a, T: Real, const C: usize, K> Impacts<'a, T, C, K> {
     /// A unilateral row whose impulse comes out negative (it would pull) leaves `A` (and the
     /// resting set) and the rest is solved again. A struck row that is not approaching (it
     /// crossed within the time tolerance by acceleration alone, so `w` is at most
-    /// `|g''| time_tolerance`) comes to rest without an impulse.
+    /// `|g''| time_tolerance`; or it creeps in at below `rest_speed / 1000`) comes to rest
+    /// without an impulse, and an event of such
+    /// rows alone changes no velocity and releases no resting contact (many contacts at
+    /// rest, a ragdoll's, otherwise evict each other on the sign of rounding noise).
     ///
     /// One coefficient for every row of an event keeps the energy law exact: the held rows have
     /// `w = 0`, so the jump takes from the kinetic energy exactly `(1 - e_event^2)` times the
@@ -117,7 +120,13 @@ impl<'a, T: Real, const C: usize, K> Impacts<'a, T, C, K> {
     {
         let e = self.model.restitution();
         let w = self.contacts.jacobian(&state.q) * state.qd;
-        let approaching: [bool; C] = core::array::from_fn(|i| struck[i] && w[i] < T::zero());
+        // Approach speeds a thousand times below the resting threshold (a contact reached by
+        // acceleration alone, or by the creep of a body settling on many contacts) are no
+        // approach: the contact comes to rest, and the projection at the end of the step
+        // takes the creep out. Solving impulses for them only divides noise, whose sign would
+        // evict resting contacts at random, event after event.
+        let noise = self.model.rest_speed() * T::from_f64(1e-3);
+        let approaching: [bool; C] = core::array::from_fn(|i| struck[i] && w[i] < -noise);
         let elastic = (0..C).any(|i| approaching[i] && -e * w[i] >= self.model.rest_speed());
         let e_event = if elastic { e } else { T::zero() };
         let active: [bool; C] =
@@ -126,7 +135,16 @@ impl<'a, T: Real, const C: usize, K> Impacts<'a, T, C, K> {
             velocity: mut after,
             impulses,
             kept,
-        } = self.jump(mechanism, state, active, &approaching, e_event)?;
+        } = if approaching.iter().any(|&a| a) {
+            self.jump(mechanism, state, active, &approaching, e_event)?
+        } else {
+            // Only contacts that settle: no impulse, nothing released.
+            Jump {
+                velocity: state.qd,
+                impulses: SVector::zeros(),
+                kept: active,
+            }
+        };
         for i in 0..C {
             let settles = struck[i] && !approaching[i];
             let plastic = !elastic && approaching[i];
@@ -186,14 +204,19 @@ impl<'a, T: Real, const C: usize, K> Impacts<'a, T, C, K> {
                 }
             });
             let impulses = schur.multipliers(&change);
-            let mut pulled = false;
+            // The row that pulls hardest leaves, alone: dropping every pulling row at once
+            // also drops rows that only pulled because of it (with many contacts, a
+            // ragdoll's, that evicts most of the resting set at every event).
+            let mut pulled: Option<(usize, T)> = None;
             for i in 0..C {
-                if active[i] && !self.bilateral[i] && impulses[i] < T::zero() {
-                    active[i] = false;
-                    pulled = true;
+                let pulls = active[i] && !self.bilateral[i] && impulses[i] < T::zero();
+                if pulls && pulled.is_none_or(|(_, p)| impulses[i] < p) {
+                    pulled = Some((i, impulses[i]));
                 }
             }
-            if !pulled {
+            if let Some((i, _)) = pulled {
+                active[i] = false;
+            } else {
                 return Ok(Jump {
                     velocity: state.qd + schur.response(&impulses),
                     impulses,

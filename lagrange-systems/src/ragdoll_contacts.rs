@@ -1,0 +1,239 @@
+//! [`RagdollContacts`]: a [`Ragdoll`]'s contacts with a floor (head, shoulders, hips,
+//! elbows, hands, knees, feet) and its joint limits, for a `ContactStepper`.
+
+use lagrange_core::constraints::contact::Contacts;
+use lagrange_core::nalgebra::{SMatrix, SVector};
+use lagrange_core::{validate, Constraints, Error, Real};
+
+use crate::ragdoll::{Mark, PARENT, RAGDOLL_COORDINATES as N, RAGDOLL_LINKS};
+use crate::Ragdoll;
+
+/// Points of a [`Ragdoll`] that touch the floor.
+pub const RAGDOLL_FLOOR_POINTS: usize = 13;
+
+/// Rows of [`RagdollContacts`]: the floor points, then a lower and an upper limit per joint.
+pub const RAGDOLL_CONTACTS: usize = RAGDOLL_FLOOR_POINTS + 2 * (RAGDOLL_LINKS - 1);
+
+/// An adult's joint ranges, rad, relative to the parent link (see [`Ragdoll`]): neck, left
+/// shoulder, left elbow, right shoulder, right elbow, left hip, left knee, right hip, right
+/// knee. The left limbs open towards negative angles, the right ones towards positive.
+pub const ADULT_JOINT_LIMITS: [[f64; 2]; RAGDOLL_LINKS - 1] = [
+    [-0.7, 0.7],
+    [-3.0, 0.4],
+    [-0.05, 2.6],
+    [-0.4, 3.0],
+    [-2.6, 0.05],
+    [-1.6, 0.3],
+    [-0.05, 2.4],
+    [-0.3, 1.6],
+    [-2.4, 0.05],
+];
+
+/// A [`Ragdoll`]'s unilateral contacts, [`RAGDOLL_CONTACTS`] rows:
+///
+/// ```text
+/// rows 0..13   floor: y_p - floor >= 0 for the top of the head, the shoulders, the hips,
+///              the elbows, the hands (finger tips), the knees and the feet (soles), in
+///              that order, left before right
+/// rows 13..31  joint k (1..9, coordinate q[k + 2]): q - lower >= 0, upper - q >= 0
+/// ```
+///
+/// The Jacobian and the velocity-product term are in closed form (a point on link `k` moves
+/// with the torso and with every joint between the two: `dp/dq_j = e_z x (p - o_j)`), and
+/// the floor rows give their horizontal Jacobian as the tangent, for Coulomb friction.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct RagdollContacts<T> {
+    ragdoll: Ragdoll<T>,
+    floor: T,
+    limits: [[T; 2]; RAGDOLL_LINKS - 1],
+    points: [Mark<T>; RAGDOLL_FLOOR_POINTS],
+}
+
+impl<T: Real> RagdollContacts<T> {
+    /// The contacts of `ragdoll` with a floor at height `floor` (m) and its joints held in
+    /// `limits` (rad, `[lower, upper]` per joint, in the order of [`ADULT_JOINT_LIMITS`]).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] `floor` when not finite, `limits` when a bound is not
+    /// finite or a lower bound is not below its upper one.
+    pub fn new(
+        ragdoll: &Ragdoll<T>,
+        floor: T,
+        limits: [[T; 2]; RAGDOLL_LINKS - 1],
+    ) -> Result<Self, Error> {
+        let floor = validate::finite("floor", floor)?;
+        for [lower, upper] in limits {
+            validate::finite("limits", lower)?;
+            validate::finite("limits", upper)?;
+            if lower.partial_cmp(&upper) != Some(core::cmp::Ordering::Less) {
+                return Err(Error::InvalidParameter {
+                    name: "limits",
+                    reason: "each lower bound must be below its upper bound",
+                });
+            }
+        }
+        let joints = ragdoll.joints();
+        let lengths = ragdoll.lengths();
+        let end = |link: usize| Mark {
+            link,
+            along: lengths[link],
+            across: T::zero(),
+        };
+        let points = [
+            end(1),
+            joints[2],
+            joints[4],
+            joints[6],
+            joints[8],
+            end(2),
+            end(4),
+            end(3),
+            end(5),
+            end(6),
+            end(8),
+            end(7),
+            end(9),
+        ];
+        Ok(Self {
+            ragdoll: *ragdoll,
+            floor,
+            limits,
+            points,
+        })
+    }
+
+    /// [`ADULT_JOINT_LIMITS`] and a floor at height `floor`.
+    ///
+    /// # Errors
+    /// As [`RagdollContacts::new`].
+    pub fn adult(ragdoll: &Ragdoll<T>, floor: T) -> Result<Self, Error> {
+        Self::new(
+            ragdoll,
+            floor,
+            ADULT_JOINT_LIMITS.map(|l| l.map(T::from_f64)),
+        )
+    }
+
+    /// The floor's height, m.
+    #[must_use]
+    pub fn floor(&self) -> T {
+        self.floor
+    }
+
+    /// The joint limits, rad.
+    #[must_use]
+    pub fn limits(&self) -> &[[T; 2]; RAGDOLL_LINKS - 1] {
+        &self.limits
+    }
+
+    /// The world positions of the floor points at `q`, m, in the order of the rows.
+    #[must_use]
+    pub fn floor_points(&self, q: &SVector<T, N>) -> [[T; 2]; RAGDOLL_FLOOR_POINTS] {
+        self.points.map(|m| self.ragdoll.world_point(q, m))
+    }
+
+    /// Floor rows' Jacobians: `(d y_p / dq, d x_p / dq)` for each point.
+    fn point_jacobians(&self, q: &SVector<T, N>) -> [([T; N], [T; N]); RAGDOLL_FLOOR_POINTS] {
+        let pose = self.ragdoll.pose(q);
+        self.points.map(|m| {
+            let p = pose.point(m.link, m.along, m.across);
+            let (mut dy, mut dx) = ([T::zero(); N], [T::zero(); N]);
+            dy[1] = T::one();
+            dx[0] = T::one();
+            // The torso turns about its centre of mass, the origin of the pose.
+            dy[2] = p[0];
+            dx[2] = -p[1];
+            let mut k = m.link;
+            while k != 0 {
+                let o = pose.origin[k];
+                dy[k + 2] = p[0] - o[0];
+                dx[k + 2] = -(p[1] - o[1]);
+                k = PARENT[k];
+            }
+            (dy, dx)
+        })
+    }
+}
+
+impl<T: Real> Constraints<T, N, RAGDOLL_CONTACTS> for RagdollContacts<T> {
+    fn position_residual(&self, q: &SVector<T, N>) -> SVector<T, RAGDOLL_CONTACTS> {
+        let points = self.floor_points(q);
+        SVector::from_fn(|i, _| match points.get(i) {
+            Some(p) => p[1] - self.floor,
+            None => {
+                let row = i - RAGDOLL_FLOOR_POINTS;
+                let (joint, upper) = (row / 2, row % 2 == 1);
+                let [lower_bound, upper_bound] = self.limits[joint];
+                let x = q[joint + 3];
+                if upper {
+                    upper_bound - x
+                } else {
+                    x - lower_bound
+                }
+            }
+        })
+    }
+
+    fn jacobian(&self, q: &SVector<T, N>) -> SMatrix<T, RAGDOLL_CONTACTS, N> {
+        let rows = self.point_jacobians(q);
+        let mut j = SMatrix::zeros();
+        for (i, (dy, _)) in rows.iter().enumerate() {
+            for (c, x) in dy.iter().enumerate() {
+                j[(i, c)] = *x;
+            }
+        }
+        for joint in 0..RAGDOLL_LINKS - 1 {
+            let row = RAGDOLL_FLOOR_POINTS + 2 * joint;
+            j[(row, joint + 3)] = T::one();
+            j[(row + 1, joint + 3)] = -T::one();
+        }
+        j
+    }
+
+    /// `y_p''` at `q'' = 0`: `-sum w_k^2 r_k` over the links from the point to the torso,
+    /// `r_k` the stretch of link `k` on the way; zero for the limits (linear in `q`).
+    fn velocity_product(
+        &self,
+        q: &SVector<T, N>,
+        qd: &SVector<T, N>,
+    ) -> SVector<T, RAGDOLL_CONTACTS> {
+        let pose = self.ragdoll.pose(q);
+        let mut w = [T::zero(); RAGDOLL_LINKS];
+        w[0] = qd[2];
+        for k in 1..RAGDOLL_LINKS {
+            w[k] = w[PARENT[k]] + qd[k + 2];
+        }
+        let mut out = SVector::zeros();
+        for (i, m) in self.points.iter().enumerate() {
+            let mut p = pose.point(m.link, m.along, m.across);
+            let mut k = m.link;
+            let mut sum = T::zero();
+            loop {
+                let o = pose.origin[k];
+                sum -= w[k] * w[k] * (p[1] - o[1]);
+                if k == 0 {
+                    break;
+                }
+                p = o;
+                k = PARENT[k];
+            }
+            out[i] = sum;
+        }
+        out
+    }
+}
+
+impl<T: Real> Contacts<T, N, RAGDOLL_CONTACTS> for RagdollContacts<T> {
+    /// The floor points' horizontal Jacobian; none for the limits.
+    fn tangent_jacobian(&self, q: &SVector<T, N>) -> Option<SMatrix<T, RAGDOLL_CONTACTS, N>> {
+        let rows = self.point_jacobians(q);
+        let mut t = SMatrix::zeros();
+        for (i, (_, dx)) in rows.iter().enumerate() {
+            for (c, x) in dx.iter().enumerate() {
+                t[(i, c)] = *x;
+            }
+        }
+        Some(t)
+    }
+}

@@ -1,0 +1,273 @@
+//! The ragdoll (issue 18): its articulated-body accelerations, mass matrix and energies agree
+//! with the automatic Euler-Lagrange path of its own Lagrangian at random states and bodies;
+//! its contact rows' Jacobian and velocity-product term agree with differences of the gaps;
+//! thrown onto a floor it never gains kinetic energy at an impact, never sinks into the
+//! floor, comes to rest and falls asleep in a scene.
+
+use lagrange_core::nalgebra::SVector;
+use lagrange_core::{Constraints, Error, Lagrangian, Mechanism, Projection, Real, State};
+use lagrange_integrators::scene::{Bank, Scene, Sleeps, Status};
+use lagrange_integrators::{ContactModel, ContactStepper, Rk4};
+use lagrange_systems::{
+    Ragdoll, RagdollBody, RagdollContacts, Segment, RAGDOLL_CONTACTS, RAGDOLL_COORDINATES as N,
+};
+use lagrange_tests::{agrees_with_automatic, for_f32_and_f64, pick, Agreement, Rng, Scales};
+
+const G: f64 = 9.81;
+
+/// A random body: every segment's mass in [0.5, 40) kg and length in [0.1, 0.7) m, widths in
+/// [0, 0.5) m, damping in [0, 2).
+fn random_body<T: Real>(rng: &mut Rng) -> RagdollBody<T> {
+    let mut seg = || Segment {
+        mass: rng.uniform(0.5, 40.0),
+        length: rng.uniform(0.1, 0.7),
+    };
+    RagdollBody {
+        torso: seg(),
+        head: seg(),
+        upper_arm: seg(),
+        forearm: seg(),
+        thigh: seg(),
+        shin: seg(),
+        shoulder_width: rng.uniform(0.0, 0.5),
+        hip_width: rng.uniform(0.0, 0.5),
+        gravity: T::from_f64(G),
+        joint_damping: rng.uniform(0.0, 2.0),
+    }
+}
+
+/// A random state: torso within 3 m of the origin, every angle in (-pi, pi), translation
+/// rates to 5 m/s, angular rates to 8 rad/s.
+fn random_state<T: Real>(rng: &mut Rng) -> State<T, N> {
+    let q: [T; N] = core::array::from_fn(|i| {
+        if i < 2 {
+            rng.uniform(-3.0, 3.0)
+        } else {
+            rng.uniform(-3.1, 3.1)
+        }
+    });
+    let qd: [T; N] = core::array::from_fn(|i| {
+        if i < 2 {
+            rng.uniform(-5.0, 5.0)
+        } else {
+            rng.uniform(-8.0, 8.0)
+        }
+    });
+    State::new(T::zero(), q, qd)
+}
+
+/// Hand (articulated-body recursion, composite rigid bodies, inverse dynamics) against
+/// automatic (second-order dual numbers on the same `T` and `V`, Cholesky of the 12x12 `M`)
+/// at 5 random bodies of 40 random states (the automatic path is slow in a debug build).
+/// Measured worst (1,000 states): accelerations 5.0e-14 in f64, 3.7e-5 in f32; mass matrices
+/// 4.4e-16 and 1.2e-7; energies identical (one `T` and `V`). The bounds leave a factor of
+/// about 10: the automatic path's Cholesky of a mass matrix ill-conditioned by light
+/// forearms on a heavy torso dominates.
+fn agrees_with_its_lagrangian<T: Real>() -> Result<(), Error> {
+    let mut rng = Rng::new(18);
+    let mut worst = Agreement::default();
+    for _ in 0..5 {
+        let doll = Ragdoll::new(random_body::<T>(&mut rng))?;
+        let scale = Scales {
+            acceleration: G / 0.1,
+            energy: doll.total_mass().to_f64() * G * 3.0,
+        };
+        let tolerance = pick::<T>(5e-4, 1e-12);
+        worst = worst.max(agrees_with_automatic(
+            &doll,
+            scale,
+            tolerance,
+            40,
+            &mut rng,
+            random_state,
+        )?);
+    }
+    println!(
+        "ragdoll ({}): worst relative difference {worst}",
+        core::any::type_name::<T>()
+    );
+    Ok(())
+}
+
+for_f32_and_f64!(agrees_with_its_lagrangian);
+
+/// The adult in the air at rest: the centre of mass falls at g and nothing turns, whatever
+/// the pose (gravity acts on every link alike).
+#[test]
+fn free_fall_is_uniform() -> Result<(), Error> {
+    let doll = Ragdoll::new(RagdollBody::<f64>::adult())?;
+    let mut rng = Rng::new(7);
+    for _ in 0..100 {
+        let mut s = random_state::<f64>(&mut rng);
+        s.qd = SVector::zeros();
+        let a = doll.acceleration(&s)?;
+        // The torso's centre and angle accelerate, but the whole body's centre of mass falls
+        // at exactly g: check it through the momentum's rate, M q'' projected on x and y.
+        let m = doll.mass_matrix(&s);
+        let force = m * a;
+        let total = doll.total_mass();
+        assert!((force[0]).abs() < 1e-9 * total * G, "{force:?}");
+        assert!((force[1] + total * G).abs() < 1e-9 * total * G, "{force:?}");
+    }
+    Ok(())
+}
+
+/// The adult, floor at 0, thrown: torso centre 1.6 m up, tilted 0.6 rad, limbs spread, moving
+/// at (2, 1) m/s and turning at 3 rad/s.
+fn thrown<T: Real>() -> State<T, N> {
+    let mut q = [T::zero(); N];
+    let mut qd = [T::zero(); N];
+    q[1] = T::from_f64(1.6);
+    q[2] = T::from_f64(0.6);
+    for (k, spread) in [
+        (4, -1.0),
+        (6, 1.0),
+        (8, -0.4),
+        (9, 0.5),
+        (10, 0.4),
+        (11, -0.5),
+    ] {
+        q[k] = T::from_f64(spread);
+    }
+    qd[0] = T::from_f64(2.0);
+    qd[1] = T::from_f64(1.0);
+    qd[2] = T::from_f64(3.0);
+    State::new(T::zero(), q, qd)
+}
+
+/// Restitution 0.3, friction 0.8, resting below 0.3 m/s (well above 2 g dt), contacts
+/// located to 1e-7 s (f64) or 1e-4 s (f32: located more finely, the micro-impacts of a
+/// body settling on a dozen contacts in single precision exceed the stepper's `4 C + 8`
+/// events in one step).
+fn model<T: Real>() -> Result<ContactModel<T>, Error> {
+    ContactModel::new(
+        T::from_f64(0.3),
+        T::from_f64(0.3),
+        T::from_f64(pick::<T>(1e-4, 1e-7)),
+    )?
+    .with_friction(T::from_f64(0.8))
+}
+
+type Stepper<T> = ContactStepper<T, N, RAGDOLL_CONTACTS, Rk4, RagdollContacts<T>>;
+
+fn stepper<T: Real>(doll: &Ragdoll<T>) -> Result<Stepper<T>, Error> {
+    Ok(ContactStepper::new(
+        Rk4,
+        RagdollContacts::adult(doll, T::zero())?,
+        model()?,
+        Projection::new(T::from_f64(pick::<T>(1e-4, 1e-9)), 8)?,
+    ))
+}
+
+/// Thrown onto the floor, RK4 at 1/240 s for 6 s: at every impact the kinetic energy does
+/// not grow (restitution <= 1 and friction only take energy: the largest change is printed,
+/// bounded by rounding); no floor point ends a step below the floor by more than the
+/// projection's tolerance; the total energy never exceeds its start.
+fn never_gains_energy_at_an_impact<T: Real>() -> Result<(), Error> {
+    let doll = Ragdoll::new(RagdollBody::<T>::adult())?;
+    let mut stepper = stepper(&doll)?;
+    let contacts = RagdollContacts::adult(&doll, T::zero())?;
+    let mut s = thrown::<T>();
+    let e0 = doll.energy(&s).to_f64();
+    let dt = T::from_f64(1.0 / 240.0);
+    let (mut gain, mut deepest, mut highest) =
+        (f64::NEG_INFINITY, f64::INFINITY, f64::NEG_INFINITY);
+    for _ in 0..(6 * 240) {
+        s = stepper.step_observed(&doll, &s, dt, |impact| {
+            let k0 = doll.kinetic_energy(&impact.state_before()).to_f64();
+            let k1 = doll.kinetic_energy(&impact.state_after()).to_f64();
+            gain = gain.max((k1 - k0) / k0.max(1.0));
+        })?;
+        let gaps = contacts.position_residual(&s.q);
+        deepest = gaps.iter().fold(deepest, |d, g| d.min(g.to_f64()));
+        highest = highest.max(doll.energy(&s).to_f64() - e0);
+    }
+    println!(
+        "ragdoll thrown ({}): {} impacts, largest relative kinetic energy change at an impact \
+         {gain:.1e}, deepest gap {deepest:.1e}, energy above the start {highest:.1e} J, final \
+         kinetic energy {:.1e} J",
+        core::any::type_name::<T>(),
+        stepper.impacts(),
+        doll.kinetic_energy(&s).to_f64()
+    );
+    assert!(stepper.impacts() > 3);
+    assert!(gain <= pick::<T>(1e-5, 1e-12), "{gain}");
+    assert!(deepest >= -pick::<T>(1e-3, 1e-8), "{deepest}");
+    // Measured: never above the start (joint damping and plastic or partly elastic impacts
+    // only take energy); the bound is rounding on an energy of ~1,400 J.
+    assert!(highest <= pick::<T>(1e-4, 1e-9) * e0.abs(), "{highest}");
+    Ok(())
+}
+
+/// Runs `$name::<f32>` and `$name::<f64>` as tests ignored in the quick debug run (`cargo
+/// xtask ci` runs them in release).
+macro_rules! long_f32_and_f64 {
+    ($($name:ident),* $(,)?) => {
+        $(
+            mod $name {
+                #[test]
+                #[ignore = "long run: cargo xtask ci runs it in release"]
+                fn f32() -> Result<(), lagrange_core::Error> {
+                    super::$name::<f32>()
+                }
+                #[test]
+                #[ignore = "long run: cargo xtask ci runs it in release"]
+                fn f64() -> Result<(), lagrange_core::Error> {
+                    super::$name::<f64>()
+                }
+            }
+        )*
+    };
+}
+
+long_f32_and_f64!(never_gains_energy_at_an_impact);
+
+/// Thrown onto the floor in a scene (a bank that sleeps: kinetic energy below 1e-3 J and the
+/// held acceleration below 1e-2 for 60 steps), frames of 1/60 s at 1/240 s: it comes to rest
+/// and falls asleep within 4 s (measured: see the printout), lying above the floor; asleep
+/// it is not stepped, and an impulse wakes it.
+fn comes_to_rest_and_sleeps<T: Real>() -> Result<(), Error> {
+    let doll = Ragdoll::new(RagdollBody::<T>::adult())?;
+    let rule = Sleeps::new(T::from_f64(1e-3), T::from_f64(1e-2), 60)?;
+    let mut bank: Bank<T, N, 1, Ragdoll<T>, Stepper<T>, Sleeps<T>> =
+        Bank::new(stepper(&doll)?, rule)?;
+    let id = bank.add(doll, thrown())?;
+    let mut scene = Scene::new(bank, T::from_f64(1.0 / 240.0), 8)?;
+    let frame = T::from_f64(1.0 / 60.0);
+    let mut asleep = None;
+    for n in 0..(60 * 6) {
+        assert_eq!(scene.advance(frame)?.failed, 0);
+        if scene.banks().status(id)? == Status::Asleep {
+            asleep = Some(f64::from(n + 1) / 60.0);
+            break;
+        }
+    }
+    let asleep = asleep.ok_or(Error::NoConvergence { iterations: 360 })?;
+    let rest = *scene.banks().state(id)?;
+    let contacts = RagdollContacts::adult(&doll, T::zero())?;
+    let lowest = contacts
+        .floor_points(&rest.q)
+        .iter()
+        .fold(f64::INFINITY, |m, p| m.min(p[1].to_f64()));
+    println!(
+        "ragdoll ({}): asleep after {asleep:.2} s, torso at {:.3} m, lowest point {lowest:.1e} m",
+        core::any::type_name::<T>(),
+        rest.q[1].to_f64()
+    );
+    assert!(asleep < 4.0, "{asleep}");
+    assert!(lowest >= -pick::<T>(1e-3, 1e-8), "{lowest}");
+    // Asleep: frames leave its bits alone.
+    for _ in 0..30 {
+        scene.advance(frame)?;
+    }
+    assert_eq!(*scene.banks().state(id)?, rest);
+    let mut kick = SVector::<T, N>::zeros();
+    kick[1] = T::from_f64(100.0);
+    scene.banks_mut().apply_impulse(id, &kick)?;
+    assert_eq!(scene.banks().status(id)?, Status::Awake);
+    scene.advance(frame)?;
+    assert!(scene.banks().state(id)?.q[1] > rest.q[1]);
+    Ok(())
+}
+
+long_f32_and_f64!(comes_to_rest_and_sleeps);

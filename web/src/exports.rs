@@ -1,0 +1,195 @@
+//! The functions the page calls: plain C ABI, numbers in and out.
+//!
+//! Conventions: `panel` indexes `setups::KINDS`; a `u32` result of 0 means success and 1 an
+//! error whose text [`lg_take_error`] gives; arrays come back through [`lg_numbers`] (an
+//! address in the module's memory, `f64`s) and [`lg_text`] (UTF-8 bytes).
+
+// `#[no_mangle]` is what makes a function an export of the .wasm; rustc counts it as unsafe
+// code, because two exports of one name would clash at link time. The names below all
+// start with `lg_` and are unique in this crate. No `unsafe` block is needed or used.
+#![allow(unsafe_code)]
+
+use std::cell::RefCell;
+
+use lagrange_core::Error;
+
+use crate::page::Page;
+use crate::scenario;
+use crate::setups::KINDS;
+use crate::sim::Panel;
+
+thread_local! {
+    /// The page: WebAssembly runs it on one thread.
+    static PAGE: RefCell<Page> = RefCell::new(Page::default());
+}
+
+/// Runs `f` on panel `panel`, or returns `missing`.
+fn with_panel<R>(panel: u32, missing: R, f: impl FnOnce(&mut dyn Panel) -> R) -> R {
+    PAGE.with_borrow_mut(|page| match page.panels.get_mut(panel as usize) {
+        Some(p) => f(p.as_mut()),
+        None => missing,
+    })
+}
+
+/// 0 for `Ok`, 1 for an error (kept by the panel, or in the page's text).
+fn code(result: Result<(), Error>) -> u32 {
+    u32::from(result.is_err())
+}
+
+/// Builds every panel in `f64` (`double` = 1) or `f32` (0): the number of panels, or 0 when
+/// one fails to build (its error in [`lg_text`]).
+#[no_mangle]
+pub extern "C" fn lg_init(double: u32) -> u32 {
+    PAGE.with_borrow_mut(|page| match page.init(double != 0) {
+        Ok(()) => u32::try_from(page.panels.len()).unwrap_or(0),
+        Err(e) => {
+            page.text = e.to_string();
+            0
+        }
+    })
+}
+
+/// Number of mechanisms the page shows.
+#[no_mangle]
+pub extern "C" fn lg_panels() -> u32 {
+    u32::try_from(KINDS.len()).unwrap_or(0)
+}
+
+/// Advances panel `panel` by `frame_time` s; its status after (0 awake, 1 asleep, 2 set
+/// aside; a failed instance is reset at once and its error kept).
+#[no_mangle]
+pub extern "C" fn lg_advance(panel: u32, frame_time: f64) -> u32 {
+    with_panel(panel, 2, |p| {
+        p.advance(frame_time);
+        p.status()
+    })
+}
+
+/// Writes panel `panel`'s points to [`lg_numbers`]: `[main, twin, exact, x0, y0, x1, ...]`
+/// (the three counts, then that many points of each group); the count of numbers.
+#[no_mangle]
+pub extern "C" fn lg_points(panel: u32) -> u32 {
+    PAGE.with_borrow_mut(|page| {
+        let Page {
+            panels, numbers, ..
+        } = page;
+        numbers.clear();
+        numbers.extend([0.0; 3]);
+        let Some(p) = panels.get(panel as usize) else {
+            return 3;
+        };
+        let counts = p.points(numbers);
+        for (slot, n) in numbers
+            .iter_mut()
+            .zip([counts.main, counts.twin, counts.exact])
+        {
+            *slot = n as f64;
+        }
+        u32::try_from(numbers.len()).unwrap_or(0)
+    })
+}
+
+/// The address of the numbers [`lg_points`] wrote.
+#[no_mangle]
+pub extern "C" fn lg_numbers() -> usize {
+    PAGE.with_borrow(|page| page.numbers.as_ptr() as usize)
+}
+
+/// The address of the text [`lg_take_error`] or [`lg_scenario`] wrote.
+#[no_mangle]
+pub extern "C" fn lg_text() -> usize {
+    PAGE.with_borrow(|page| page.text.as_ptr() as usize)
+}
+
+/// The length in bytes of the text at [`lg_text`].
+#[no_mangle]
+pub extern "C" fn lg_text_len() -> u32 {
+    PAGE.with_borrow(|page| u32::try_from(page.text.len()).unwrap_or(0))
+}
+
+/// Panel `panel`'s relative energy error.
+#[no_mangle]
+pub extern "C" fn lg_energy_error(panel: u32) -> f64 {
+    with_panel(panel, 0.0, |p| p.energy_error())
+}
+
+/// Panel `panel`'s status: 0 awake, 1 asleep, 2 set aside.
+#[no_mangle]
+pub extern "C" fn lg_status(panel: u32) -> u32 {
+    with_panel(panel, 2, |p| p.status())
+}
+
+/// Panel `panel`'s scene time, s.
+#[no_mangle]
+pub extern "C" fn lg_time(panel: u32) -> f64 {
+    with_panel(panel, 0.0, |p| p.time())
+}
+
+/// Panel `panel`'s fixed step, s.
+#[no_mangle]
+pub extern "C" fn lg_dt(panel: u32) -> f64 {
+    with_panel(panel, 0.0, |p| p.dt())
+}
+
+/// Sets panel `panel`'s fixed step to `dt` s (0 or 1; on an error the panel is reset).
+#[no_mangle]
+pub extern "C" fn lg_set_dt(panel: u32, dt: f64) -> u32 {
+    with_panel(panel, 1, |p| code(p.set_dt(dt)))
+}
+
+/// Restarts panel `panel` with integrator `method` (0 RK4, 1 Stormer-Verlet, 2
+/// semi-implicit Euler).
+#[no_mangle]
+pub extern "C" fn lg_set_method(panel: u32, method: u32) -> u32 {
+    PAGE.with_borrow_mut(
+        |page| match page.set_method(panel as usize, method as usize) {
+            Ok(()) => 0,
+            Err(e) => {
+                page.text = e.to_string();
+                1
+            }
+        },
+    )
+}
+
+/// Drags point `point` of panel `panel`'s main instance to the velocity `(vx, vy)` m/s.
+#[no_mangle]
+pub extern "C" fn lg_drag(panel: u32, point: u32, vx: f64, vy: f64) -> u32 {
+    with_panel(panel, 1, |p| code(p.drag(point as usize, vx, vy)))
+}
+
+/// Sets panel `panel`'s input (the cart-pole's force, N).
+#[no_mangle]
+pub extern "C" fn lg_input(panel: u32, value: f64) -> u32 {
+    with_panel(panel, 1, |p| code(p.set_input(value)))
+}
+
+/// Resets panel `panel` to its start.
+#[no_mangle]
+pub extern "C" fn lg_reset(panel: u32) {
+    with_panel(panel, (), |p| p.reset());
+}
+
+/// Takes panel `panel`'s last error into [`lg_text`]: its length in bytes (0: none).
+#[no_mangle]
+pub extern "C" fn lg_take_error(panel: u32) -> u32 {
+    PAGE.with_borrow_mut(|page| {
+        let error = page
+            .panels
+            .get_mut(panel as usize)
+            .and_then(|p| p.take_error());
+        page.text = error.map(|e| e.to_string()).unwrap_or_default();
+        u32::try_from(page.text.len()).unwrap_or(0)
+    })
+}
+
+/// Runs the scripted scenario in `f64` (`double` = 1) or `f32` into [`lg_text`] (see
+/// [`scenario::text`]): its length in bytes.
+#[no_mangle]
+pub extern "C" fn lg_scenario(double: u32) -> u32 {
+    let text = scenario::text(double != 0);
+    PAGE.with_borrow_mut(|page| {
+        page.text = text;
+        u32::try_from(page.text.len()).unwrap_or(0)
+    })
+}
