@@ -659,7 +659,7 @@ impl<T: Real> Mechanism<T, RAGDOLL_COORDINATES> for Ragdoll<T> {
         s: &State<T, RAGDOLL_COORDINATES>,
         extra: &F,
     ) -> Result<SVector<T, RAGDOLL_COORDINATES>, Error> {
-        let tau = free_law_force(self, s, extra);
+        let tau = free_law_force(self, s, extra)?;
         self.articulated(&self.pose(&s.q), &s.qd, &tau, self.body.gravity)
     }
 
@@ -668,7 +668,7 @@ impl<T: Real> Mechanism<T, RAGDOLL_COORDINATES> for Ragdoll<T> {
         s: &State<T, RAGDOLL_COORDINATES>,
         extra: &F,
     ) -> Result<SVector<T, RAGDOLL_COORDINATES>, Error> {
-        Ok(free_law_force(self, s, extra))
+        free_law_force(self, s, extra)
     }
 }
 

@@ -7,7 +7,7 @@
 use crate::cmd;
 
 /// The examples, in the order the demo runs them.
-const EXAMPLES: [&str; 8] = [
+const EXAMPLES: [&str; 9] = [
     "origin_pendulum",
     "double_pendulum_energy",
     "own_mechanism",
