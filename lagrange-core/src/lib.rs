@@ -52,6 +52,7 @@ mod error;
 pub mod fast_trig;
 mod forces;
 mod jacobian;
+mod jet;
 mod lagrangian;
 mod mechanism;
 pub mod prelude;

@@ -1,0 +1,898 @@
+//! The second-order jet behind [`EulerLagrange`](crate::EulerLagrange): one evaluation of a
+//! kinetic energy over it gives the mass matrix, `dT/dq` and the mixed term of the
+//! Euler-Lagrange equations together.
+//!
+//! A [`Jet`] holds, for a value `x(t, q, q')` computed from the seeded coordinates:
+//!
+//! ```text
+//! v   x
+//! gq  dx/dq                      N
+//! gp  dx/dq'                     N
+//! h   d2x/dq'dq'                 N x N, upper triangle only (i <= j)
+//! d   dx/de                      along the direction e: dq = q' (and dt = 1 when seeded)
+//! dp  d2x/dq'de                  N
+//! ```
+//!
+//! which is all that `M = d2T/dq'2` and `f = dT/dq - (d2T/dq'dq) q' - d2T/dq'dt` need: the
+//! mixed term is one directional derivative of the velocity gradient, `O(N)` per operation
+//! instead of the `O(N^2)` of a full mixed Hessian, and only the velocity Hessian is
+//! `O(N^2)`, its symmetric half computed. Each part carries a flag that is clear when the
+//! part is exactly zero (a parameter, a function of `q` only, a value linear in `q'`), and an
+//! operation touches only the parts its operands make non-zero: in the mass matrix's part of
+//! the work every sine and cosine of a coordinate is a plain number times the parts it has.
+
+// The loops below index `lo..hi` with `hi <= N`: their bounds checks fold away and small
+// ones unroll, where iterator chains with `skip` and `take` stayed loops (measured: a double
+// pendulum's acceleration took 3.7 times as long).
+#![allow(clippy::needless_range_loop)]
+
+use crate::scalar::{powi_by_squaring, Real, Scalar};
+use core::marker::PhantomData;
+use core::ops::{Add, AddAssign, Div, DivAssign, Mul, MulAssign, Neg, Sub, SubAssign};
+use num_traits::{One, Zero};
+
+/// Flag of `gq`: may be non-zero.
+const GQ: u8 = 1;
+/// Flag of `gp`.
+const GP: u8 = 2;
+/// Flag of `h`.
+const H: u8 = 4;
+/// Flag of `d`.
+const D: u8 = 8;
+/// Flag of `dp`.
+const DP: u8 = 16;
+
+/// Up to this many coordinates every loop runs over all of them (unrolled, no bookkeeping);
+/// above it, over the jet's span only.
+pub(crate) const DENSE: usize = 4;
+
+/// A value with its first derivatives in the coordinates and velocities, its second
+/// derivatives in the velocities, and the derivative along one direction of it and of its
+/// velocity gradient (see the module's docs).
+///
+/// A part whose flag is clear is exactly zero, in its storage too; so is every entry of a
+/// part outside the span `lo..hi` of coordinates the value depends on (a link of a chain
+/// depends on the links before it only), over which alone the operations loop.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Jet<S: Scalar, const N: usize, R = <S as Scalar>::Real> {
+    /// The value.
+    pub(crate) v: S,
+    /// `dx/de` along the seeded direction.
+    pub(crate) d: S,
+    /// Which parts may be non-zero.
+    parts: u8,
+    /// The first coordinate of the span outside which every entry is zero.
+    lo: usize,
+    /// One past the last coordinate of the span.
+    hi: usize,
+    /// `dx/dq`.
+    pub(crate) gq: [S; N],
+    /// `dx/dq'`.
+    pub(crate) gp: [S; N],
+    /// `d2x/dq'de`.
+    pub(crate) dp: [S; N],
+    /// `d2x/dq'_i dq'_j` for `i <= j` (the rest stays zero).
+    pub(crate) h: [[S; N]; N],
+    real: PhantomData<R>,
+}
+
+/// The loop bounds of a span `lo..hi`: all of `0..N` for a small `N`. Capped at `N`, so
+/// that the compiler sees every index in range.
+#[inline(always)]
+fn bounds<const N: usize>(lo: usize, hi: usize) -> (usize, usize) {
+    if N <= DENSE {
+        (0, N)
+    } else {
+        (lo, hi.min(N))
+    }
+}
+
+/// `x *= c` over `lo..hi`.
+#[inline(always)]
+fn scale<S: Scalar, const N: usize>(x: &mut [S; N], c: S, (lo, hi): (usize, usize)) {
+    for i in lo..hi {
+        x[i] *= c;
+    }
+}
+
+/// `x += y` over `lo..hi`.
+#[inline(always)]
+fn add<S: Scalar, const N: usize>(x: &mut [S; N], y: &[S; N], (lo, hi): (usize, usize)) {
+    for i in lo..hi {
+        x[i] += y[i];
+    }
+}
+
+/// `x -= y` over `lo..hi`.
+#[inline(always)]
+fn sub<S: Scalar, const N: usize>(x: &mut [S; N], y: &[S; N], (lo, hi): (usize, usize)) {
+    for i in lo..hi {
+        x[i] -= y[i];
+    }
+}
+
+/// `x += c y` over `lo..hi`.
+#[inline(always)]
+fn add_scaled<S: Scalar, const N: usize>(
+    x: &mut [S; N],
+    c: S,
+    y: &[S; N],
+    (lo, hi): (usize, usize),
+) {
+    for i in lo..hi {
+        x[i] += c * y[i];
+    }
+}
+
+/// `x = a x + b y` over `lo..hi`.
+#[inline(always)]
+fn combine<S: Scalar, const N: usize>(
+    x: &mut [S; N],
+    a: S,
+    b: S,
+    y: &[S; N],
+    (lo, hi): (usize, usize),
+) {
+    for i in lo..hi {
+        x[i] = a * x[i] + b * y[i];
+    }
+}
+
+/// `h *= c` over the upper triangle of `lo..hi`.
+#[inline(always)]
+fn scale_upper<S: Scalar, const N: usize>(h: &mut [[S; N]; N], c: S, (lo, hi): (usize, usize)) {
+    for i in lo..hi {
+        for j in i..hi {
+            h[i][j] *= c;
+        }
+    }
+}
+
+/// `h += k` over the upper triangle of `lo..hi`.
+#[inline(always)]
+fn add_upper<S: Scalar, const N: usize>(
+    h: &mut [[S; N]; N],
+    k: &[[S; N]; N],
+    (lo, hi): (usize, usize),
+) {
+    for i in lo..hi {
+        for j in i..hi {
+            h[i][j] += k[i][j];
+        }
+    }
+}
+
+/// `h -= k` over the upper triangle of `lo..hi`.
+#[inline(always)]
+fn sub_upper<S: Scalar, const N: usize>(
+    h: &mut [[S; N]; N],
+    k: &[[S; N]; N],
+    (lo, hi): (usize, usize),
+) {
+    for i in lo..hi {
+        for j in i..hi {
+            h[i][j] -= k[i][j];
+        }
+    }
+}
+
+/// `h += c k` over the upper triangle of `lo..hi`.
+#[inline(always)]
+fn add_scaled_upper<S: Scalar, const N: usize>(
+    h: &mut [[S; N]; N],
+    c: S,
+    k: &[[S; N]; N],
+    (lo, hi): (usize, usize),
+) {
+    for i in lo..hi {
+        for j in i..hi {
+            h[i][j] += c * k[i][j];
+        }
+    }
+}
+
+/// `h += a b^T + b a^T` over the upper triangle of `lo..hi`.
+#[inline(always)]
+fn add_outer<S: Scalar, const N: usize>(
+    h: &mut [[S; N]; N],
+    a: &[S; N],
+    b: &[S; N],
+    (lo, hi): (usize, usize),
+) {
+    for i in lo..hi {
+        let (ai, bi) = (a[i], b[i]);
+        for j in i..hi {
+            h[i][j] += ai * b[j] + bi * a[j];
+        }
+    }
+}
+
+/// `h += c a a^T` over the upper triangle of `lo..hi`.
+#[inline(always)]
+fn add_square<S: Scalar, const N: usize>(
+    h: &mut [[S; N]; N],
+    c: S,
+    a: &[S; N],
+    (lo, hi): (usize, usize),
+) {
+    for i in lo..hi {
+        let ai = a[i] * c;
+        for j in i..hi {
+            h[i][j] += ai * a[j];
+        }
+    }
+}
+
+impl<S: Scalar<Real = R>, const N: usize, R: Real> Jet<S, N, R> {
+    /// A constant: every derivative zero.
+    #[inline(always)]
+    pub(crate) fn constant(v: S) -> Self {
+        Self {
+            v,
+            d: S::zero(),
+            parts: 0,
+            lo: N,
+            hi: 0,
+            gq: [S::zero(); N],
+            gp: [S::zero(); N],
+            dp: [S::zero(); N],
+            h: [[S::zero(); N]; N],
+            real: PhantomData,
+        }
+    }
+
+    /// The value `v`, in place of a constant (every derivative of `self` zero).
+    #[inline(always)]
+    fn reset_constant(&mut self, v: S) {
+        debug_assert!(self.parts == 0);
+        self.v = v;
+    }
+
+    /// Widens the span to `k`.
+    #[inline(always)]
+    fn include(&mut self, k: usize) {
+        if N > DENSE {
+            self.lo = self.lo.min(k);
+            self.hi = self.hi.max(k + 1);
+        }
+    }
+
+    /// Widens the span to that of `o`.
+    #[inline(always)]
+    fn include_span(&mut self, o: &Self) {
+        if N > DENSE {
+            self.lo = self.lo.min(o.lo);
+            self.hi = self.hi.max(o.hi);
+        }
+    }
+
+    /// The loop bounds of the span.
+    #[inline(always)]
+    fn span(&self) -> (usize, usize) {
+        bounds::<N>(self.lo, self.hi)
+    }
+
+    /// The loop bounds of the union of the spans of `self` and `o`.
+    #[inline(always)]
+    fn union(&self, o: &Self) -> (usize, usize) {
+        bounds::<N>(self.lo.min(o.lo), self.hi.max(o.hi))
+    }
+
+    /// Sets `self` to coordinate `k` at `q`, moving at `rate` along the direction (`gq` and
+    /// `d` seeded); `self` a constant.
+    pub(crate) fn seed_coordinate(&mut self, q: S, k: usize, rate: S) {
+        self.reset_constant(q);
+        if let Some(e) = self.gq.get_mut(k) {
+            *e = S::one();
+            self.parts |= GQ;
+            self.include(k);
+        }
+        self.d = rate;
+        self.parts |= D;
+    }
+
+    /// Sets `self` to velocity `k` at `qd` (`gp` seeded); `self` a constant.
+    pub(crate) fn seed_velocity(&mut self, qd: S, k: usize) {
+        self.reset_constant(qd);
+        if let Some(e) = self.gp.get_mut(k) {
+            *e = S::one();
+            self.parts |= GP;
+            self.include(k);
+        }
+    }
+
+    /// Coordinate `k` at `q`, moving at `rate` along the direction.
+    pub(crate) fn coordinate(q: S, k: usize, rate: S) -> Self {
+        let mut x = Self::constant(S::zero());
+        x.seed_coordinate(q, k, rate);
+        x
+    }
+
+    /// Velocity `k` at `qd`.
+    pub(crate) fn velocity(qd: S, k: usize) -> Self {
+        let mut x = Self::constant(S::zero());
+        x.seed_velocity(qd, k);
+        x
+    }
+
+    /// Time at `t`, moving at unit rate along the direction (`d` seeded).
+    pub(crate) fn time(t: S) -> Self {
+        let mut x = Self::constant(t);
+        x.d = S::one();
+        x.parts |= D;
+        x
+    }
+
+    /// `d2x/dq'_i dq'_j`, read from the stored upper triangle.
+    pub(crate) fn hessian(&self, i: usize, j: usize) -> S {
+        let (i, j) = if i <= j { (i, j) } else { (j, i) };
+        self.h
+            .get(i)
+            .and_then(|row| row.get(j))
+            .copied()
+            .unwrap_or_else(S::zero)
+    }
+
+    /// Every part times `c`.
+    #[inline(always)]
+    fn scale_by(&mut self, c: S) {
+        self.v *= c;
+        let (p, span) = (self.parts, self.span());
+        if p & GQ != 0 {
+            scale(&mut self.gq, c, span);
+        }
+        if p & GP != 0 {
+            scale(&mut self.gp, c, span);
+        }
+        if p & H != 0 {
+            scale_upper(&mut self.h, c, span);
+        }
+        if p & D != 0 {
+            self.d *= c;
+        }
+        if p & DP != 0 {
+            scale(&mut self.dp, c, span);
+        }
+    }
+
+    /// `self = g(self)` for a function `g` with value `f0`, first derivative `f1` and second
+    /// derivative `f2` at `self.v`.
+    #[inline(always)]
+    fn chain(&mut self, f0: S, f1: S, f2: S) {
+        let (p, span) = (self.parts, self.span());
+        if p & GP != 0 {
+            if p & H != 0 {
+                scale_upper(&mut self.h, f1, span);
+            }
+            add_square(&mut self.h, f2, &self.gp, span);
+            if p & DP != 0 {
+                scale(&mut self.dp, f1, span);
+            }
+            if p & D != 0 {
+                add_scaled(&mut self.dp, f2 * self.d, &self.gp, span);
+                self.parts |= DP;
+            }
+            scale(&mut self.gp, f1, span);
+            self.parts |= H;
+        }
+        if p & GQ != 0 {
+            scale(&mut self.gq, f1, span);
+        }
+        if p & D != 0 {
+            self.d *= f1;
+        }
+        self.v = f0;
+    }
+
+    /// `self = g(self, o)` for a function `g` with value `f0`, first derivatives `fa`, `fb`
+    /// and second derivatives `faa`, `fab`, `fbb` at `(self.v, o.v)` (every part computed:
+    /// for the rare functions of two variables).
+    fn chain2(&mut self, o: &Self, f0: S, (fa, fb): (S, S), (faa, fab, fbb): (S, S, S)) {
+        let a = *self;
+        let b = o;
+        let all = (0, N);
+        let mix = |x: &[S; N], y: &[S; N]| core::array::from_fn(|i| fa * x[i] + fb * y[i]);
+        self.gq = mix(&a.gq, &b.gq);
+        self.gp = mix(&a.gp, &b.gp);
+        self.d = fa * a.d + fb * b.d;
+        self.dp = core::array::from_fn(|i| {
+            fa * a.dp[i]
+                + fb * b.dp[i]
+                + (faa * a.d + fab * b.d) * a.gp[i]
+                + (fbb * b.d + fab * a.d) * b.gp[i]
+        });
+        scale_upper(&mut self.h, fa, all);
+        add_scaled_upper(&mut self.h, fb, &b.h, all);
+        add_square(&mut self.h, faa, &a.gp, all);
+        add_square(&mut self.h, fbb, &b.gp, all);
+        let fab_b = b.gp.map(|x| x * fab);
+        add_outer(&mut self.h, &a.gp, &fab_b, all);
+        self.v = f0;
+        self.parts = a.parts | b.parts;
+        if self.parts & GP != 0 {
+            self.parts |= H | DP;
+        }
+        self.include_span(b);
+    }
+
+    /// `self *= o` when both have derivatives.
+    #[inline(always)]
+    fn mul_general(&mut self, o: &Self) {
+        let (a, b) = (self.parts, o.parts);
+        let (av, bv) = (self.v, o.v);
+        let (sa, sb, su) = (self.span(), o.span(), self.union(o));
+        // Second-order parts first: they read the first-order parts before those change.
+        if a & H != 0 {
+            scale_upper(&mut self.h, bv, sa);
+        }
+        if b & H != 0 {
+            add_scaled_upper(&mut self.h, av, &o.h, sb);
+        }
+        if a & GP != 0 && b & GP != 0 {
+            add_outer(&mut self.h, &self.gp, &o.gp, su);
+            self.parts |= H;
+        }
+        if a & DP != 0 {
+            scale(&mut self.dp, bv, sa);
+        }
+        if b & DP != 0 {
+            add_scaled(&mut self.dp, av, &o.dp, sb);
+        }
+        if a & GP != 0 && b & D != 0 {
+            add_scaled(&mut self.dp, o.d, &self.gp, sa);
+            self.parts |= DP;
+        }
+        if a & D != 0 && b & GP != 0 {
+            add_scaled(&mut self.dp, self.d, &o.gp, sb);
+            self.parts |= DP;
+        }
+        // First-order parts: x' = b.v a' + a.v b'.
+        for (flag, x, y) in [(GQ, &mut self.gq, &o.gq), (GP, &mut self.gp, &o.gp)] {
+            match (a & flag != 0, b & flag != 0) {
+                (true, true) => combine(x, bv, av, y, su),
+                (true, false) => scale(x, bv, sa),
+                (false, true) => add_scaled(x, av, y, sb),
+                (false, false) => {}
+            }
+        }
+        self.d = bv * self.d + av * o.d;
+        self.v = av * bv;
+        self.parts |= b;
+        self.include_span(o);
+    }
+}
+
+impl<S: Scalar<Real = R>, const N: usize, R: Real> Jet<S, N, R> {
+    /// `self += o` (or `-=` with `SIGN` false).
+    #[inline(always)]
+    fn add_jet<const SIGN: bool>(&mut self, o: &Self) {
+        let (p, span) = (o.parts, o.span());
+        if SIGN {
+            self.v += o.v;
+        } else {
+            self.v -= o.v;
+        }
+        if p == 0 {
+            return;
+        }
+        if p & GQ != 0 {
+            if SIGN {
+                add(&mut self.gq, &o.gq, span);
+            } else {
+                sub(&mut self.gq, &o.gq, span);
+            }
+        }
+        if p & GP != 0 {
+            if SIGN {
+                add(&mut self.gp, &o.gp, span);
+            } else {
+                sub(&mut self.gp, &o.gp, span);
+            }
+        }
+        if p & H != 0 {
+            if SIGN {
+                add_upper(&mut self.h, &o.h, span);
+            } else {
+                sub_upper(&mut self.h, &o.h, span);
+            }
+        }
+        if p & D != 0 {
+            if SIGN {
+                self.d += o.d;
+            } else {
+                self.d -= o.d;
+            }
+        }
+        if p & DP != 0 {
+            if SIGN {
+                add(&mut self.dp, &o.dp, span);
+            } else {
+                sub(&mut self.dp, &o.dp, span);
+            }
+        }
+        self.parts |= p;
+        self.include_span(o);
+    }
+
+    /// `self *= o`.
+    #[inline(always)]
+    fn mul_jet(&mut self, o: &Self) {
+        if o.parts == 0 {
+            self.scale_by(o.v);
+        } else {
+            self.mul_general(o);
+        }
+    }
+}
+
+// The operators work in place on an operand they own, and take the other by reference: a
+// jet of a long chain is kilobytes, and every copy of one costs as much as the arithmetic.
+
+impl<S: Scalar<Real = R>, const N: usize, R: Real> AddAssign for Jet<S, N, R> {
+    #[inline(always)]
+    fn add_assign(&mut self, o: Self) {
+        self.add_jet::<true>(&o);
+    }
+}
+
+impl<S: Scalar<Real = R>, const N: usize, R: Real> SubAssign for Jet<S, N, R> {
+    #[inline(always)]
+    fn sub_assign(&mut self, o: Self) {
+        self.add_jet::<false>(&o);
+    }
+}
+
+impl<S: Scalar<Real = R>, const N: usize, R: Real> MulAssign for Jet<S, N, R> {
+    #[inline(always)]
+    fn mul_assign(&mut self, mut o: Self) {
+        if self.parts == 0 {
+            o.scale_by(self.v);
+            *self = o;
+        } else {
+            self.mul_jet(&o);
+        }
+    }
+}
+
+impl<S: Scalar<Real = R>, const N: usize, R: Real> DivAssign for Jet<S, N, R> {
+    #[inline(always)]
+    fn div_assign(&mut self, o: Self) {
+        if o.parts == 0 {
+            let v = self.v / o.v;
+            self.scale_by(o.v.recip());
+            self.v = v;
+        } else {
+            *self *= o.recip();
+        }
+    }
+}
+
+impl<S: Scalar<Real = R>, const N: usize, R: Real> Add for Jet<S, N, R> {
+    type Output = Self;
+    #[inline(always)]
+    fn add(mut self, mut o: Self) -> Self {
+        if self.parts == 0 {
+            o.v = self.v + o.v;
+            o
+        } else {
+            self.add_jet::<true>(&o);
+            self
+        }
+    }
+}
+
+impl<S: Scalar<Real = R>, const N: usize, R: Real> Sub for Jet<S, N, R> {
+    type Output = Self;
+    #[inline(always)]
+    fn sub(mut self, o: Self) -> Self {
+        self.add_jet::<false>(&o);
+        self
+    }
+}
+
+impl<S: Scalar<Real = R>, const N: usize, R: Real> Mul for Jet<S, N, R> {
+    type Output = Self;
+    #[inline(always)]
+    fn mul(mut self, mut o: Self) -> Self {
+        if self.parts == 0 {
+            o.scale_by(self.v);
+            o
+        } else {
+            self.mul_jet(&o);
+            self
+        }
+    }
+}
+
+impl<S: Scalar<Real = R>, const N: usize, R: Real> Div for Jet<S, N, R> {
+    type Output = Self;
+    #[inline(always)]
+    fn div(mut self, o: Self) -> Self {
+        self /= o;
+        self
+    }
+}
+
+impl<S: Scalar<Real = R>, const N: usize, R: Real> Neg for Jet<S, N, R> {
+    type Output = Self;
+    #[inline(always)]
+    fn neg(mut self) -> Self {
+        self.scale_by(-S::one());
+        self
+    }
+}
+
+/// `a op x` from `a op= x` for a plain number `x`.
+macro_rules! with_real {
+    ($op:ident, $f:ident, $assign:ident, $fa:ident) => {
+        impl<S: Scalar<Real = R>, const N: usize, R: Real> $op<R> for Jet<S, N, R> {
+            type Output = Self;
+            #[inline(always)]
+            fn $f(mut self, x: R) -> Self {
+                $assign::$fa(&mut self, x);
+                self
+            }
+        }
+    };
+}
+
+with_real!(Add, add, AddAssign, add_assign);
+with_real!(Sub, sub, SubAssign, sub_assign);
+with_real!(Mul, mul, MulAssign, mul_assign);
+with_real!(Div, div, DivAssign, div_assign);
+
+impl<S: Scalar<Real = R>, const N: usize, R: Real> AddAssign<R> for Jet<S, N, R> {
+    #[inline(always)]
+    fn add_assign(&mut self, x: R) {
+        self.v += x;
+    }
+}
+
+impl<S: Scalar<Real = R>, const N: usize, R: Real> SubAssign<R> for Jet<S, N, R> {
+    #[inline(always)]
+    fn sub_assign(&mut self, x: R) {
+        self.v -= x;
+    }
+}
+
+impl<S: Scalar<Real = R>, const N: usize, R: Real> MulAssign<R> for Jet<S, N, R> {
+    #[inline(always)]
+    fn mul_assign(&mut self, x: R) {
+        self.scale_by(S::from_real(x));
+    }
+}
+
+impl<S: Scalar<Real = R>, const N: usize, R: Real> DivAssign<R> for Jet<S, N, R> {
+    #[inline(always)]
+    fn div_assign(&mut self, x: R) {
+        *self /= Self::constant(S::from_real(x));
+    }
+}
+
+impl<S: Scalar<Real = R>, const N: usize, R: Real> Zero for Jet<S, N, R> {
+    fn zero() -> Self {
+        Self::constant(S::zero())
+    }
+    fn is_zero(&self) -> bool {
+        let flat = |x: &[S; N]| x.iter().all(Zero::is_zero);
+        self.v.is_zero()
+            && self.d.is_zero()
+            && flat(&self.gq)
+            && flat(&self.gp)
+            && flat(&self.dp)
+            && self.h.iter().all(flat)
+    }
+}
+
+impl<S: Scalar<Real = R>, const N: usize, R: Real> One for Jet<S, N, R> {
+    fn one() -> Self {
+        Self::constant(S::one())
+    }
+}
+
+impl<S: Scalar<Real = R>, const N: usize, R: Real> Scalar for Jet<S, N, R> {
+    type Real = R;
+
+    fn from_real(x: R) -> Self {
+        Self::constant(S::from_real(x))
+    }
+    fn from_f64(x: f64) -> Self {
+        Self::constant(S::from_f64(x))
+    }
+    fn value(self) -> R {
+        self.v.value()
+    }
+    #[inline(always)]
+    fn sin(mut self) -> Self {
+        let (s, c) = self.v.sin_cos();
+        self.chain(s, c, -s);
+        self
+    }
+    #[inline(always)]
+    fn cos(mut self) -> Self {
+        let (s, c) = self.v.sin_cos();
+        self.chain(c, -s, -c);
+        self
+    }
+    #[inline(always)]
+    fn sin_cos(self) -> (Self, Self) {
+        let (s, c) = self.v.sin_cos();
+        let mut cos = self;
+        let mut sin = self;
+        sin.chain(s, c, -s);
+        cos.chain(c, -s, -c);
+        (sin, cos)
+    }
+    fn tan(mut self) -> Self {
+        let t = self.v.tan();
+        let f1 = S::one() + t * t;
+        self.chain(t, f1, (t + t) * f1);
+        self
+    }
+    fn sqrt(mut self) -> Self {
+        let r = self.v.sqrt();
+        let f1 = (r + r).recip();
+        self.chain(r, f1, -(f1 * f1) / r);
+        self
+    }
+    fn exp(mut self) -> Self {
+        let e = self.v.exp();
+        self.chain(e, e, e);
+        self
+    }
+    fn ln(mut self) -> Self {
+        let r = self.v.recip();
+        self.chain(self.v.ln(), r, -(r * r));
+        self
+    }
+    fn powi(self, n: i32) -> Self {
+        powi_by_squaring(self, n)
+    }
+    fn abs(self) -> Self {
+        if self.v.value() < R::zero() {
+            -self
+        } else {
+            self
+        }
+    }
+    fn atan2(mut self, x: Self) -> Self {
+        // g(y, x) = atan2(y, x): g_y = x / r2, g_x = -y / r2, g_yy = -2 x y / r2^2 = -g_xx,
+        // g_yx = (y^2 - x^2) / r2^2.
+        let (y0, x0) = (self.v, x.v);
+        let inv = (x0 * x0 + y0 * y0).recip();
+        let xy = (x0 * y0 + x0 * y0) * inv * inv;
+        self.chain2(
+            &x,
+            y0.atan2(x0),
+            (x0 * inv, -(y0 * inv)),
+            (-xy, (y0 * y0 - x0 * x0) * inv * inv, xy),
+        );
+        self
+    }
+    #[inline(always)]
+    fn recip(mut self) -> Self {
+        let r = self.v.recip();
+        let f1 = -(r * r);
+        self.chain(r, f1, -(f1 + f1) * r);
+        self
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::Dual;
+
+    type J = Jet<f64, 2>;
+    type D2 = Dual<Dual<f64, 4>, 4>;
+
+    /// Variables of the jet: `q0, q1` moving at `r0, r1`, then `p0, p1`, time moving at 1.
+    fn jets(x: [f64; 5]) -> [J; 5] {
+        [
+            J::coordinate(x[0], 0, 0.3),
+            J::coordinate(x[1], 1, -0.7),
+            J::velocity(x[2], 0),
+            J::velocity(x[3], 1),
+            J::time(x[4]),
+        ]
+    }
+
+    /// The same with nested duals over `(q0, q1, p0, p1)`, and time as a constant.
+    fn duals(x: [f64; 5]) -> [D2; 5] {
+        let v = |k: usize| D2::variable(Dual::variable(x[k], k), k);
+        [v(0), v(1), v(2), v(3), D2::constant(Dual::constant(x[4]))]
+    }
+
+    /// A function of everything, through every operation a jet has.
+    fn f<S: Scalar<Real = f64>>([q0, q1, p0, p1, _]: [S; 5]) -> S {
+        let (s, c) = (q0 - q1).sin_cos();
+        let a = p0 * p0 * c + p0 * p1 * s * 1.5 - (p1 * q0).sin() / (q1.exp() + 2.0);
+        let b = (p0 + q1).cos() * (p1 * p1 + 1.0).sqrt() + (p0 * p0 + 3.0).ln() * q0.tan();
+        let e = (p1 - q0).atan2(p0 + 2.0) * (q1 + p0).recip() + (p1 - 2.0).abs().powi(3) / 4.0;
+        a + b * 0.5 + e - p0 / (q0 * q0 + 1.0)
+    }
+
+    /// Every part of the jet equals the nested duals' derivatives to rounding.
+    #[test]
+    fn parts_agree_with_nested_duals() {
+        let x = [0.4, -1.1, 0.8, -0.3, 2.0];
+        let j = f(jets(x));
+        let r = f(duals(x));
+        let rate = [0.3, -0.7];
+        let close = |a: f64, b: f64| (a - b).abs() <= 1e-13 * (1.0 + b.abs());
+        assert!(close(j.v, r.re.re));
+        for i in 0..2 {
+            assert!(close(j.gq[i], r.re.eps[i]), "gq {i}");
+            assert!(close(j.gp[i], r.re.eps[2 + i]), "gp {i}");
+            for k in 0..2 {
+                assert!(close(j.hessian(i, k), r.eps[2 + i].eps[2 + k]), "h {i} {k}");
+            }
+            let dp = r.eps[2 + i].eps[0] * rate[0] + r.eps[2 + i].eps[1] * rate[1];
+            assert!(close(j.dp[i], dp), "dp {i}: {} {dp}", j.dp[i]);
+        }
+        assert!(close(j.d, r.re.eps[0] * rate[0] + r.re.eps[1] * rate[1]));
+    }
+
+    /// A chain-like function of six coordinates (more than `DENSE`, so spans are tracked):
+    /// every part agrees with nested duals over all twelve variables.
+    #[test]
+    fn spans_agree_with_nested_duals() {
+        const M: usize = 6;
+        type Big = Dual<Dual<f64, 12>, 12>;
+        fn chain<S: Scalar<Real = f64>>(q: &[S; M], p: &[S; M]) -> S {
+            let (mut vx, mut vy, mut t) = (S::zero(), S::zero(), S::zero());
+            for j in 0..M {
+                let (s, c) = q[j].sin_cos();
+                let u = p[j] * (1.0 + 0.1 * j as f64);
+                vx += u * c;
+                vy += u * s;
+                t += (vx * vx + vy * vy) * (0.5 + 0.2 * j as f64);
+            }
+            // Terms that reach back to the first links, and one of two variables.
+            t + p[0] * p[M - 1] * q[2].cos() - (p[3] * q[4]).sin() / (q[0] * q[0] + 2.0)
+                + p[1].atan2(q[1] + 3.0)
+        }
+        let x: [f64; 2 * M] = core::array::from_fn(|i| 0.3 * (i as f64 + 1.0).sin());
+        let rate: [f64; M] = core::array::from_fn(|i| x[M + i]);
+        let jq: [Jet<f64, M>; M] = core::array::from_fn(|k| Jet::coordinate(x[k], k, rate[k]));
+        let jp: [Jet<f64, M>; M] = core::array::from_fn(|k| Jet::velocity(x[M + k], k));
+        let j = chain(&jq, &jp);
+        let v = |k: usize| Big::variable(Dual::variable(x[k], k), k);
+        let r = chain(
+            &core::array::from_fn(v),
+            &core::array::from_fn(|k| v(M + k)),
+        );
+        let close = |a: f64, b: f64| (a - b).abs() <= 1e-13 * (1.0 + b.abs());
+        assert!(close(j.v, r.re.re));
+        let mut d = 0.0;
+        for i in 0..M {
+            d += r.re.eps[i] * rate[i];
+            assert!(close(j.gq[i], r.re.eps[i]), "gq {i}");
+            assert!(close(j.gp[i], r.re.eps[M + i]), "gp {i}");
+            let mut dp = 0.0;
+            for k in 0..M {
+                assert!(close(j.hessian(i, k), r.eps[M + i].eps[M + k]), "h {i} {k}");
+                dp += r.eps[M + i].eps[k] * rate[k];
+            }
+            assert!(close(j.dp[i], dp), "dp {i}: {} {dp}", j.dp[i]);
+        }
+        assert!(close(j.d, d));
+    }
+
+    /// Time seeded along the direction: `d` and `dp` pick up `d/dt`.
+    #[test]
+    fn time_enters_the_direction() {
+        let [_, _, p0, _, t] = jets([0.0, 0.0, 0.5, 0.0, 2.0]);
+        let x = p0 * p0 * t;
+        // d/dt = p0^2 = 0.25; d/dt d/dp0 = 2 p0 = 1.
+        assert_eq!((x.d, x.dp[0]), (0.25, 1.0));
+    }
+
+    /// A constant touches no derivative, and division by one is exact.
+    #[test]
+    fn constants_stay_constant() {
+        let c = J::from_f64(2.0) * J::from_f64(3.0) / J::one() + 1.0;
+        assert_eq!(c, J::constant(7.0));
+        assert!((c - 7.0).is_zero());
+    }
+}
