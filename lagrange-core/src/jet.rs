@@ -20,11 +20,10 @@
 //! part is exactly zero (a parameter, a function of `q` only, a value linear in `q'`), and an
 //! operation touches only the parts its operands make non-zero: in the mass matrix's part of
 //! the work every sine and cosine of a coordinate is a plain number times the parts it has.
-
-// The loops below index `lo..hi` with `hi <= N`: their bounds checks fold away and small
-// ones unroll, where iterator chains with `skip` and `take` stayed loops (measured: a double
-// pendulum's acceleration took 3.7 times as long).
-#![allow(clippy::needless_range_loop)]
+//!
+//! The operators work in place on the operand they own and read the other by reference: a
+//! jet of a long chain is kilobytes, and a copy of one costs about as much as the arithmetic
+//! on it.
 
 use crate::scalar::{powi_by_squaring, Real, Scalar};
 use core::marker::PhantomData;
@@ -42,17 +41,10 @@ const D: u8 = 8;
 /// Flag of `dp`.
 const DP: u8 = 16;
 
-/// Up to this many coordinates every loop runs over all of them (unrolled, no bookkeeping);
-/// above it, over the jet's span only.
-pub(crate) const DENSE: usize = 4;
-
 /// A value with its first derivatives in the coordinates and velocities, its second
 /// derivatives in the velocities, and the derivative along one direction of it and of its
-/// velocity gradient (see the module's docs).
-///
-/// A part whose flag is clear is exactly zero, in its storage too; so is every entry of a
-/// part outside the span `lo..hi` of coordinates the value depends on (a link of a chain
-/// depends on the links before it only), over which alone the operations loop.
+/// velocity gradient (see the module's docs). A part whose flag is clear is exactly zero, in
+/// its storage too.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct Jet<S: Scalar, const N: usize, R = <S as Scalar>::Real> {
     /// The value.
@@ -61,10 +53,6 @@ pub(crate) struct Jet<S: Scalar, const N: usize, R = <S as Scalar>::Real> {
     pub(crate) d: S,
     /// Which parts may be non-zero.
     parts: u8,
-    /// The first coordinate of the span outside which every entry is zero.
-    lo: usize,
-    /// One past the last coordinate of the span.
-    hi: usize,
     /// `dx/dq`.
     pub(crate) gq: [S; N],
     /// `dx/dq'`.
@@ -76,149 +64,111 @@ pub(crate) struct Jet<S: Scalar, const N: usize, R = <S as Scalar>::Real> {
     real: PhantomData<R>,
 }
 
-/// The loop bounds of a span `lo..hi`: all of `0..N` for a small `N`. Capped at `N`, so
-/// that the compiler sees every index in range.
+/// `x *= c`.
 #[inline(always)]
-fn bounds<const N: usize>(lo: usize, hi: usize) -> (usize, usize) {
-    if N <= DENSE {
-        (0, N)
-    } else {
-        (lo, hi.min(N))
+fn scale<S: Scalar, const N: usize>(x: &mut [S; N], c: S) {
+    for e in x {
+        *e *= c;
     }
 }
 
-/// `x *= c` over `lo..hi`.
+/// `x += y`.
 #[inline(always)]
-fn scale<S: Scalar, const N: usize>(x: &mut [S; N], c: S, (lo, hi): (usize, usize)) {
-    for i in lo..hi {
-        x[i] *= c;
+fn add<S: Scalar, const N: usize>(x: &mut [S; N], y: &[S; N]) {
+    for (e, f) in x.iter_mut().zip(y) {
+        *e += *f;
     }
 }
 
-/// `x += y` over `lo..hi`.
+/// `x -= y`.
 #[inline(always)]
-fn add<S: Scalar, const N: usize>(x: &mut [S; N], y: &[S; N], (lo, hi): (usize, usize)) {
-    for i in lo..hi {
-        x[i] += y[i];
+fn sub<S: Scalar, const N: usize>(x: &mut [S; N], y: &[S; N]) {
+    for (e, f) in x.iter_mut().zip(y) {
+        *e -= *f;
     }
 }
 
-/// `x -= y` over `lo..hi`.
+/// `x += c y`.
 #[inline(always)]
-fn sub<S: Scalar, const N: usize>(x: &mut [S; N], y: &[S; N], (lo, hi): (usize, usize)) {
-    for i in lo..hi {
-        x[i] -= y[i];
+fn add_scaled<S: Scalar, const N: usize>(x: &mut [S; N], c: S, y: &[S; N]) {
+    for (e, f) in x.iter_mut().zip(y) {
+        *e += c * *f;
     }
 }
 
-/// `x += c y` over `lo..hi`.
+/// `x = a x + b y`.
 #[inline(always)]
-fn add_scaled<S: Scalar, const N: usize>(
-    x: &mut [S; N],
-    c: S,
-    y: &[S; N],
-    (lo, hi): (usize, usize),
-) {
-    for i in lo..hi {
-        x[i] += c * y[i];
+fn combine<S: Scalar, const N: usize>(x: &mut [S; N], a: S, b: S, y: &[S; N]) {
+    for (e, f) in x.iter_mut().zip(y) {
+        *e = a * *e + b * *f;
     }
 }
 
-/// `x = a x + b y` over `lo..hi`.
+/// Each row `i` of the upper triangle of `h` (from its diagonal) with `i`.
 #[inline(always)]
-fn combine<S: Scalar, const N: usize>(
-    x: &mut [S; N],
-    a: S,
-    b: S,
-    y: &[S; N],
-    (lo, hi): (usize, usize),
-) {
-    for i in lo..hi {
-        x[i] = a * x[i] + b * y[i];
-    }
+fn upper<S, const N: usize>(h: &mut [[S; N]; N]) -> impl Iterator<Item = (usize, &mut [S])> {
+    h.iter_mut()
+        .enumerate()
+        .map(|(i, row)| (i, row.get_mut(i..).unwrap_or_default()))
 }
 
-/// `h *= c` over the upper triangle of `lo..hi`.
+/// `h *= c` over the upper triangle.
 #[inline(always)]
-fn scale_upper<S: Scalar, const N: usize>(h: &mut [[S; N]; N], c: S, (lo, hi): (usize, usize)) {
-    for i in lo..hi {
-        for j in i..hi {
-            h[i][j] *= c;
+fn scale_upper<S: Scalar, const N: usize>(h: &mut [[S; N]; N], c: S) {
+    for (_, row) in upper(h) {
+        for e in row {
+            *e *= c;
         }
     }
 }
 
-/// `h += k` over the upper triangle of `lo..hi`.
+/// `h += k` over the upper triangle.
 #[inline(always)]
-fn add_upper<S: Scalar, const N: usize>(
-    h: &mut [[S; N]; N],
-    k: &[[S; N]; N],
-    (lo, hi): (usize, usize),
-) {
-    for i in lo..hi {
-        for j in i..hi {
-            h[i][j] += k[i][j];
+fn add_upper<S: Scalar, const N: usize>(h: &mut [[S; N]; N], k: &[[S; N]; N]) {
+    for ((i, row), other) in upper(h).zip(k) {
+        for (e, f) in row.iter_mut().zip(other.iter().skip(i)) {
+            *e += *f;
         }
     }
 }
 
-/// `h -= k` over the upper triangle of `lo..hi`.
+/// `h -= k` over the upper triangle.
 #[inline(always)]
-fn sub_upper<S: Scalar, const N: usize>(
-    h: &mut [[S; N]; N],
-    k: &[[S; N]; N],
-    (lo, hi): (usize, usize),
-) {
-    for i in lo..hi {
-        for j in i..hi {
-            h[i][j] -= k[i][j];
+fn sub_upper<S: Scalar, const N: usize>(h: &mut [[S; N]; N], k: &[[S; N]; N]) {
+    for ((i, row), other) in upper(h).zip(k) {
+        for (e, f) in row.iter_mut().zip(other.iter().skip(i)) {
+            *e -= *f;
         }
     }
 }
 
-/// `h += c k` over the upper triangle of `lo..hi`.
+/// `h += c k` over the upper triangle.
 #[inline(always)]
-fn add_scaled_upper<S: Scalar, const N: usize>(
-    h: &mut [[S; N]; N],
-    c: S,
-    k: &[[S; N]; N],
-    (lo, hi): (usize, usize),
-) {
-    for i in lo..hi {
-        for j in i..hi {
-            h[i][j] += c * k[i][j];
+fn add_scaled_upper<S: Scalar, const N: usize>(h: &mut [[S; N]; N], c: S, k: &[[S; N]; N]) {
+    for ((i, row), other) in upper(h).zip(k) {
+        for (e, f) in row.iter_mut().zip(other.iter().skip(i)) {
+            *e += c * *f;
         }
     }
 }
 
-/// `h += a b^T + b a^T` over the upper triangle of `lo..hi`.
+/// `h += a b^T + b a^T` over the upper triangle.
 #[inline(always)]
-fn add_outer<S: Scalar, const N: usize>(
-    h: &mut [[S; N]; N],
-    a: &[S; N],
-    b: &[S; N],
-    (lo, hi): (usize, usize),
-) {
-    for i in lo..hi {
-        let (ai, bi) = (a[i], b[i]);
-        for j in i..hi {
-            h[i][j] += ai * b[j] + bi * a[j];
+fn add_outer<S: Scalar, const N: usize>(h: &mut [[S; N]; N], a: &[S; N], b: &[S; N]) {
+    for ((i, row), (ai, bi)) in upper(h).zip(a.iter().zip(b)) {
+        for (e, (aj, bj)) in row.iter_mut().zip(a.iter().zip(b).skip(i)) {
+            *e += *ai * *bj + *bi * *aj;
         }
     }
 }
 
-/// `h += c a a^T` over the upper triangle of `lo..hi`.
+/// `h += c a a^T` over the upper triangle.
 #[inline(always)]
-fn add_square<S: Scalar, const N: usize>(
-    h: &mut [[S; N]; N],
-    c: S,
-    a: &[S; N],
-    (lo, hi): (usize, usize),
-) {
-    for i in lo..hi {
-        let ai = a[i] * c;
-        for j in i..hi {
-            h[i][j] += ai * a[j];
+fn add_square<S: Scalar, const N: usize>(h: &mut [[S; N]; N], c: S, a: &[S; N]) {
+    for ((i, row), ai) in upper(h).zip(a) {
+        let ci = c * *ai;
+        for (e, aj) in row.iter_mut().zip(a.iter().skip(i)) {
+            *e += ci * *aj;
         }
     }
 }
@@ -231,8 +181,6 @@ impl<S: Scalar<Real = R>, const N: usize, R: Real> Jet<S, N, R> {
             v,
             d: S::zero(),
             parts: 0,
-            lo: N,
-            hi: 0,
             gq: [S::zero(); N],
             gp: [S::zero(); N],
             dp: [S::zero(); N],
@@ -241,86 +189,51 @@ impl<S: Scalar<Real = R>, const N: usize, R: Real> Jet<S, N, R> {
         }
     }
 
-    /// The value `v`, in place of a constant (every derivative of `self` zero).
+    /// Coordinate `k` at `q`, moving at `rate` along the direction (`gq` and `d` seeded).
     #[inline(always)]
-    fn reset_constant(&mut self, v: S) {
-        debug_assert!(self.parts == 0);
-        self.v = v;
-    }
-
-    /// Widens the span to `k`.
-    #[inline(always)]
-    fn include(&mut self, k: usize) {
-        if N > DENSE {
-            self.lo = self.lo.min(k);
-            self.hi = self.hi.max(k + 1);
-        }
-    }
-
-    /// Widens the span to that of `o`.
-    #[inline(always)]
-    fn include_span(&mut self, o: &Self) {
-        if N > DENSE {
-            self.lo = self.lo.min(o.lo);
-            self.hi = self.hi.max(o.hi);
-        }
-    }
-
-    /// The loop bounds of the span.
-    #[inline(always)]
-    fn span(&self) -> (usize, usize) {
-        bounds::<N>(self.lo, self.hi)
-    }
-
-    /// The loop bounds of the union of the spans of `self` and `o`.
-    #[inline(always)]
-    fn union(&self, o: &Self) -> (usize, usize) {
-        bounds::<N>(self.lo.min(o.lo), self.hi.max(o.hi))
-    }
-
-    /// Sets `self` to coordinate `k` at `q`, moving at `rate` along the direction (`gq` and
-    /// `d` seeded); `self` a constant.
-    pub(crate) fn seed_coordinate(&mut self, q: S, k: usize, rate: S) {
-        self.reset_constant(q);
-        if let Some(e) = self.gq.get_mut(k) {
-            *e = S::one();
-            self.parts |= GQ;
-            self.include(k);
-        }
-        self.d = rate;
-        self.parts |= D;
-    }
-
-    /// Sets `self` to velocity `k` at `qd` (`gp` seeded); `self` a constant.
-    pub(crate) fn seed_velocity(&mut self, qd: S, k: usize) {
-        self.reset_constant(qd);
-        if let Some(e) = self.gp.get_mut(k) {
-            *e = S::one();
-            self.parts |= GP;
-            self.include(k);
-        }
-    }
-
-    /// Coordinate `k` at `q`, moving at `rate` along the direction.
     pub(crate) fn coordinate(q: S, k: usize, rate: S) -> Self {
-        let mut x = Self::constant(S::zero());
+        let mut x = Self::constant(q);
         x.seed_coordinate(q, k, rate);
         x
     }
 
-    /// Velocity `k` at `qd`.
+    /// Velocity `k` at `qd` (`gp` seeded).
+    #[inline(always)]
     pub(crate) fn velocity(qd: S, k: usize) -> Self {
-        let mut x = Self::constant(S::zero());
+        let mut x = Self::constant(qd);
         x.seed_velocity(qd, k);
         x
     }
 
     /// Time at `t`, moving at unit rate along the direction (`d` seeded).
+    #[inline(always)]
     pub(crate) fn time(t: S) -> Self {
         let mut x = Self::constant(t);
         x.d = S::one();
-        x.parts |= D;
+        x.parts = D;
         x
+    }
+
+    /// Makes `self`, a constant, coordinate `k` at `q` moving at `rate`.
+    #[inline(always)]
+    fn seed_coordinate(&mut self, q: S, k: usize, rate: S) {
+        self.v = q;
+        if let Some(e) = self.gq.get_mut(k) {
+            *e = S::one();
+            self.parts |= GQ;
+        }
+        self.d = rate;
+        self.parts |= D;
+    }
+
+    /// Makes `self`, a constant, velocity `k` at `qd`.
+    #[inline(always)]
+    fn seed_velocity(&mut self, qd: S, k: usize) {
+        self.v = qd;
+        if let Some(e) = self.gp.get_mut(k) {
+            *e = S::one();
+            self.parts |= GP;
+        }
     }
 
     /// `d2x/dq'_i dq'_j`, read from the stored upper triangle.
@@ -337,46 +250,70 @@ impl<S: Scalar<Real = R>, const N: usize, R: Real> Jet<S, N, R> {
     #[inline(always)]
     fn scale_by(&mut self, c: S) {
         self.v *= c;
-        let (p, span) = (self.parts, self.span());
+        let p = self.parts;
         if p & GQ != 0 {
-            scale(&mut self.gq, c, span);
+            scale(&mut self.gq, c);
         }
         if p & GP != 0 {
-            scale(&mut self.gp, c, span);
+            scale(&mut self.gp, c);
         }
         if p & H != 0 {
-            scale_upper(&mut self.h, c, span);
+            scale_upper(&mut self.h, c);
         }
         if p & D != 0 {
             self.d *= c;
         }
         if p & DP != 0 {
-            scale(&mut self.dp, c, span);
+            scale(&mut self.dp, c);
         }
+    }
+
+    /// `self = c o` for `self` a constant: only the parts `o` has are written (the rest of
+    /// `self` is zero already).
+    #[inline(always)]
+    fn set_scaled(&mut self, c: S, o: &Self) {
+        let p = o.parts;
+        self.v = c * o.v;
+        if p & GQ != 0 {
+            add_scaled(&mut self.gq, c, &o.gq);
+        }
+        if p & GP != 0 {
+            add_scaled(&mut self.gp, c, &o.gp);
+        }
+        if p & H != 0 {
+            add_scaled_upper(&mut self.h, c, &o.h);
+        }
+        if p & D != 0 {
+            self.d = c * o.d;
+        }
+        if p & DP != 0 {
+            add_scaled(&mut self.dp, c, &o.dp);
+        }
+        self.parts = p;
     }
 
     /// `self = g(self)` for a function `g` with value `f0`, first derivative `f1` and second
     /// derivative `f2` at `self.v`.
     #[inline(always)]
     fn chain(&mut self, f0: S, f1: S, f2: S) {
-        let (p, span) = (self.parts, self.span());
+        let p = self.parts;
         if p & GP != 0 {
             if p & H != 0 {
-                scale_upper(&mut self.h, f1, span);
+                scale_upper(&mut self.h, f1);
             }
-            add_square(&mut self.h, f2, &self.gp, span);
+            add_square(&mut self.h, f2, &self.gp);
             if p & DP != 0 {
-                scale(&mut self.dp, f1, span);
+                scale(&mut self.dp, f1);
             }
             if p & D != 0 {
-                add_scaled(&mut self.dp, f2 * self.d, &self.gp, span);
+                add_scaled(&mut self.dp, f2 * self.d, &self.gp);
                 self.parts |= DP;
             }
-            scale(&mut self.gp, f1, span);
+            scale(&mut self.gp, f1);
             self.parts |= H;
         }
         if p & GQ != 0 {
-            scale(&mut self.gq, f1, span);
+            scale(&mut self.gq, f1);
         }
         if p & D != 0 {
             self.d *= f1;
@@ -388,9 +325,7 @@ impl<S: Scalar<Real = R>, const N: usize, R: Real> Jet<S, N, R> {
     /// and second derivatives `faa`, `fab`, `fbb` at `(self.v, o.v)` (every part computed:
     /// for the rare functions of two variables).
     fn chain2(&mut self, o: &Self, f0: S, (fa, fb): (S, S), (faa, fab, fbb): (S, S, S)) {
-        let a = *self;
-        let b = o;
-        let all = (0, N);
+        let (a, b) = (*self, o);
         let mix = |x: &[S; N], y: &[S; N]| core::array::from_fn(|i| fa * x[i] + fb * y[i]);
         self.gq = mix(&a.gq, &b.gq);
         self.gp = mix(&a.gp, &b.gp);
@@ -401,117 +336,63 @@ impl<S: Scalar<Real = R>, const N: usize, R: Real> Jet<S, N, R> {
                 + (faa * a.d + fab * b.d) * a.gp[i]
                 + (fbb * b.d + fab * a.d) * b.gp[i]
         });
-        scale_upper(&mut self.h, fa, all);
-        add_scaled_upper(&mut self.h, fb, &b.h, all);
-        add_square(&mut self.h, faa, &a.gp, all);
-        add_square(&mut self.h, fbb, &b.gp, all);
-        let fab_b = b.gp.map(|x| x * fab);
-        add_outer(&mut self.h, &a.gp, &fab_b, all);
+        scale_upper(&mut self.h, fa);
+        add_scaled_upper(&mut self.h, fb, &b.h);
+        add_square(&mut self.h, faa, &a.gp);
+        add_square(&mut self.h, fbb, &b.gp);
+        add_outer(&mut self.h, &a.gp, &b.gp.map(|x| x * fab));
         self.v = f0;
         self.parts = a.parts | b.parts;
         if self.parts & GP != 0 {
             self.parts |= H | DP;
         }
-        self.include_span(b);
     }
 
-    /// `self *= o` when both have derivatives.
+    /// `self += o`, or `self -= o` with `PLUS` false.
     #[inline(always)]
-    fn mul_general(&mut self, o: &Self) {
-        let (a, b) = (self.parts, o.parts);
-        let (av, bv) = (self.v, o.v);
-        let (sa, sb, su) = (self.span(), o.span(), self.union(o));
-        // Second-order parts first: they read the first-order parts before those change.
-        if a & H != 0 {
-            scale_upper(&mut self.h, bv, sa);
-        }
-        if b & H != 0 {
-            add_scaled_upper(&mut self.h, av, &o.h, sb);
-        }
-        if a & GP != 0 && b & GP != 0 {
-            add_outer(&mut self.h, &self.gp, &o.gp, su);
-            self.parts |= H;
-        }
-        if a & DP != 0 {
-            scale(&mut self.dp, bv, sa);
-        }
-        if b & DP != 0 {
-            add_scaled(&mut self.dp, av, &o.dp, sb);
-        }
-        if a & GP != 0 && b & D != 0 {
-            add_scaled(&mut self.dp, o.d, &self.gp, sa);
-            self.parts |= DP;
-        }
-        if a & D != 0 && b & GP != 0 {
-            add_scaled(&mut self.dp, self.d, &o.gp, sb);
-            self.parts |= DP;
-        }
-        // First-order parts: x' = b.v a' + a.v b'.
-        for (flag, x, y) in [(GQ, &mut self.gq, &o.gq), (GP, &mut self.gp, &o.gp)] {
-            match (a & flag != 0, b & flag != 0) {
-                (true, true) => combine(x, bv, av, y, su),
-                (true, false) => scale(x, bv, sa),
-                (false, true) => add_scaled(x, av, y, sb),
-                (false, false) => {}
-            }
-        }
-        self.d = bv * self.d + av * o.d;
-        self.v = av * bv;
-        self.parts |= b;
-        self.include_span(o);
-    }
-}
-
-impl<S: Scalar<Real = R>, const N: usize, R: Real> Jet<S, N, R> {
-    /// `self += o` (or `-=` with `SIGN` false).
-    #[inline(always)]
-    fn add_jet<const SIGN: bool>(&mut self, o: &Self) {
-        let (p, span) = (o.parts, o.span());
-        if SIGN {
+    fn add_jet<const PLUS: bool>(&mut self, o: &Self) {
+        let p = o.parts;
+        if PLUS {
             self.v += o.v;
         } else {
             self.v -= o.v;
         }
-        if p == 0 {
-            return;
-        }
         if p & GQ != 0 {
-            if SIGN {
-                add(&mut self.gq, &o.gq, span);
+            if PLUS {
+                add(&mut self.gq, &o.gq);
             } else {
-                sub(&mut self.gq, &o.gq, span);
+                sub(&mut self.gq, &o.gq);
             }
         }
         if p & GP != 0 {
-            if SIGN {
-                add(&mut self.gp, &o.gp, span);
+            if PLUS {
+                add(&mut self.gp, &o.gp);
             } else {
-                sub(&mut self.gp, &o.gp, span);
+                sub(&mut self.gp, &o.gp);
             }
         }
         if p & H != 0 {
-            if SIGN {
-                add_upper(&mut self.h, &o.h, span);
+            if PLUS {
+                add_upper(&mut self.h, &o.h);
             } else {
-                sub_upper(&mut self.h, &o.h, span);
+                sub_upper(&mut self.h, &o.h);
             }
         }
         if p & D != 0 {
-            if SIGN {
+            if PLUS {
                 self.d += o.d;
             } else {
                 self.d -= o.d;
             }
         }
         if p & DP != 0 {
-            if SIGN {
-                add(&mut self.dp, &o.dp, span);
+            if PLUS {
+                add(&mut self.dp, &o.dp);
             } else {
-                sub(&mut self.dp, &o.dp, span);
+                sub(&mut self.dp, &o.dp);
             }
         }
         self.parts |= p;
-        self.include_span(o);
     }
 
     /// `self *= o`.
@@ -519,14 +400,57 @@ impl<S: Scalar<Real = R>, const N: usize, R: Real> Jet<S, N, R> {
     fn mul_jet(&mut self, o: &Self) {
         if o.parts == 0 {
             self.scale_by(o.v);
+        } else if self.parts == 0 {
+            self.set_scaled(self.v, o);
         } else {
             self.mul_general(o);
         }
     }
-}
 
-// The operators work in place on an operand they own, and take the other by reference: a
-// jet of a long chain is kilobytes, and every copy of one costs as much as the arithmetic.
+    /// `self *= o` when both have derivatives.
+    #[inline(always)]
+    fn mul_general(&mut self, o: &Self) {
+        let (a, b) = (self.parts, o.parts);
+        let (av, bv) = (self.v, o.v);
+        // Second-order parts first: they read the first-order parts before those change.
+        if a & H != 0 {
+            scale_upper(&mut self.h, bv);
+        }
+        if b & H != 0 {
+            add_scaled_upper(&mut self.h, av, &o.h);
+        }
+        if a & GP != 0 && b & GP != 0 {
+            add_outer(&mut self.h, &self.gp, &o.gp);
+            self.parts |= H;
+        }
+        if a & DP != 0 {
+            scale(&mut self.dp, bv);
+        }
+        if b & DP != 0 {
+            add_scaled(&mut self.dp, av, &o.dp);
+        }
+        if a & GP != 0 && b & D != 0 {
+            add_scaled(&mut self.dp, o.d, &self.gp);
+            self.parts |= DP;
+        }
+        if a & D != 0 && b & GP != 0 {
+            add_scaled(&mut self.dp, self.d, &o.gp);
+            self.parts |= DP;
+        }
+        // First-order parts: x' = b.v a' + a.v b'.
+        for (flag, x, y) in [(GQ, &mut self.gq, &o.gq), (GP, &mut self.gp, &o.gp)] {
+            match (a & flag != 0, b & flag != 0) {
+                (true, true) => combine(x, bv, av, y),
+                (true, false) => scale(x, bv),
+                (false, true) => add_scaled(x, av, y),
+                (false, false) => {}
+            }
+        }
+        self.d = bv * self.d + av * o.d;
+        self.v = av * bv;
+        self.parts |= b;
+    }
+}
 
 impl<S: Scalar<Real = R>, const N: usize, R: Real> AddAssign for Jet<S, N, R> {
     #[inline(always)]
@@ -544,13 +468,8 @@ impl<S: Scalar<Real = R>, const N: usize, R: Real> SubAssign for Jet<S, N, R> {
 
 impl<S: Scalar<Real = R>, const N: usize, R: Real> MulAssign for Jet<S, N, R> {
     #[inline(always)]
-    fn mul_assign(&mut self, mut o: Self) {
-        if self.parts == 0 {
-            o.scale_by(self.v);
-            *self = o;
-        } else {
-            self.mul_jet(&o);
-        }
+    fn mul_assign(&mut self, o: Self) {
+        self.mul_jet(&o);
     }
 }
 
@@ -562,56 +481,37 @@ impl<S: Scalar<Real = R>, const N: usize, R: Real> DivAssign for Jet<S, N, R> {
             self.scale_by(o.v.recip());
             self.v = v;
         } else {
-            *self *= o.recip();
+            self.mul_jet(&o.recip());
         }
     }
 }
 
-impl<S: Scalar<Real = R>, const N: usize, R: Real> Add for Jet<S, N, R> {
-    type Output = Self;
-    #[inline(always)]
-    fn add(mut self, mut o: Self) -> Self {
-        if self.parts == 0 {
-            o.v = self.v + o.v;
-            o
-        } else {
-            self.add_jet::<true>(&o);
-            self
+/// `a op b` from `a op= b`, for jets and for plain numbers on the right.
+macro_rules! by_value {
+    ($op:ident, $f:ident, $assign:ident, $fa:ident) => {
+        impl<S: Scalar<Real = R>, const N: usize, R: Real> $op for Jet<S, N, R> {
+            type Output = Self;
+            #[inline(always)]
+            fn $f(mut self, o: Self) -> Self {
+                $assign::$fa(&mut self, o);
+                self
+            }
         }
-    }
-}
-
-impl<S: Scalar<Real = R>, const N: usize, R: Real> Sub for Jet<S, N, R> {
-    type Output = Self;
-    #[inline(always)]
-    fn sub(mut self, o: Self) -> Self {
-        self.add_jet::<false>(&o);
-        self
-    }
-}
-
-impl<S: Scalar<Real = R>, const N: usize, R: Real> Mul for Jet<S, N, R> {
-    type Output = Self;
-    #[inline(always)]
-    fn mul(mut self, mut o: Self) -> Self {
-        if self.parts == 0 {
-            o.scale_by(self.v);
-            o
-        } else {
-            self.mul_jet(&o);
-            self
+        impl<S: Scalar<Real = R>, const N: usize, R: Real> $op<R> for Jet<S, N, R> {
+            type Output = Self;
+            #[inline(always)]
+            fn $f(mut self, o: R) -> Self {
+                $assign::$fa(&mut self, o);
+                self
+            }
         }
-    }
+    };
 }
 
-impl<S: Scalar<Real = R>, const N: usize, R: Real> Div for Jet<S, N, R> {
-    type Output = Self;
-    #[inline(always)]
-    fn div(mut self, o: Self) -> Self {
-        self /= o;
-        self
-    }
-}
+by_value!(Add, add, AddAssign, add_assign);
+by_value!(Sub, sub, SubAssign, sub_assign);
+by_value!(Mul, mul, MulAssign, mul_assign);
+by_value!(Div, div, DivAssign, div_assign);
 
 impl<S: Scalar<Real = R>, const N: usize, R: Real> Neg for Jet<S, N, R> {
     type Output = Self;
@@ -621,25 +521,6 @@ impl<S: Scalar<Real = R>, const N: usize, R: Real> Neg for Jet<S, N, R> {
         self
     }
 }
-
-/// `a op x` from `a op= x` for a plain number `x`.
-macro_rules! with_real {
-    ($op:ident, $f:ident, $assign:ident, $fa:ident) => {
-        impl<S: Scalar<Real = R>, const N: usize, R: Real> $op<R> for Jet<S, N, R> {
-            type Output = Self;
-            #[inline(always)]
-            fn $f(mut self, x: R) -> Self {
-                $assign::$fa(&mut self, x);
-                self
-            }
-        }
-    };
-}
-
-with_real!(Add, add, AddAssign, add_assign);
-with_real!(Sub, sub, SubAssign, sub_assign);
-with_real!(Mul, mul, MulAssign, mul_assign);
-with_real!(Div, div, DivAssign, div_assign);
 
 impl<S: Scalar<Real = R>, const N: usize, R: Real> AddAssign<R> for Jet<S, N, R> {
     #[inline(always)]
@@ -833,8 +714,8 @@ mod tests {
         assert!(close(j.d, r.re.eps[0] * rate[0] + r.re.eps[1] * rate[1]));
     }
 
-    /// A chain-like function of six coordinates (more than `DENSE`, so spans are tracked):
-    /// every part agrees with nested duals over all twelve variables.
+    /// A chain-like function of six coordinates: every part agrees with nested duals over all
+    /// twelve variables.
     #[test]
     fn spans_agree_with_nested_duals() {
         const M: usize = 6;
@@ -870,9 +751,9 @@ mod tests {
             assert!(close(j.gq[i], r.re.eps[i]), "gq {i}");
             assert!(close(j.gp[i], r.re.eps[M + i]), "gp {i}");
             let mut dp = 0.0;
-            for k in 0..M {
+            for (k, rk) in rate.iter().enumerate() {
                 assert!(close(j.hessian(i, k), r.eps[M + i].eps[M + k]), "h {i} {k}");
-                dp += r.eps[M + i].eps[k] * rate[k];
+                dp += r.eps[M + i].eps[k] * rk;
             }
             assert!(close(j.dp[i], dp), "dp {i}: {} {dp}", j.dp[i]);
         }

@@ -1,7 +1,7 @@
 //! Automatic Euler-Lagrange: write `T` and `V` once, generic over a [`Scalar`], and get the
 //! equations of motion by differentiating them with forward-mode dual numbers.
 
-use crate::jet::{Jet, DENSE};
+use crate::jet::Jet;
 use crate::mechanism::finite;
 use crate::{
     central_difference_jacobian, solve_spd, Cholesky, Dual, Error, GeneralizedForce, Jacobian,
@@ -104,13 +104,12 @@ type Directional<T> = Dual<T, 1>;
 /// gradients in `q` and `q'`, the upper half of its Hessian in `q'` (that is `M`), and the
 /// derivative of its velocity gradient along `(dq, dt) = (q', 1)` (the mixed and time terms
 /// at once, `O(N)` per operation instead of a second Hessian); parts that are exactly zero (a
-/// parameter, a function of `q` alone, a value linear in `q'`) are skipped, and for `N > 4`
-/// so are the coordinates a value does not depend on. `M q'' = f + Q` is then solved by
-/// Cholesky ([`solve_spd`]). No symbolic step, no heap. This is both the general path for a
+/// parameter, a function of `q` alone, a value linear in `q'`) are skipped. `M q'' = f + Q`
+/// is then solved by Cholesky ([`solve_spd`]). No symbolic step, no heap. This is both the general path for a
 /// user's own mechanism and the oracle the hand-derived systems are tested against.
 ///
-/// Cost: for a kinetic energy of `K` operations, about `K N^2 / 2` for `M` (less where values
-/// depend on few coordinates) and `K N` for `f`, plus `N^3 / 6` for the solve; a jet holds
+/// Cost: for a kinetic energy of `K` operations, up to `K N^2 / 2` for `M` (less where parts
+/// are zero) and `K N` for `f`, plus `N^3 / 6` for the solve; a jet holds
 /// `N^2 + 3 N + 2` numbers, which for a long chain (kilobytes at `N = 20`) makes copying them
 /// a large part of the cost.
 ///
@@ -179,32 +178,14 @@ where
     } else {
         Jet::constant(t)
     };
-    let (jq, jqd) = if N <= DENSE {
-        // Small: built whole, so that the compiler can follow every seed through `T`.
-        (
-            SVector::from_fn(|k, _| {
-                if moving {
-                    Jet::coordinate(q[k], k, qd[k])
-                } else {
-                    Jet::constant(q[k])
-                }
-            }),
-            SVector::from_fn(|k, _| Jet::velocity(qd[k], k)),
-        )
-    } else {
-        // Large: made in place, a jet of a long chain being kilobytes.
-        let mut jq = SVector::<Jet<S, N>, N>::from_element(Jet::constant(S::zero()));
-        let mut jqd = jq;
-        for (k, (x, v)) in jq.iter_mut().zip(jqd.iter_mut()).enumerate() {
-            if moving {
-                x.seed_coordinate(q[k], k, qd[k]);
-            } else {
-                x.v = q[k];
-            }
-            v.seed_velocity(qd[k], k);
+    let jq = SVector::<Jet<S, N>, N>::from_fn(|k, _| {
+        if moving {
+            Jet::coordinate(q[k], k, qd[k])
+        } else {
+            Jet::constant(q[k])
         }
-        (jq, jqd)
-    };
+    });
+    let jqd = SVector::<Jet<S, N>, N>::from_fn(|k, _| Jet::velocity(qd[k], k));
     l.kinetic(t, &jq, &jqd)
 }
 
