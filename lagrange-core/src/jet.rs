@@ -96,6 +96,14 @@ fn add_scaled<S: Scalar, const N: usize>(x: &mut [S; N], c: S, y: &[S; N]) {
     }
 }
 
+/// `x = c y`.
+#[inline(always)]
+fn set_scaled<S: Scalar, const N: usize>(x: &mut [S; N], c: S, y: &[S; N]) {
+    for (e, f) in x.iter_mut().zip(y) {
+        *e = c * *f;
+    }
+}
+
 /// `x = a x + b y`.
 #[inline(always)]
 fn combine<S: Scalar, const N: usize>(x: &mut [S; N], a: S, b: S, y: &[S; N]) {
@@ -246,48 +254,36 @@ impl<S: Scalar<Real = R>, const N: usize, R: Real> Jet<S, N, R> {
             .unwrap_or_else(S::zero)
     }
 
-    /// Every part times `c`.
+    /// Every part times `c` (the first-order parts whatever their flags: zeros stay zero).
     #[inline(always)]
     fn scale_by(&mut self, c: S) {
         self.v *= c;
+        self.d *= c;
+        scale(&mut self.gq, c);
+        scale(&mut self.gp, c);
         let p = self.parts;
-        if p & GQ != 0 {
-            scale(&mut self.gq, c);
-        }
-        if p & GP != 0 {
-            scale(&mut self.gp, c);
-        }
         if p & H != 0 {
             scale_upper(&mut self.h, c);
-        }
-        if p & D != 0 {
-            self.d *= c;
         }
         if p & DP != 0 {
             scale(&mut self.dp, c);
         }
     }
 
-    /// `self = c o` for `self` a constant: only the parts `o` has are written (the rest of
-    /// `self` is zero already).
+    /// `self = c o` for `self` a constant: the second-order parts only where `o` has them
+    /// (they are zero in `self` already).
     #[inline(always)]
     fn set_scaled(&mut self, c: S, o: &Self) {
         let p = o.parts;
         self.v = c * o.v;
-        if p & GQ != 0 {
-            add_scaled(&mut self.gq, c, &o.gq);
-        }
-        if p & GP != 0 {
-            add_scaled(&mut self.gp, c, &o.gp);
-        }
+        self.d = c * o.d;
+        set_scaled(&mut self.gq, c, &o.gq);
+        set_scaled(&mut self.gp, c, &o.gp);
         if p & H != 0 {
             add_scaled_upper(&mut self.h, c, &o.h);
         }
-        if p & D != 0 {
-            self.d = c * o.d;
-        }
         if p & DP != 0 {
-            add_scaled(&mut self.dp, c, &o.dp);
+            set_scaled(&mut self.dp, c, &o.dp);
         }
         self.parts = p;
     }
@@ -305,19 +301,12 @@ impl<S: Scalar<Real = R>, const N: usize, R: Real> Jet<S, N, R> {
             if p & DP != 0 {
                 scale(&mut self.dp, f1);
             }
-            if p & D != 0 {
-                add_scaled(&mut self.dp, f2 * self.d, &self.gp);
-                self.parts |= DP;
-            }
-            scale(&mut self.gp, f1);
-            self.parts |= H;
+            add_scaled(&mut self.dp, f2 * self.d, &self.gp);
+            self.parts |= H | DP;
         }
-        if p & GQ != 0 {
-            scale(&mut self.gq, f1);
-        }
-        if p & D != 0 {
-            self.d *= f1;
-        }
+        scale(&mut self.gp, f1);
+        scale(&mut self.gq, f1);
+        self.d *= f1;
         self.v = f0;
     }
 
@@ -348,41 +337,27 @@ impl<S: Scalar<Real = R>, const N: usize, R: Real> Jet<S, N, R> {
         }
     }
 
-    /// `self += o`, or `self -= o` with `PLUS` false.
+    /// `self += o`, or `self -= o` with `PLUS` false (the first-order parts whatever their
+    /// flags).
     #[inline(always)]
     fn add_jet<const PLUS: bool>(&mut self, o: &Self) {
         let p = o.parts;
         if PLUS {
             self.v += o.v;
+            self.d += o.d;
+            add(&mut self.gq, &o.gq);
+            add(&mut self.gp, &o.gp);
         } else {
             self.v -= o.v;
-        }
-        if p & GQ != 0 {
-            if PLUS {
-                add(&mut self.gq, &o.gq);
-            } else {
-                sub(&mut self.gq, &o.gq);
-            }
-        }
-        if p & GP != 0 {
-            if PLUS {
-                add(&mut self.gp, &o.gp);
-            } else {
-                sub(&mut self.gp, &o.gp);
-            }
+            self.d -= o.d;
+            sub(&mut self.gq, &o.gq);
+            sub(&mut self.gp, &o.gp);
         }
         if p & H != 0 {
             if PLUS {
                 add_upper(&mut self.h, &o.h);
             } else {
                 sub_upper(&mut self.h, &o.h);
-            }
-        }
-        if p & D != 0 {
-            if PLUS {
-                self.d += o.d;
-            } else {
-                self.d -= o.d;
             }
         }
         if p & DP != 0 {
@@ -419,15 +394,13 @@ impl<S: Scalar<Real = R>, const N: usize, R: Real> Jet<S, N, R> {
         if b & H != 0 {
             add_scaled_upper(&mut self.h, av, &o.h);
         }
-        if a & GP != 0 && b & GP != 0 {
+        if a & b & GP != 0 {
             add_outer(&mut self.h, &self.gp, &o.gp);
             self.parts |= H;
         }
-        if a & DP != 0 {
-            scale(&mut self.dp, bv);
-        }
-        if b & DP != 0 {
-            add_scaled(&mut self.dp, av, &o.dp);
+        // dp' = b.v a.dp + a.v b.dp + b.d a.gp + a.d b.gp.
+        if (a | b) & DP != 0 {
+            combine(&mut self.dp, bv, av, &o.dp);
         }
         if a & GP != 0 && b & D != 0 {
             add_scaled(&mut self.dp, o.d, &self.gp);
@@ -438,14 +411,8 @@ impl<S: Scalar<Real = R>, const N: usize, R: Real> Jet<S, N, R> {
             self.parts |= DP;
         }
         // First-order parts: x' = b.v a' + a.v b'.
-        for (flag, x, y) in [(GQ, &mut self.gq, &o.gq), (GP, &mut self.gp, &o.gp)] {
-            match (a & flag != 0, b & flag != 0) {
-                (true, true) => combine(x, bv, av, y),
-                (true, false) => scale(x, bv),
-                (false, true) => add_scaled(x, av, y),
-                (false, false) => {}
-            }
-        }
+        combine(&mut self.gq, bv, av, &o.gq);
+        combine(&mut self.gp, bv, av, &o.gp);
         self.d = bv * self.d + av * o.d;
         self.v = av * bv;
         self.parts |= b;
