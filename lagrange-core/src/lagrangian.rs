@@ -156,37 +156,40 @@ impl<T: Real, const N: usize, L: defmt::Format> defmt::Format for EulerLagrange<
     }
 }
 
-/// `T` at `(t, q, q')` over a [`Jet`]: velocities seeded, and, when `moving`, coordinates
-/// seeded and moving at `q'` (and time at unit rate where [`Lagrangian::EXPLICIT_TIME`]), so
-/// that the jet's directional parts give the mixed and time terms. Not `moving`, every
-/// function of `q` is a plain number to the jet: only the mass matrix is computed.
-#[inline(always)]
+/// `M = d2T/dq'dq'` and `T`'s part of `f`, `dT/dq - (d2T/dq'dq) q' - d2T/dq'dt`, from `T` at
+/// `(t, q, q')` over a [`Jet`] (velocities seeded, coordinates seeded and moving at `q'`, and
+/// time at unit rate where [`Lagrangian::EXPLICIT_TIME`], so that the jet's directional parts
+/// give the mixed and time terms).
+///
+/// The one place that evaluates `T` over a jet, for every use (the law, `M` alone, `f`
+/// alone, the time term), and kept out of line, so that each scalar's `T` over a jet has this
+/// one caller: the compiler may then inline it here, where every seed's flags are known, and
+/// fold the jet's tests of them away. (Whether it does depends on the size of `T`; the
+/// automatic-cost bench measured no difference from two callers on this machine.)
+#[inline(never)]
 fn kinetic_jet<T, S, L, const N: usize>(
     l: &L,
     t: S,
     q: &SVector<S, N>,
     qd: &SVector<S, N>,
-    moving: bool,
-) -> Jet<S, N>
+) -> (SMatrix<S, N, N>, SVector<S, N>)
 where
     T: Real,
     S: Scalar<Real = T>,
     L: Lagrangian<T, N>,
 {
-    let t = if moving && L::EXPLICIT_TIME {
+    let t = if L::EXPLICIT_TIME {
         Jet::time(t)
     } else {
         Jet::constant(t)
     };
-    let jq = SVector::<Jet<S, N>, N>::from_fn(|k, _| {
-        if moving {
-            Jet::coordinate(q[k], k, qd[k])
-        } else {
-            Jet::constant(q[k])
-        }
-    });
+    let jq = SVector::<Jet<S, N>, N>::from_fn(|k, _| Jet::coordinate(q[k], k, qd[k]));
     let jqd = SVector::<Jet<S, N>, N>::from_fn(|k, _| Jet::velocity(qd[k], k));
-    l.kinetic(t, &jq, &jqd)
+    let r = l.kinetic(t, &jq, &jqd);
+    (
+        SMatrix::from_fn(|i, k| r.hessian(i, k)),
+        SVector::from_fn(|i, _| r.gq[i] - r.dp[i]),
+    )
 }
 
 /// `dV/dq` over any scalar `S`, from one evaluation of `V` over `Dual<S, N>`.
@@ -204,7 +207,7 @@ where
 }
 
 /// `M = d2T/dq'dq'` over any scalar `S` (plain for the mass matrix, a dual number for its
-/// derivatives), from one evaluation of `T` over a [`Jet`] in which `q` is constant.
+/// derivatives), from one evaluation of `T` over a [`Jet`].
 fn mass_matrix_in<T, S, L, const N: usize>(
     l: &L,
     t: S,
@@ -216,8 +219,7 @@ where
     S: Scalar<Real = T>,
     L: Lagrangian<T, N>,
 {
-    let r = kinetic_jet(l, t, q, qd, false);
-    SMatrix::from_fn(|i, k| r.hessian(i, k))
+    kinetic_jet(l, t, q, qd).0
 }
 
 /// `M` and `f = dT/dq - dV/dq - (d2T/dq'dq) q' - d2T/dq'dt` over any scalar `S`, from one
@@ -241,18 +243,13 @@ where
         // dT/dq = 0 and d2T/dq'dq = 0: nothing of T to differentiate but the time term.
         let mut f = -dv;
         if L::EXPLICIT_TIME {
-            // Time alone moving: r.dp = d2T/dq'dt.
-            let q = q.map(Jet::constant);
-            let qd = SVector::<Jet<S, N>, N>::from_fn(|k, _| Jet::velocity(qd[k], k));
-            let r = l.kinetic(Jet::time(t), &q, &qd);
-            f -= SVector::<S, N>::from(r.dp);
+            // T's part is then -d2T/dq'dt alone (dT/dq = 0 and d2T/dq'dq = 0).
+            f += kinetic_jet(l, t, q, qd).1;
         }
         return (SMatrix::zeros(), f);
     }
-    let r = kinetic_jet(l, t, q, qd, true);
-    let m = SMatrix::from_fn(|i, k| r.hessian(i, k));
-    let f = SVector::<S, N>::from_fn(|i, _| r.gq[i] - dv[i] - r.dp[i]);
-    (m, f)
+    let (m, f) = kinetic_jet(l, t, q, qd);
+    (m, f - dv)
 }
 
 /// `v` as one-direction duals, seeded along component `k` when `seed` is true.
