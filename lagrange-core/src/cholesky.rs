@@ -11,7 +11,8 @@ use nalgebra::{SMatrix, SVector};
 ///
 /// # Errors
 /// [`Error::SingularMassMatrix`] with the index of the failing pivot;
-/// [`Error::NonFiniteState`] when `m` holds NaN or infinity (a non-finite state).
+/// [`Error::NonFiniteState`] when `m` holds NaN or infinity (a non-finite state), or the
+/// solution is not finite (`b` not finite, or so large that `x` overflows).
 ///
 /// ```
 /// use lagrange_core::{solve_spd, Error};
@@ -28,7 +29,12 @@ pub fn solve_spd<T: Real, const N: usize>(
     m: &SMatrix<T, N, N>,
     b: &SVector<T, N>,
 ) -> Result<SVector<T, N>, Error> {
-    Ok(Cholesky::factor(m)?.solve(b))
+    let x = Cholesky::factor(m)?.solve(b);
+    if x.iter().all(|v| v.is_finite()) {
+        Ok(x)
+    } else {
+        Err(Error::NonFiniteState)
+    }
 }
 
 /// The Cholesky factorisation of a symmetric positive definite matrix, factored once to solve

@@ -38,9 +38,10 @@ pub enum Error {
     /// An adaptive integrator needed a step smaller than its minimum.
     StepSizeUnderflow,
     /// Constraint row `row` is, to within `sqrt(EPSILON)` of its own size, a combination of the
-    /// rows before it (in the mass-weighted sense of `J M^-1 J^T`): the constraints are
-    /// redundant, or the configuration is one where they are singular (their Jacobian loses
-    /// rank, or a row's gradient vanishes).
+    /// rows before it (in the mass-weighted sense of `J M^-1 J^T`), or (row 0, or any row whose
+    /// gradient vanishes) singular on its own: the constraints are redundant, or the
+    /// configuration is one where they are singular (their Jacobian loses rank, or a row's
+    /// gradient vanishes).
     RedundantConstraints {
         /// Index of the first dependent constraint row.
         row: usize,
@@ -87,9 +88,14 @@ impl fmt::Display for Error {
                 write!(f, "no convergence after {iterations} iterations")
             }
             Self::StepSizeUnderflow => f.write_str("step size fell below its minimum"),
+            // Row 0 has no rows before it: it is singular on its own (its gradient vanishes in
+            // the mass metric, as for a pendulum's bob at its pivot).
+            Self::RedundantConstraints { row: 0 } => f.write_str(
+                "constraint 0 is singular here (its gradient vanishes in the mass metric)",
+            ),
             Self::RedundantConstraints { row } => write!(
                 f,
-                "constraint {row} depends on the ones before it (redundant or singular constraints)"
+                "constraint {row} is singular here or depends on the ones before it (redundant or singular constraints)"
             ),
             Self::ConstraintViolated { row } => {
                 write!(f, "state violates constraint {row} beyond the tolerance")

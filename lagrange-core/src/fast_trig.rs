@@ -342,3 +342,99 @@ pub fn sin_cos(x: f32) -> (f32, f32) {
         (-s, c)
     }
 }
+
+/// The bits of `|x|` as a signed integer (below 2^31: compared as such, the comparison
+/// vectorizes where unsigned ones do not).
+#[inline(always)]
+#[allow(clippy::cast_possible_wrap)] // the sign bit is cleared
+fn magnitude(x: f32) -> i32 {
+    (x.to_bits() & !SIGN) as i32
+}
+
+/// `if take { a } else { b }` by the bits, with no branch (both computed: the lanes of a
+/// vector take different sides).
+#[inline(always)]
+fn pick(take: bool, a: f32, b: f32) -> f32 {
+    let mask = u32::from(take).wrapping_neg();
+    f32::from_bits((a.to_bits() & mask) | (b.to_bits() & !mask))
+}
+
+/// `sin_cos` of each of `L` arguments, bit for bit [`sin_cos`] of each: the arguments up to
+/// 512 in magnitude take the small and the medium path of every lane, selected lane by lane
+/// with no branch, so that the loop vectorizes; the rare one beyond 512, infinite or NaN, is
+/// then done alone. The same operations as [`sin_cos`], in the same order.
+#[must_use]
+#[inline(always)]
+pub fn sin_cos_lanes<const L: usize>(x: [f32; L]) -> ([f32; L], [f32; L]) {
+    let (mut sin, mut cos) = ([0.0; L], [0.0; L]);
+    let mut reduced = 0u32;
+    for &xi in &x {
+        reduced |= u32::from(magnitude(xi) > FRAC_PI_4_BITS as i32);
+    }
+    if reduced == 0 {
+        // Every lane small: the small path alone, stage by stage over the lanes (each stage
+        // a loop the compiler vectorizes), the operations of `sin_kernel` and `cos_kernel`.
+        let u = x.map(|r| r * r);
+        for i in 0..L {
+            let (r, u) = (x[i], u[i]);
+            let p = SIN_POLY[0] + u * (SIN_POLY[1] + u * SIN_POLY[2]);
+            let kernel = r + r * u * p;
+            sin[i] = pick(magnitude(r) < TINY_BITS as i32, r, kernel);
+        }
+        for i in 0..L {
+            let u = u[i];
+            let p = COS_POLY[0] + u * (COS_POLY[1] + u * COS_POLY[2]);
+            cos[i] = (1.0 - 0.5 * u) + u * u * p;
+        }
+        return (sin, cos);
+    }
+    sin_cos_lanes_reduced(x)
+}
+
+/// [`sin_cos_lanes`] where some lane needs reducing: every lane through both the small and
+/// the medium path, selected lane by lane (out of line, so that the small path inlines).
+#[inline(never)]
+fn sin_cos_lanes_reduced<const L: usize>(x: [f32; L]) -> ([f32; L], [f32; L]) {
+    let [p1, p2, p3, p4] = FRAC_PI_2_PARTS;
+    let (mut sin, mut cos) = ([0.0; L], [0.0; L]);
+    let mut rare = 0u32;
+    for ((s, c), &xi) in sin.iter_mut().zip(&mut cos).zip(&x) {
+        let abs = magnitude(xi);
+        // Small (|x| <= pi/4).
+        let small_sin = pick(abs < TINY_BITS as i32, xi, sin_kernel(xi));
+        let small_cos = cos_kernel(xi);
+        // Medium, as `reduce_medium` (k below 2^9 where it matters, so a signed conversion
+        // gives the same k); meaningless in the lanes that are small or rare, whose results
+        // come from elsewhere.
+        let ax = xi.abs();
+        #[allow(clippy::cast_possible_truncation)] // saturating; exact where it is used
+        let k = (ax * core::f32::consts::FRAC_2_PI + 0.5) as i32;
+        #[allow(clippy::cast_precision_loss)] // below 2^9 where it is used: exact
+        let kf = k as f32;
+        let t1 = ax - kf * p1;
+        let (t2, e2) = two_sum(t1, -(kf * p2));
+        let (t3, e3) = two_sum(t2, -(kf * p3));
+        let (hi, lo) = two_sum(t3, (e2 + e3) - kf * p4);
+        let ms = sin_kernel_lo(hi, lo);
+        let mc = cos_kernel_lo(hi, lo);
+        // by_quadrant, as selects: odd quadrants swap, then the signs of quadrants 2 and 3
+        // (first) and 1 and 2 (second).
+        let odd = k & 1 != 0;
+        let (first, second) = (pick(odd, mc, ms), pick(odd, ms, mc));
+        let first = pick(k & 2 != 0, -first, first);
+        let second = pick(k.wrapping_add(1) & 2 != 0, -second, second);
+        let medium_sin = pick(xi.to_bits() & SIGN == 0, first, -first);
+        let small = abs <= FRAC_PI_4_BITS as i32;
+        *s = pick(small, small_sin, medium_sin);
+        *c = pick(small, small_cos, second);
+        rare |= u32::from(abs >= MEDIUM_BITS as i32);
+    }
+    if rare != 0 {
+        for ((s, c), &xi) in sin.iter_mut().zip(&mut cos).zip(&x) {
+            if xi.to_bits() & !SIGN >= MEDIUM_BITS {
+                (*s, *c) = sin_cos(xi);
+            }
+        }
+    }
+    (sin, cos)
+}

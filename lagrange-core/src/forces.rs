@@ -2,6 +2,7 @@
 //! mechanism, never by editing it.
 
 use crate::constraints::Constraints;
+use crate::mechanism::{finite, finite_jacobian};
 use crate::{
     central_difference_jacobian, validate, Error, Jacobian, Lagrangian, Mechanism, Real, Scalar,
     State,
@@ -19,7 +20,9 @@ pub trait GeneralizedForce<T: Real, const N: usize> {
     /// that a mechanism stepped without extra forces pays nothing for them.
     const IS_ZERO: bool = false;
 
-    /// The force at `state`.
+    /// The force at `state`. No error channel: a force of the library is NaN or infinite
+    /// only for a state that is or for one so extreme that it overflows; the laws refuse a
+    /// non-finite force, yours included ([`Error::NonFiniteState`]).
     fn force(&self, state: &State<T, N>) -> SVector<T, N>;
 
     /// `(dQ/dq, dQ/dq')` at `state`, for the Newton matrices of implicit integrators. The
@@ -111,10 +114,12 @@ impl<T: Real, const N: usize> ViscousDamping<T, N> {
     /// Damping with one coefficient per coordinate (units: force per unit generalized velocity).
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] `coefficients` when any is negative or not finite.
+    /// [`Error::InvalidParameter`] naming the first entry (`coefficients[i]`) that is negative
+    /// or not finite.
     pub fn new(coefficients: [T; N]) -> Result<Self, Error> {
-        for c in coefficients {
-            validate::non_negative("coefficients", c)?;
+        const NAMES: [&str; 32] = crate::entry_names!("coefficients");
+        for (i, c) in coefficients.into_iter().enumerate() {
+            validate::non_negative(validate::entry(&NAMES, i, "coefficients"), c)?;
         }
         Ok(Self {
             coefficients: SVector::from(coefficients),
@@ -243,32 +248,40 @@ where
     fn rhs(&self, state: &State<T, N>) -> SVector<T, N> {
         self.mechanism.rhs(state)
     }
+    // Each hook checks what it passes on: the inner mechanism may be a user's whose results
+    // are not checked (the library's never return a non-finite `Ok`).
     fn solve_mass(&self, state: &State<T, N>, b: &SVector<T, N>) -> Result<SVector<T, N>, Error> {
-        self.mechanism.solve_mass(state, b)
+        finite(self.mechanism.solve_mass(state, b)?)
     }
     fn law<G: GeneralizedForce<T, N>>(
         &self,
         state: &State<T, N>,
         extra: &G,
     ) -> Result<SVector<T, N>, Error> {
-        self.mechanism
-            .law(state, &(Borrowed(&self.force), Borrowed(extra)))
+        finite(
+            self.mechanism
+                .law(state, &(Borrowed(&self.force), Borrowed(extra)))?,
+        )
     }
     fn law_jacobian<G: GeneralizedForce<T, N>>(
         &self,
         state: &State<T, N>,
         extra: &G,
     ) -> Result<(SVector<T, N>, Jacobian<T, N>), Error> {
-        self.mechanism
-            .law_jacobian(state, &(Borrowed(&self.force), Borrowed(extra)))
+        finite_jacobian(
+            self.mechanism
+                .law_jacobian(state, &(Borrowed(&self.force), Borrowed(extra)))?,
+        )
     }
     fn law_force<G: GeneralizedForce<T, N>>(
         &self,
         state: &State<T, N>,
         extra: &G,
     ) -> Result<SVector<T, N>, Error> {
-        self.mechanism
-            .law_force(state, &(Borrowed(&self.force), Borrowed(extra)))
+        finite(
+            self.mechanism
+                .law_force(state, &(Borrowed(&self.force), Borrowed(extra)))?,
+        )
     }
     fn velocity_jump(
         &self,

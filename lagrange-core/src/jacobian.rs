@@ -60,6 +60,9 @@ impl<T: Real, const N: usize> core::ops::Add for Jacobian<T, N> {
 /// dg/dx_j ~ (g(x + h_j e_j) - g(x - h_j e_j)) / (2 h_j),     h_j = EPSILON^(1/3) (1 + |x_j|)
 /// ```
 ///
+/// No error channel: where `g` or the state is not finite, entries are NaN or infinite
+/// ([`Jacobian::is_finite`] tells; the implicit integrators refuse such a Jacobian).
+///
 /// The truncation error `O(h^2)` and the rounding error `O(EPSILON / h)` balance at a relative
 /// accuracy of about `EPSILON^(2/3)`: ~4e-11 in `f64`, ~2e-5 in `f32`. Exact (to rounding) for
 /// `g` linear in the state. That is accurate enough for a Newton matrix: Newton still converges

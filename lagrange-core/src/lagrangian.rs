@@ -74,16 +74,22 @@ pub trait Lagrangian<T: Real, const N: usize> {
     }
 
     /// Kinetic energy `T` at `state` (computed only when asked, never inside a step).
+    ///
+    /// No error channel: for a state that is not finite, or a state and parameters so extreme
+    /// that a term overflows, the result is NaN or an infinity (never a panic); check it with
+    /// `is_finite` where it matters.
     fn kinetic_energy(&self, state: &State<T, N>) -> T {
         self.kinetic(state.t, &state.q, &state.qd)
     }
 
-    /// Potential energy `V` at `state`.
+    /// Potential energy `V` at `state` (no error channel: NaN or an infinity for a state that
+    /// is not finite or so extreme that a term overflows, never a panic).
     fn potential_energy(&self, state: &State<T, N>) -> T {
         self.potential(state.t, &state.q)
     }
 
-    /// Total energy `T + V` at `state`.
+    /// Total energy `T + V` at `state` (no error channel: NaN or an infinity for a state that
+    /// is not finite or so extreme that a term overflows, never a panic).
     fn energy(&self, state: &State<T, N>) -> T {
         self.kinetic_energy(state) + self.potential_energy(state)
     }
@@ -357,6 +363,7 @@ impl<T: Real, const N: usize, L: Lagrangian<T, N>> Mechanism<T, N> for EulerLagr
         let r = residual_jacobian(&self.lagrangian, s, &qdd) - forces;
         let mut j = Jacobian::<T, N>::zeros();
         for k in 0..N {
+            // Each column solved is finite (solve_mass refuses anything else).
             let dq = self.solve_mass(s, &-r.wrt_q.column(k).into_owned())?;
             let dqd = self.solve_mass(s, &-r.wrt_qd.column(k).into_owned())?;
             j.wrt_q.set_column(k, &dq);
@@ -371,8 +378,7 @@ impl<T: Real, const N: usize, L: Lagrangian<T, N>> Mechanism<T, N> for EulerLagr
         s: &State<T, N>,
         extra: &F,
     ) -> Result<SVector<T, N>, Error> {
-        let q = self.lagrangian.non_conservative_force(s);
-        Ok(if F::IS_ZERO { q } else { q + extra.force(s) })
+        crate::free_law_force(&self.lagrangian, s, extra)
     }
 }
 

@@ -4,8 +4,8 @@
 use crate::constraints::{Constrained, Constraints, Held};
 use crate::forces::{Forced, NoForce};
 use crate::{
-    central_difference_jacobian, solve_spd, Error, GeneralizedForce, Jacobian, Lagrangian, Real,
-    State,
+    central_difference_jacobian, solve_spd, Error, GeneralizedForce, Jacobian, Lagrangian, Lanes,
+    Real, State,
 };
 use nalgebra::{SMatrix, SVector};
 
@@ -45,9 +45,16 @@ use nalgebra::{SMatrix, SVector};
 pub trait Mechanism<T: Real, const N: usize>: Lagrangian<T, N> {
     /// The mass matrix `M = d2L/dq'2`, symmetric positive definite away from singular
     /// configurations.
+    ///
+    /// No error channel: for a state that is not finite or so extreme that an entry
+    /// overflows, entries are NaN or infinite (never a panic); the solves that use `M` refuse
+    /// them ([`Error::NonFiniteState`]).
     fn mass_matrix(&self, state: &State<T, N>) -> SMatrix<T, N, N>;
 
     /// The right-hand side `f` of `M q'' = f + Q`, without the generalized forces `Q`.
+    ///
+    /// No error channel: for a state that is not finite or so extreme that a term overflows,
+    /// components are NaN or infinite (never a panic); the law refuses them.
     fn rhs(&self, state: &State<T, N>) -> SVector<T, N>;
 
     /// Solves `M x = b` at `state`: a fixed-size Cholesky solve by default
@@ -66,6 +73,12 @@ pub trait Mechanism<T: Real, const N: usize>: Lagrangian<T, N> {
     /// hand-derived mechanism overrides it with its closed form, a constrained one adds its
     /// constraint forces. Call it through [`Mechanism::acceleration`] or
     /// [`Mechanism::acceleration_with`], which check the result.
+    ///
+    /// **Finite or an error.** Like every function of the library that returns a `Result`,
+    /// the library's laws (the default, every system's, every wrapper's) return `Ok` only
+    /// with finite accelerations, and [`Error::NonFiniteState`] where they would not be. A
+    /// law of your own should do the same; if it does not, [`Mechanism::acceleration`] still
+    /// refuses its non-finite result.
     ///
     /// [`solve_mass`]: Mechanism::solve_mass
     ///
@@ -89,7 +102,8 @@ pub trait Mechanism<T: Real, const N: usize>: Lagrangian<T, N> {
     /// this type states.
     ///
     /// # Errors
-    /// The first error of any evaluation of the law.
+    /// The first error of any evaluation of the law; [`Error::NonFiniteState`] when the
+    /// accelerations or the Jacobian are not finite.
     fn law_jacobian<F: GeneralizedForce<T, N>>(
         &self,
         state: &State<T, N>,
@@ -101,23 +115,28 @@ pub trait Mechanism<T: Real, const N: usize>: Lagrangian<T, N> {
     /// The generalized force the law applies besides `f`: `M q'' - f`, that is `Q + extra`
     /// for an unconstrained law, plus the constraint forces for a constrained one. The
     /// default evaluates exactly that (one law, one mass matrix, one `f`); a type may
-    /// override it with the same force in closed form.
+    /// override it with the same force in closed form ([`free_law_force`] for a free law).
+    ///
+    /// [`free_law_force`]: crate::free_law_force
     ///
     /// # Errors
-    /// As [`Mechanism::law`].
+    /// As [`Mechanism::law`]; [`Error::NonFiniteState`] when the force is not finite.
     fn law_force<F: GeneralizedForce<T, N>>(
         &self,
         state: &State<T, N>,
         extra: &F,
     ) -> Result<SVector<T, N>, Error> {
         let qdd = self.law(state, extra)?;
-        Ok(self.mass_matrix(state) * qdd - self.rhs(state))
+        finite(self.mass_matrix(state) * qdd - self.rhs(state))
     }
 
     /// The generalized accelerations `q''` (the law with no extra force).
     ///
     /// # Errors
     /// As [`Mechanism::law`]; [`Error::NonFiniteState`] when they are not finite.
+    // Inlined into the integrators' stages: returned through memory, the accelerations of a
+    // mechanism stepped in lanes stall every load that reads them back.
+    #[inline(always)]
     fn acceleration(&self, state: &State<T, N>) -> Result<SVector<T, N>, Error> {
         self.acceleration_with(state, &NoForce)
     }
@@ -142,6 +161,7 @@ pub trait Mechanism<T: Real, const N: usize>: Lagrangian<T, N> {
     ///
     /// # Errors
     /// As [`Mechanism::acceleration`].
+    #[inline(always)]
     fn acceleration_with<F: GeneralizedForce<T, N>>(
         &self,
         state: &State<T, N>,
@@ -159,12 +179,7 @@ pub trait Mechanism<T: Real, const N: usize>: Lagrangian<T, N> {
         &self,
         state: &State<T, N>,
     ) -> Result<(SVector<T, N>, Jacobian<T, N>), Error> {
-        let (qdd, j) = self.law_jacobian(state, &NoForce)?;
-        if j.is_finite() {
-            Ok((finite(qdd)?, j))
-        } else {
-            Err(Error::NonFiniteState)
-        }
+        finite_jacobian(self.law_jacobian(state, &NoForce)?)
     }
 
     /// The change of velocities `dq'` that a generalized impulse `p` (a force integrated over
@@ -195,6 +210,15 @@ pub trait Mechanism<T: Real, const N: usize>: Lagrangian<T, N> {
         impulse: &SVector<T, N>,
     ) -> Result<SVector<T, N>, Error> {
         finite(self.solve_mass(state, impulse)?)
+    }
+
+    /// These instances of the type side by side, as one mechanism over [`Lanes`] (lane `i`
+    /// is `instances[i]`), where the type can gather its parameters (a plain struct of
+    /// scalars): what lets a scene step a bank `L` instances at a time, each lane bit for bit
+    /// its instance alone. `None` by default, and then a bank steps them one by one.
+    fn gather<const L: usize>(instances: [&Self; L]) -> Option<impl Mechanism<Lanes<T, L>, N>> {
+        let _ = instances;
+        None::<Ungathered>
     }
 
     /// This mechanism with `force` added to its generalized forces.
@@ -238,12 +262,24 @@ pub(crate) fn finite<T: Real, const N: usize>(v: SVector<T, N>) -> Result<SVecto
     }
 }
 
+/// `(qdd, j)` when both are finite, else [`Error::NonFiniteState`]: what a wrapper checks
+/// before passing on an inner law's Jacobian.
+pub(crate) fn finite_jacobian<T: Real, const N: usize>(
+    (qdd, j): (SVector<T, N>, Jacobian<T, N>),
+) -> Result<(SVector<T, N>, Jacobian<T, N>), Error> {
+    if j.is_finite() {
+        Ok((finite(qdd)?, j))
+    } else {
+        Err(Error::NonFiniteState)
+    }
+}
+
 /// The law of `mechanism` at `state` with `extra`, and its Jacobian by central differences of
 /// the law: the default of [`Mechanism::law_jacobian`].
 ///
 /// # Errors
 /// The first error of any evaluation of the law; [`Error::NonFiniteState`] when the
-/// accelerations are not finite.
+/// accelerations or the Jacobian are not finite.
 pub fn jacobian_by_differences<T, const N: usize, M, F>(
     mechanism: &M,
     state: &State<T, N>,
@@ -264,6 +300,35 @@ where
     });
     match failure {
         Some(e) => Err(e),
-        None => Ok((qdd, j)),
+        None if j.is_finite() => Ok((qdd, j)),
+        None => Err(Error::NonFiniteState),
+    }
+}
+
+/// The mechanism of a type that gathers no lanes ([`Mechanism::gather`]'s default): a type with
+/// no value, so that none of its methods can be called.
+#[derive(Debug, Clone, Copy)]
+pub(crate) enum Ungathered {}
+
+impl<T: Real, const N: usize> Lagrangian<T, N> for Ungathered {
+    fn kinetic<S: crate::Scalar<Real = T>>(
+        &self,
+        _t: S,
+        _q: &SVector<S, N>,
+        _qd: &SVector<S, N>,
+    ) -> S {
+        match *self {}
+    }
+    fn potential<S: crate::Scalar<Real = T>>(&self, _t: S, _q: &SVector<S, N>) -> S {
+        match *self {}
+    }
+}
+
+impl<T: Real, const N: usize> Mechanism<T, N> for Ungathered {
+    fn mass_matrix(&self, _state: &State<T, N>) -> SMatrix<T, N, N> {
+        match *self {}
+    }
+    fn rhs(&self, _state: &State<T, N>) -> SVector<T, N> {
+        match *self {}
     }
 }

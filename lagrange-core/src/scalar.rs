@@ -75,7 +75,7 @@ pub trait Scalar:
     fn recip(self) -> Self;
 }
 
-mod sealed {
+pub(crate) mod sealed {
     pub trait Sealed {}
     impl Sealed for f32 {}
     impl Sealed for f64 {}
@@ -127,6 +127,20 @@ pub trait Real:
     fn atan(self) -> Self;
     /// `self` to a real power.
     fn powf(self, e: Self) -> Self;
+    /// Sine and cosine of each of `L` values, bit for bit [`Scalar::sin_cos`] of each: what
+    /// [`Lanes`](crate::Lanes) computes with (`f32`'s a vectorizable form of
+    /// [`fast_trig`](crate::fast_trig)).
+    fn sin_cos_lanes<const L: usize>(x: [Self; L]) -> ([Self; L], [Self; L]);
+}
+
+/// `sin_cos` of each value, one at a time.
+#[inline]
+pub(crate) fn sin_cos_each<S: Scalar, const L: usize>(x: [S; L]) -> ([S; L], [S; L]) {
+    let (mut s, mut c) = (x, x);
+    for ((si, ci), xi) in s.iter_mut().zip(&mut c).zip(x) {
+        (*si, *ci) = xi.sin_cos();
+    }
+    (s, c)
 }
 
 /// `x^n` by binary powering, shared by every scalar so all give the same sequence of products.
@@ -149,7 +163,7 @@ pub(crate) fn powi_by_squaring<S: Scalar>(x: S, n: i32) -> S {
 macro_rules! impl_real {
     ($t:ident, $sin:ident, $cos:ident, $sin_cos:ident, $tan:ident, $sqrt:ident, $exp:ident,
      $ln:ident, $fabs:ident, $atan2:ident, $floor:ident, $round:ident, $asin:ident,
-     $acos:ident, $atan:ident, $pow:ident, $cbrt_eps:expr) => {
+     $acos:ident, $atan:ident, $pow:ident, $lanes:path, $cbrt_eps:expr) => {
         impl Scalar for $t {
             type Real = $t;
             #[inline]
@@ -270,6 +284,10 @@ macro_rules! impl_real {
             fn powf(self, e: $t) -> $t {
                 libm::$pow(self, e)
             }
+            #[inline(always)]
+            fn sin_cos_lanes<const L: usize>(x: [$t; L]) -> ([$t; L], [$t; L]) {
+                $lanes(x)
+            }
         }
     };
 }
@@ -291,6 +309,7 @@ impl_real!(
     acos,
     atan,
     pow,
+    sin_cos_each,
     6.055_454_452_393_343e-6 // 2^(-52/3)
 );
 impl_real!(
@@ -310,5 +329,6 @@ impl_real!(
     acosf,
     atanf,
     powf,
+    scalar_trig::sin_cos_lanesf,
     4.921_566_4e-3 // 2^(-23/3)
 );

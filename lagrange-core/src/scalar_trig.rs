@@ -14,7 +14,9 @@ pub(crate) fn sin_cos(x: f64) -> (f64, f64) {
 }
 
 #[cfg(not(feature = "libm-trig"))]
-pub(crate) use crate::fast_trig::{cos as cosf, sin as sinf, sin_cos as sin_cosf};
+pub(crate) use crate::fast_trig::{
+    cos as cosf, sin as sinf, sin_cos as sin_cosf, sin_cos_lanes as sin_cos_lanesf,
+};
 
 #[cfg(feature = "libm-trig")]
 pub(crate) use libm::{cosf, sinf};
@@ -24,4 +26,11 @@ pub(crate) use libm::{cosf, sinf};
 #[inline]
 pub(crate) fn sin_cosf(x: f32) -> (f32, f32) {
     (libm::sinf(x), libm::cosf(x))
+}
+
+/// `(sin x, cos x)` of each lane by `libm`.
+#[cfg(feature = "libm-trig")]
+#[inline]
+pub(crate) fn sin_cos_lanesf<const L: usize>(x: [f32; L]) -> ([f32; L], [f32; L]) {
+    (x.map(libm::sinf), x.map(libm::cosf))
 }

@@ -6,8 +6,8 @@ use lagrange_core::constraints::contact::{
     drop_dependent_contacts, ActiveRows, ContactModel, Contacts, Impact, Impacts,
 };
 
-use crate::integrator::{check_step, continues};
-use crate::{Cost, Integrator, Method, Work};
+use crate::integrator::{check_run_step, check_step, continues, step_loop};
+use crate::{Cost, Failure, Integrator, Method, Work};
 use lagrange_core::constraints::Projection;
 use lagrange_core::nalgebra::SVector;
 use lagrange_core::{Error, Mechanism, Real, State};
@@ -166,20 +166,57 @@ where
     /// [`Error::InvalidParameter`] `dt` unless positive and finite; [`Error::NonFiniteState`];
     /// [`Error::ConstraintViolated`] for a start state that violates a bilateral row or
     /// penetrates a contact beyond the projection's tolerance; [`Error::NoConvergence`] after
-    /// `4 C + 8` events in one step; the inner integrator's and the projection's errors.
+    /// `4 C + 8` events in one step; the inner integrator's and the projection's errors. A
+    /// step that fails leaves the stepper as it found it (resting set, impact count, the
+    /// state it continues from); `observe` has seen the impacts before the failure.
     pub fn step_observed<M, F>(
         &mut self,
         mechanism: &M,
         state: &State<T, N>,
         dt: T,
-        mut observe: F,
+        observe: F,
     ) -> Result<State<T, N>, Error>
     where
         M: Mechanism<T, N>,
         I: for<'a> Integrator<T, N, ActiveRows<'a, T, C, M, K>>,
         F: FnMut(&Impact<T, N, C>),
     {
-        let dt = check_step(state, dt)?;
+        self.transaction(|c| c.step_events(mechanism, state, dt, observe, false))
+    }
+
+    /// `f`, and the stepper as it was (resting set, impact count, the state it continues
+    /// from) when `f` fails.
+    fn transaction<V, E>(&mut self, f: impl FnOnce(&mut Self) -> Result<V, E>) -> Result<V, E> {
+        let saved = (self.resting, self.impacts, self.last);
+        let result = f(self);
+        if result.is_err() {
+            (self.resting, self.impacts, self.last) = saved;
+        }
+        result
+    }
+
+    /// The step of [`ContactStepper::step_observed`], or of a run (`run`: a `dt` below the
+    /// resolution of the time is taken). The inner integrator's steps are steps of a run
+    /// either way: what is left of `dt` after an impact and the bisection's trial lengths may
+    /// be far below the resolution of the time.
+    fn step_events<M, F>(
+        &mut self,
+        mechanism: &M,
+        state: &State<T, N>,
+        dt: T,
+        mut observe: F,
+        run: bool,
+    ) -> Result<State<T, N>, Error>
+    where
+        M: Mechanism<T, N>,
+        I: for<'a> Integrator<T, N, ActiveRows<'a, T, C, M, K>>,
+        F: FnMut(&Impact<T, N, C>),
+    {
+        let dt = if run {
+            check_run_step(state, dt)?
+        } else {
+            check_step(state, dt)?
+        };
         if !self.last.is_some_and(|last| continues(&last, state)) {
             self.start(state)?;
         }
@@ -188,7 +225,7 @@ where
         let mut remaining = dt;
         let mut events = 0;
         loop {
-            let trial = self.integrator.step(
+            let trial = self.integrator.run_step(
                 &active(
                     mechanism,
                     &self.contacts,
@@ -300,7 +337,7 @@ where
             if mid <= lo || mid >= hi {
                 break; // the bracket is at the resolution of T
             }
-            let trial = self.integrator.step(
+            let trial = self.integrator.run_step(
                 &active(
                     mechanism,
                     &self.contacts,
@@ -364,5 +401,36 @@ where
             &self.resting,
         );
         self.integrator.law_acceleration(&rows, state)
+    }
+
+    /// A step of a run; see [`ContactStepper::step_observed`].
+    fn run_step(
+        &mut self,
+        mechanism: &M,
+        state: &State<T, N>,
+        dt: T,
+    ) -> Result<State<T, N>, Error> {
+        self.transaction(|c| c.step_events(mechanism, state, dt, |_| {}, true))
+    }
+
+    /// As the default, and a run that fails leaves the stepper as it found it (resting set,
+    /// impact count, the state it continues from), like a step that fails.
+    fn integrate_with<F: FnMut(&State<T, N>)>(
+        &mut self,
+        mechanism: &M,
+        state: &State<T, N>,
+        dt: T,
+        steps: u64,
+        observe: F,
+    ) -> Result<State<T, N>, Failure<T, N>> {
+        self.transaction(|c| {
+            step_loop(
+                state,
+                dt,
+                steps,
+                |s| c.step_events(mechanism, s, dt, |_| {}, true),
+                observe,
+            )
+        })
     }
 }

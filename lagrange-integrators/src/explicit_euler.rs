@@ -1,8 +1,8 @@
 //! Explicit (forward) Euler.
 
-use crate::integrator::{check_step, finish, Cost};
+use crate::integrator::{check_run_step, check_step, finish, step_loop, Cost, Failure};
 use crate::{Integrator, Method};
-use lagrange_core::{Error, Mechanism, Real, State};
+use lagrange_core::{Error, Lanes, Mechanism, Real, State};
 
 /// Forward Euler: `q1 = q0 + h q'0`, `q'1 = q'0 + h q''0`.
 ///
@@ -20,13 +20,56 @@ impl Method for ExplicitEuler {
 }
 
 impl<T: Real, const N: usize, M: Mechanism<T, N>> Integrator<T, N, M> for ExplicitEuler {
+    /// The same step over lanes: it keeps nothing between steps.
+    fn step_lanes<const L: usize, G: Mechanism<Lanes<T, L>, N>>(
+        &self,
+        mechanism: &G,
+        state: &State<Lanes<T, L>, N>,
+        dt: T,
+    ) -> Option<Result<State<Lanes<T, L>, N>, Error>> {
+        Some(Integrator::<Lanes<T, L>, N, G>::run_step(
+            &mut ExplicitEuler,
+            mechanism,
+            state,
+            Lanes::splat(dt),
+        ))
+    }
+
     fn step(&mut self, m: &M, s: &State<T, N>, dt: T) -> Result<State<T, N>, Error> {
         let h = check_step(s, dt)?;
-        let a = m.acceleration(s)?;
-        finish(State {
-            t: s.t + h,
-            q: s.q + s.qd * h,
-            qd: s.qd + a * h,
-        })
+        advance(m, s, h)
     }
+
+    fn run_step(&mut self, m: &M, s: &State<T, N>, dt: T) -> Result<State<T, N>, Error> {
+        advance(m, s, check_run_step(s, dt)?)
+    }
+
+    /// As the default, with `dt` and the start checked once rather than at every step (each
+    /// step's end is checked, so the next step's start is known finite), as [`Rk4`](crate::Rk4)
+    /// does.
+    fn integrate_with<F: FnMut(&State<T, N>)>(
+        &mut self,
+        m: &M,
+        state: &State<T, N>,
+        dt: T,
+        steps: u64,
+        observe: F,
+    ) -> Result<State<T, N>, Failure<T, N>> {
+        step_loop(state, dt, steps, |s| advance(m, s, dt), observe)
+    }
+}
+
+/// One step of `h` from `s`, unchecked but for the result.
+#[inline(always)]
+fn advance<T: Real, const N: usize, M: Mechanism<T, N>>(
+    m: &M,
+    s: &State<T, N>,
+    h: T,
+) -> Result<State<T, N>, Error> {
+    let a = m.acceleration(s)?;
+    finish(State {
+        t: s.t + h,
+        q: s.q + s.qd * h,
+        qd: s.qd + a * h,
+    })
 }

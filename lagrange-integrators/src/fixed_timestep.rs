@@ -57,8 +57,9 @@ impl<T: Real, const N: usize, I> FixedTimestep<T, N, I> {
         max_steps_per_frame: u32,
         start: State<T, N>,
     ) -> Result<Self, Error> {
-        let clock = FrameClock::new(dt, max_steps_per_frame, start.t)?;
+        // The start is checked first: its time is a state's, not a parameter of this call.
         start.check_finite()?;
+        let clock = FrameClock::new(dt, max_steps_per_frame, start.t)?;
         Ok(Self {
             integrator,
             clock,
@@ -71,9 +72,11 @@ impl<T: Real, const N: usize, I> FixedTimestep<T, N, I> {
     /// fixed steps it pays for, up to the cap ([`FrameClock::advance`]).
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] `frame_time` when negative or not finite (nothing changes);
-    /// the first error of a step, after which the current state is the last good one and the
-    /// failed step's time stays accumulated.
+    /// [`Error::InvalidParameter`] `frame_time` when negative or not finite; the first error
+    /// of a step. Either way the frame is refused whole: the states, the accumulated time and
+    /// the clock are as before the call (the integrator may have learnt from the frame's
+    /// successful steps, but it continues only from the state it returned, so the next frame
+    /// steps from the current state afresh).
     pub fn advance<M: Mechanism<T, N>>(
         &mut self,
         mechanism: &M,
@@ -82,16 +85,21 @@ impl<T: Real, const N: usize, I> FixedTimestep<T, N, I> {
     where
         I: Integrator<T, N, M>,
     {
+        let saved = (self.clock, self.previous, self.current);
         let (integrator, previous, current) =
             (&mut self.integrator, &mut self.previous, &mut self.current);
         let dt = self.clock.dt();
-        self.clock.advance(frame_time, |t| {
-            let mut next = integrator.step(mechanism, current, dt)?;
+        let frame = self.clock.advance(frame_time, |t| {
+            let mut next = integrator.run_step(mechanism, current, dt)?;
             next.t = t;
             *previous = *current;
             *current = next;
             Ok(())
-        })
+        });
+        if frame.is_err() {
+            (self.clock, self.previous, self.current) = saved;
+        }
+        frame
     }
 
     /// The fraction of a step accumulated but not yet taken, in `[0, 1]`.
@@ -102,7 +110,8 @@ impl<T: Real, const N: usize, I> FixedTimestep<T, N, I> {
 
     /// The state to draw: linear interpolation between the last two steps by
     /// [`FixedTimestep::alpha`] (it lags the simulation by up to one step, and never
-    /// extrapolates).
+    /// extrapolates). The two states are finite; only a difference between them that
+    /// overflows (states near `T::MAX`) makes it infinite.
     #[must_use]
     pub fn interpolated(&self) -> State<T, N> {
         let a = self.alpha();

@@ -78,7 +78,8 @@ impl<T: Real> FrameClock<T> {
     ///
     /// # Errors
     /// [`Error::InvalidParameter`] `frame_time` when negative or not finite (nothing changes);
-    /// the first error of `step`, after which the steps before it count and the failed step's
+    /// [`Error::NonFiniteState`] when the time after a step overflows; the first error of
+    /// `step`, after which the steps before it count and the failed step's
     /// time stays accumulated.
     pub fn advance(
         &mut self,
@@ -93,7 +94,11 @@ impl<T: Real> FrameClock<T> {
         while self.due(self.accumulator) && steps < self.max_steps_per_frame {
             let mut next = self.clock;
             next.tick(self.dt);
-            step(next.time())?;
+            let t = next.time();
+            if !t.is_finite() {
+                return Err(Error::NonFiniteState);
+            }
+            step(t)?;
             self.clock = next;
             self.accumulator -= self.dt;
             steps += 1;

@@ -1,7 +1,10 @@
 //! [`ImplicitRungeKutta`]: the one stepper behind implicit midpoint, Gauss-Legendre, backward
 //! Euler and Radau IIA, each given by its Butcher tableau ([`ImplicitTableau`]).
 
-use crate::integrator::{check_signed, check_step, finish, Cost, Work};
+use crate::integrator::{
+    check_run_step, check_signed, check_signed_run, check_step, finish, step_loop, Cost, Failure,
+    Work,
+};
 use crate::newton::{self, BlockMatrix, Blocks, NewtonProblem, NewtonSettings, Start};
 use crate::{Integrator, Method, MidpointTableau, SymmetricBase};
 use core::marker::PhantomData;
@@ -259,6 +262,24 @@ where
         let h = check_step(s, dt)?;
         self.advance(m, s, h)
     }
+
+    fn run_step(&mut self, m: &Mech, s: &State<T, N>, dt: T) -> Result<State<T, N>, Error> {
+        let h = check_run_step(s, dt)?;
+        self.advance(m, s, h)
+    }
+
+    /// As the default, with `dt` and the start checked once rather than at every step (each
+    /// step's end is checked, so the next step's start is known finite).
+    fn integrate_with<F: FnMut(&State<T, N>)>(
+        &mut self,
+        m: &Mech,
+        state: &State<T, N>,
+        dt: T,
+        steps: u64,
+        observe: F,
+    ) -> Result<State<T, N>, Failure<T, N>> {
+        step_loop(state, dt, steps, |s| self.advance(m, s, dt), observe)
+    }
 }
 
 /// The implicit midpoint rule is symmetric and of order 2: a base for [`Yoshida4`](crate::Yoshida4).
@@ -270,6 +291,11 @@ where
 {
     fn signed_step(&mut self, m: &Mech, s: &State<T, N>, h: T) -> Result<State<T, N>, Error> {
         let h = check_signed(s, h)?;
+        self.advance(m, s, h)
+    }
+
+    fn signed_run_step(&mut self, m: &Mech, s: &State<T, N>, h: T) -> Result<State<T, N>, Error> {
+        let h = check_signed_run(s, h)?;
         self.advance(m, s, h)
     }
 }

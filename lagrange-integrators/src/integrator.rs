@@ -1,9 +1,10 @@
 //! The [`Integrator`] trait every method implements (one way to step), what a step costs
 //! ([`Cost`], [`Work`]), what a failed run reports ([`Failure`]), and the checks they share.
 
+use crate::Clock;
 use core::fmt;
 use lagrange_core::nalgebra::SVector;
-use lagrange_core::{Error, Mechanism, Real, State};
+use lagrange_core::{Error, Lanes, Mechanism, Real, State};
 
 /// What a step of a method costs, in evaluations of the mechanism's acceleration law, for
 /// every method alike: `fixed + per_iteration * iterations` accelerations and `jacobians`
@@ -149,7 +150,8 @@ pub trait Integrator<T: Real, const N: usize, M: Mechanism<T, N>>: Method {
     /// [`Error::InvalidParameter`] `dt` when `dt` is not positive and finite;
     /// [`Error::StepSizeUnderflow`] when `state.t + dt` rounds to `state.t`;
     /// [`Error::NonFiniteState`] when `state` is not finite, or the new state is not (a step
-    /// past the stability limit); whatever the mechanism's law returns.
+    /// past the stability limit, or a time `state.t + dt` that overflows); whatever the
+    /// mechanism's law returns.
     fn step(&mut self, mechanism: &M, state: &State<T, N>, dt: T) -> Result<State<T, N>, Error>;
 
     /// The accelerations of the law this method steps, at `state`: the mechanism's own
@@ -163,13 +165,58 @@ pub trait Integrator<T: Real, const N: usize, M: Mechanism<T, N>>: Method {
         mechanism.acceleration(state)
     }
 
-    /// Takes `steps` steps of `dt` from `state` and returns the last state. The time of the
-    /// `k`-th state is `state.t + k dt` summed without rounding drift (a compensated sum), so
-    /// that a long run keeps its clock.
+    /// Steps `L` instances at once, side by side in lanes (their mechanisms gathered by
+    /// [`Mechanism::gather`]), each lane bit for bit what [`Integrator::run_step`] gives for its
+    /// instance alone: where the method keeps nothing between steps, `Some`; `None` by
+    /// default, and then the caller steps the instances one by one. The result is that of
+    /// every lane only if no comparison diverged across the lanes meanwhile
+    /// ([`lagrange_core::divergences`]): the caller reads the count before and after, and
+    /// steps the instances one by one otherwise (or on an error).
+    fn step_lanes<const L: usize, G: Mechanism<Lanes<T, L>, N>>(
+        &self,
+        mechanism: &G,
+        state: &State<Lanes<T, L>, N>,
+        dt: T,
+    ) -> Option<Result<State<Lanes<T, L>, N>, Error>> {
+        let _ = (mechanism, state, dt);
+        None
+    }
+
+    /// One step of a run whose own clock keeps the time (the runs of
+    /// [`Integrator::integrate`], [`FixedTimestep`](crate::FixedTimestep),
+    /// [`Projected`](crate::Projected), [`ContactStepper`](crate::ContactStepper)): as
+    /// [`Integrator::step`], except that a `dt` below the resolution of `state.t` (where
+    /// `state.t + dt` rounds to `state.t`, as after days of an `f32` game clock at 1/120 s) is
+    /// taken, not refused. The run's [`Clock`] carries the exact time and sets the new state's
+    /// time; the step evaluates the mechanism at the rounded times.
+    ///
+    /// The default is [`Integrator::step`], which refuses such a step; every fixed-step method
+    /// of the library overrides it (the adaptive pairs do not: their steps are chosen in time,
+    /// and need a time that moves).
     ///
     /// # Errors
-    /// The first error of any step, with the step and the last good state ([`Failure`]);
-    /// `dt` and `state` are checked even when `steps` is zero.
+    /// As [`Integrator::step`], but for [`Error::StepSizeUnderflow`] where only the rounded
+    /// time would not move.
+    fn run_step(
+        &mut self,
+        mechanism: &M,
+        state: &State<T, N>,
+        dt: T,
+    ) -> Result<State<T, N>, Error> {
+        self.step(mechanism, state, dt)
+    }
+
+    /// Takes `steps` steps of `dt` from `state` and returns the last state. The time of the
+    /// `k`-th state is `state.t + k dt` rounded once from its exact value ([`Clock`]), so
+    /// that a long run keeps its clock: after 10^8 `f32` steps of 1/120 s it is within an ulp
+    /// of the exact time. The steps are [`Integrator::run_step`]s, so a `dt` below the
+    /// resolution of the state's time is taken as long as the run as a whole moves the time.
+    ///
+    /// # Errors
+    /// The first error of any step, with the step and the last good state ([`Failure`]).
+    /// Before any step, `dt` and `state` are checked (even when `steps` is zero) and so is
+    /// the run's end time `state.t + max(steps, 1) dt`: [`Error::StepSizeUnderflow`] when it
+    /// rounds to `state.t`, [`Error::NonFiniteState`] when it overflows.
     fn integrate(
         &mut self,
         mechanism: &M,
@@ -192,52 +239,22 @@ pub trait Integrator<T: Real, const N: usize, M: Mechanism<T, N>>: Method {
         steps: u64,
         observe: F,
     ) -> Result<State<T, N>, Failure<T, N>> {
-        step_loop(state, dt, steps, |s| self.step(mechanism, s, dt), observe)
-    }
-}
-
-/// Time advanced by a sum compensated for rounding: `t0 + k dt` to within an ulp however many
-/// steps `k`, where adding `dt` to `t` each step would drift by `k` roundings.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Clock<T> {
-    /// The rounded sum.
-    hi: T,
-    /// The rounding errors of the sum so far.
-    lo: T,
-}
-
-impl<T: Real> Clock<T> {
-    /// A clock at `t`.
-    #[must_use]
-    pub fn new(t: T) -> Self {
-        Self {
-            hi: t,
-            lo: T::zero(),
-        }
-    }
-
-    /// Advances by `dt` (Knuth's two-sum keeps the rounding error exactly).
-    pub fn tick(&mut self, dt: T) {
-        let s = self.hi + dt;
-        let b = s - self.hi;
-        let error = (self.hi - (s - b)) + (dt - b);
-        self.hi = s;
-        self.lo += error;
-    }
-
-    /// The time now.
-    #[must_use]
-    pub fn time(&self) -> T {
-        self.hi + self.lo
+        step_loop(
+            state,
+            dt,
+            steps,
+            |s| self.run_step(mechanism, s, dt),
+            observe,
+        )
     }
 }
 
 /// `steps` applications of `advance` from `state`, calling `observe` with each new state, the
-/// time of each from a compensated [`Clock`]: the loop of [`Integrator::integrate_with`],
+/// time of each from an exact [`Clock`]: the loop of [`Integrator::integrate_with`],
 /// shared with the methods that override it to inline their stages.
 ///
 /// # Errors
-/// `dt` or `state` refused ([`check_step`]), or the first error of `advance`, as a
+/// `dt`, `state` or the run refused ([`check_run`]), or the first error of `advance`, as a
 /// [`Failure`].
 #[inline(always)]
 pub(crate) fn step_loop<T: Real, const N: usize>(
@@ -252,32 +269,93 @@ pub(crate) fn step_loop<T: Real, const N: usize>(
         step,
         last: *last,
     };
-    check_step(state, dt).map_err(|e| fail(e, 0, state))?;
+    check_run(state, dt, steps).map_err(|e| fail(e, 0, state))?;
     let mut s = *state;
     let mut clock = Clock::new(state.t);
     for k in 0..steps {
         let mut next = advance(&s).map_err(|e| fail(e, k, &s))?;
         clock.tick(dt);
         next.t = clock.time();
+        if !next.t.is_finite() {
+            return Err(fail(Error::NonFiniteState, k, &s));
+        }
         s = next;
         observe(&s);
     }
     Ok(s)
 }
 
-/// `dt` when it is positive and finite and advances the time of `s`, which must be finite.
+/// `dt` when it is positive and finite and advances the time of `s`, which must be finite,
+/// to a finite time.
 pub(crate) fn check_step<T: Real, const N: usize>(s: &State<T, N>, dt: T) -> Result<T, Error> {
     let dt = check_dt(dt)?;
     s.check_finite()?;
     advances(s.t, dt).map(|()| dt)
 }
 
-/// `h` when it is finite and moves the time of `s` (either way), which must be finite: the
-/// check of a composition's signed substep.
+/// `dt` when it is positive and finite, `s` is finite, and a run of `steps` steps of `dt` (at
+/// least one) from `s` ends at a time that differs from `s.t` and is finite.
+pub(crate) fn check_run<T: Real, const N: usize>(
+    s: &State<T, N>,
+    dt: T,
+    steps: u64,
+) -> Result<T, Error> {
+    let dt = check_dt(dt)?;
+    s.check_finite()?;
+    // One step (or none) is checked as a step is; a longer run by its clock (within an ulp).
+    let end = if steps <= 1 {
+        s.t + dt
+    } else {
+        Clock::after(s.t, dt, steps)
+    };
+    if end == s.t {
+        Err(Error::StepSizeUnderflow)
+    } else if !end.is_finite() {
+        Err(Error::NonFiniteState)
+    } else {
+        Ok(dt)
+    }
+}
+
+/// `dt` when it is positive and finite and takes the time of `s`, which must be finite, to a
+/// finite time (it may not move the rounded time: a step of a run, [`Integrator::run_step`]).
+pub(crate) fn check_run_step<T: Real, const N: usize>(s: &State<T, N>, dt: T) -> Result<T, Error> {
+    let dt = check_dt(dt)?;
+    s.check_finite()?;
+    if (s.t + dt).is_finite() {
+        Ok(dt)
+    } else {
+        Err(Error::NonFiniteState)
+    }
+}
+
+/// `h` when it is finite and not zero and takes the time of `s`, which must be finite, to a
+/// finite time (it may not move the rounded time: a substep of a run,
+/// [`SymmetricBase::signed_run_step`](crate::SymmetricBase::signed_run_step)).
+pub(crate) fn check_signed_run<T: Real, const N: usize>(s: &State<T, N>, h: T) -> Result<T, Error> {
+    if !h.is_finite() || h == T::zero() {
+        return Err(Error::InvalidParameter {
+            name: "h",
+            reason: "must be finite and not zero",
+        });
+    }
+    s.check_finite()?;
+    if (s.t + h).is_finite() {
+        Ok(h)
+    } else {
+        Err(Error::NonFiniteState)
+    }
+}
+
+/// `h` when it is finite and moves the time of `s` (either way) to a finite time, `s` being
+/// finite: the check of a composition's signed substep ([`SymmetricBase::signed_step`],
+/// whose step is `h`).
+///
+/// [`SymmetricBase::signed_step`]: crate::SymmetricBase::signed_step
 pub(crate) fn check_signed<T: Real, const N: usize>(s: &State<T, N>, h: T) -> Result<T, Error> {
     if !h.is_finite() {
         return Err(Error::InvalidParameter {
-            name: "dt",
+            name: "h",
             reason: "must be finite",
         });
     }
@@ -297,11 +375,16 @@ pub(crate) fn check_dt<T: Real>(dt: T) -> Result<T, Error> {
     }
 }
 
-/// `Ok` when `t + dt` differs from `t`: a step that cannot move the clock is an error, not a
-/// silent no-op.
+/// `Ok` when `t + dt` differs from `t` and is finite: a step that cannot move the clock is an
+/// error, not a silent no-op ([`Error::StepSizeUnderflow`]), and one that would carry it past
+/// the largest finite time would end in a state that is not finite
+/// ([`Error::NonFiniteState`]).
 pub(crate) fn advances<T: Real>(t: T, dt: T) -> Result<(), Error> {
-    if t + dt == t {
+    let end = t + dt;
+    if end == t {
         Err(Error::StepSizeUnderflow)
+    } else if !end.is_finite() {
+        Err(Error::NonFiniteState)
     } else {
         Ok(())
     }

@@ -57,6 +57,7 @@
 
 mod adaptive;
 mod backward_euler;
+mod clock;
 mod contact_stepper;
 mod explicit_euler;
 mod fixed_timestep;
@@ -82,6 +83,7 @@ pub use adaptive::{
     EmbeddedRungeKutta, Statistics, Stop,
 };
 pub use backward_euler::{BackwardEuler, BackwardEulerTableau};
+pub use clock::Clock;
 pub use contact_stepper::ContactStepper;
 pub use explicit_euler::ExplicitEuler;
 pub use fixed_timestep::FixedTimestep;
@@ -89,7 +91,7 @@ pub use frame_clock::{Frame, FrameClock};
 pub use gauss_legendre::{GaussLegendre2, GaussLegendre2Tableau};
 pub use implicit_midpoint::{ImplicitMidpoint, MidpointTableau};
 pub use implicit_rk::{ImplicitRungeKutta, ImplicitTableau};
-pub use integrator::{Clock, Cost, Failure, Integrator, Method, Work};
+pub use integrator::{Cost, Failure, Integrator, Method, Work};
 pub use lagrange_core::constraints::contact::{ActiveRows, ContactModel, Contacts, Impact};
 pub use newton::NewtonSettings;
 pub use projected::Projected;

@@ -86,17 +86,48 @@ where
     /// constraints beyond the projection's tolerance; the inner integrator's errors;
     /// [`Projection::project`]'s errors.
     fn step(&mut self, mechanism: &M, state: &State<T, N>, dt: T) -> Result<State<T, N>, Error> {
-        if !self.last.is_some_and(|last| continues(&last, state)) {
-            mechanism.check_state(state, self.projection.tolerance())?;
-        }
-        let next = self.integrator.step(mechanism, state, dt)?;
-        let projected = self.projection.project(mechanism, mechanism, &next)?;
-        self.last = Some(projected);
-        Ok(projected)
+        self.projected(mechanism, state, dt, false)
+    }
+
+    /// A step of the inner integrator's run ([`Integrator::run_step`]), then the projection.
+    fn run_step(
+        &mut self,
+        mechanism: &M,
+        state: &State<T, N>,
+        dt: T,
+    ) -> Result<State<T, N>, Error> {
+        self.projected(mechanism, state, dt, true)
     }
 
     /// The inner integrator's.
     fn law_acceleration(&self, mechanism: &M, state: &State<T, N>) -> Result<SVector<T, N>, Error> {
         self.integrator.law_acceleration(mechanism, state)
+    }
+}
+
+impl<T: Real, const N: usize, const C: usize, I> Projected<T, N, C, I> {
+    /// A step (of a run, `run`) of the inner integrator, then the projection.
+    fn projected<M>(
+        &mut self,
+        mechanism: &M,
+        state: &State<T, N>,
+        dt: T,
+        run: bool,
+    ) -> Result<State<T, N>, Error>
+    where
+        M: Mechanism<T, N> + Constraints<T, N, C>,
+        I: Integrator<T, N, M>,
+    {
+        if !self.last.is_some_and(|last| continues(&last, state)) {
+            mechanism.check_state(state, self.projection.tolerance())?;
+        }
+        let next = if run {
+            self.integrator.run_step(mechanism, state, dt)?
+        } else {
+            self.integrator.step(mechanism, state, dt)?
+        };
+        let projected = self.projection.project(mechanism, mechanism, &next)?;
+        self.last = Some(projected);
+        Ok(projected)
     }
 }

@@ -1,8 +1,8 @@
 //! The classical fourth-order Runge-Kutta method.
 
-use crate::integrator::{check_step, finish, step_loop, Cost, Failure};
+use crate::integrator::{check_run_step, check_step, finish, step_loop, Cost, Failure};
 use crate::{Integrator, Method};
-use lagrange_core::{Error, Mechanism, Real, State};
+use lagrange_core::{Error, Lanes, Mechanism, Real, State};
 
 /// Classical Runge-Kutta on `y = (q, q')`, `y' = (q', q'')`:
 ///
@@ -30,8 +30,28 @@ impl Method for Rk4 {
 }
 
 impl<T: Real, const N: usize, M: Mechanism<T, N>> Integrator<T, N, M> for Rk4 {
+    /// The same step over lanes: it keeps nothing between steps.
+    fn step_lanes<const L: usize, G: Mechanism<Lanes<T, L>, N>>(
+        &self,
+        mechanism: &G,
+        state: &State<Lanes<T, L>, N>,
+        dt: T,
+    ) -> Option<Result<State<Lanes<T, L>, N>, Error>> {
+        Some(Integrator::<Lanes<T, L>, N, G>::run_step(
+            &mut Rk4,
+            mechanism,
+            state,
+            Lanes::splat(dt),
+        ))
+    }
+
     fn step(&mut self, m: &M, s: &State<T, N>, dt: T) -> Result<State<T, N>, Error> {
         let h = check_step(s, dt)?;
+        finish(stages(m, s, h)?)
+    }
+
+    fn run_step(&mut self, m: &M, s: &State<T, N>, dt: T) -> Result<State<T, N>, Error> {
+        let h = check_run_step(s, dt)?;
         finish(stages(m, s, h)?)
     }
 

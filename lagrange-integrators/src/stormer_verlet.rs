@@ -1,7 +1,9 @@
 //! Symmetric Stormer-Verlet: velocity Verlet made time-reversible for accelerations that
 //! depend on the velocities, the base of the order-4 compositions.
 
-use crate::integrator::{check_signed, check_step, finish, Cost, Work};
+use crate::integrator::{
+    check_run_step, check_signed, check_signed_run, check_step, finish, Cost, Work,
+};
 use crate::newton::{self, BlockMatrix, Blocks, NewtonProblem, NewtonSettings, Start};
 use crate::{Integrator, Method, SymmetricBase};
 use lagrange_core::nalgebra::{SMatrix, SVector};
@@ -171,11 +173,21 @@ impl<T: Real, const N: usize, M: Mechanism<T, N>> Integrator<T, N, M> for Storme
         let h = check_step(s, dt)?;
         self.advance(m, s, h)
     }
+
+    fn run_step(&mut self, m: &M, s: &State<T, N>, dt: T) -> Result<State<T, N>, Error> {
+        let h = check_run_step(s, dt)?;
+        self.advance(m, s, h)
+    }
 }
 
 impl<T: Real, const N: usize, M: Mechanism<T, N>> SymmetricBase<T, N, M> for StormerVerlet<T, N> {
     fn signed_step(&mut self, m: &M, s: &State<T, N>, h: T) -> Result<State<T, N>, Error> {
         let h = check_signed(s, h)?;
+        self.advance(m, s, h)
+    }
+
+    fn signed_run_step(&mut self, m: &M, s: &State<T, N>, h: T) -> Result<State<T, N>, Error> {
+        let h = check_signed_run(s, h)?;
         self.advance(m, s, h)
     }
 }

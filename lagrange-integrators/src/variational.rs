@@ -1,9 +1,12 @@
 //! [`VariationalMidpoint`]: the discrete Euler-Lagrange equations of the midpoint discrete
 //! Lagrangian, with discrete forces (Lagrange-d'Alembert), in position-momentum form.
 
-use crate::integrator::{check_signed, check_step, continues, Clock, Cost, Failure, Work};
+use crate::integrator::{
+    check_run, check_run_step, check_signed, check_signed_run, check_step, continues, Cost,
+    Failure, Work,
+};
 use crate::newton::{self, BlockMatrix, Blocks, NewtonProblem, NewtonSettings, Start};
-use crate::{Integrator, Method, SymmetricBase};
+use crate::{Clock, Integrator, Method, SymmetricBase};
 use lagrange_core::nalgebra::{SMatrix, SVector};
 use lagrange_core::{
     central_difference_jacobian, Dual, Error, Jacobian, Lagrangian, Mechanism, NoForce, Real,
@@ -318,7 +321,9 @@ impl<T: Real, const N: usize> VariationalMidpoint<T, N> {
         }
     }
 
-    /// The momenta `p = dL/dq'` at `state` (the continuous Legendre transform).
+    /// The momenta `p = dL/dq'` at `state` (the continuous Legendre transform). No error
+    /// channel: NaN or infinite for a state that is not finite or so extreme that it
+    /// overflows; [`VariationalMidpoint::step_phase`] refuses such a phase state.
     pub fn momentum<Sys: Lagrangian<T, N>>(&self, sys: &Sys, state: &State<T, N>) -> SVector<T, N> {
         directional(sys, state.t, &state.q, &state.qd, T::zero())
     }
@@ -370,7 +375,9 @@ impl<T: Real, const N: usize> VariationalMidpoint<T, N> {
     ///
     /// # Errors
     /// [`Error::InvalidParameter`] `dt` when not positive and finite;
-    /// [`Error::NonFiniteState`] for a non-finite start or result; [`Error::NoConvergence`] or
+    /// [`Error::StepSizeUnderflow`] when `phase.t + dt` rounds to `phase.t`;
+    /// [`Error::NonFiniteState`] for a non-finite start or result (a time that overflows
+    /// too); [`Error::NoConvergence`] or
     /// [`Error::SingularJacobian`] from Newton on the discrete Euler-Lagrange equation.
     pub fn step_phase<M: Mechanism<T, N>>(
         &mut self,
@@ -379,6 +386,10 @@ impl<T: Real, const N: usize> VariationalMidpoint<T, N> {
         dt: T,
     ) -> Result<PhaseState<T, N>, Error> {
         let dt = crate::integrator::check_dt(dt)?;
+        if !phase.is_finite() {
+            return Err(Error::NonFiniteState);
+        }
+        crate::integrator::advances(phase.t, dt)?;
         let guess = self.guess(&phase.q, dt);
         self.step_from(m, phase, dt, guess)
     }
@@ -391,7 +402,8 @@ impl<T: Real, const N: usize> VariationalMidpoint<T, N> {
         }
     }
 
-    /// A step of `h` (either sign) from `phase` with the guess `q1`.
+    /// A step of `h` (either sign, checked by the caller: it may be below the resolution of
+    /// the time in a run) from `phase` with the guess `q1`.
     fn step_from<M: Mechanism<T, N>>(
         &mut self,
         m: &M,
@@ -402,7 +414,6 @@ impl<T: Real, const N: usize> VariationalMidpoint<T, N> {
         if !phase.is_finite() {
             return Err(Error::NonFiniteState);
         }
-        crate::integrator::advances(phase.t, h)?;
         let mut problem = DiscreteEulerLagrange {
             sys: m,
             start: phase,
@@ -482,6 +493,11 @@ impl<T: Real, const N: usize, M: Mechanism<T, N>> Integrator<T, N, M>
         self.advance(m, s, h)
     }
 
+    fn run_step(&mut self, m: &M, s: &State<T, N>, dt: T) -> Result<State<T, N>, Error> {
+        let h = check_run_step(s, dt)?;
+        self.advance(m, s, h)
+    }
+
     /// In position-momentum form throughout, converting to velocities only at the end (the
     /// default would convert after every step).
     fn integrate(
@@ -496,7 +512,7 @@ impl<T: Real, const N: usize, M: Mechanism<T, N>> Integrator<T, N, M>
             step,
             last: *last,
         };
-        let dt = check_step(state, dt).map_err(|e| fail(e, 0, state))?;
+        let dt = check_run(state, dt, steps).map_err(|e| fail(e, 0, state))?;
         if steps == 0 {
             return Ok(*state);
         }
@@ -536,6 +552,11 @@ impl<T: Real, const N: usize, M: Mechanism<T, N>> SymmetricBase<T, N, M>
 {
     fn signed_step(&mut self, m: &M, s: &State<T, N>, h: T) -> Result<State<T, N>, Error> {
         let h = check_signed(s, h)?;
+        self.advance(m, s, h)
+    }
+
+    fn signed_run_step(&mut self, m: &M, s: &State<T, N>, h: T) -> Result<State<T, N>, Error> {
+        let h = check_signed_run(s, h)?;
         self.advance(m, s, h)
     }
 }

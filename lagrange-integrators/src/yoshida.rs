@@ -1,7 +1,7 @@
 //! Yoshida's order-4 composition (the triple jump; Forest-Ruth in kick-drift form) of a
 //! symmetric second-order method.
 
-use crate::integrator::{check_step, Cost, Work};
+use crate::integrator::{check_run_step, check_step, Cost, Work};
 use crate::{Integrator, Method};
 use lagrange_core::{Error, Mechanism, Real, State};
 
@@ -13,7 +13,8 @@ pub trait SymmetricBase<T: Real, const N: usize, M: Mechanism<T, N>>: Integrator
     /// A step of `h`, which may be negative: a composition steps back in its middle substep.
     ///
     /// # Errors
-    /// [`Error::NonFiniteState`] for a non-finite `state` or result;
+    /// [`Error::InvalidParameter`] `h` when not finite; [`Error::NonFiniteState`] for a
+    /// non-finite `state` or result (a time `state.t + h` that overflows too);
     /// [`Error::StepSizeUnderflow`] when `state.t + h` rounds to `state.t` (`h = 0` too); as
     /// [`Integrator::step`] otherwise.
     fn signed_step(
@@ -22,6 +23,22 @@ pub trait SymmetricBase<T: Real, const N: usize, M: Mechanism<T, N>>: Integrator
         state: &State<T, N>,
         h: T,
     ) -> Result<State<T, N>, Error>;
+
+    /// A signed substep of a run whose clock keeps the time ([`Integrator::run_step`]): as
+    /// [`SymmetricBase::signed_step`], but an `h` below the resolution of `state.t` is taken.
+    /// The default is [`SymmetricBase::signed_step`].
+    ///
+    /// # Errors
+    /// As [`SymmetricBase::signed_step`], but for [`Error::StepSizeUnderflow`] where only the
+    /// rounded time would not move.
+    fn signed_run_step(
+        &mut self,
+        mechanism: &M,
+        state: &State<T, N>,
+        h: T,
+    ) -> Result<State<T, N>, Error> {
+        self.signed_step(mechanism, state, h)
+    }
 }
 
 /// The weights of the triple jump, `w1, w0, w1`:
@@ -111,10 +128,44 @@ where
 {
     fn step(&mut self, m: &M, s: &State<T, N>, dt: T) -> Result<State<T, N>, Error> {
         let dt = check_step(s, dt)?;
+        self.compose(m, s, dt, false)
+    }
+
+    fn run_step(&mut self, m: &M, s: &State<T, N>, dt: T) -> Result<State<T, N>, Error> {
+        let dt = check_run_step(s, dt)?;
+        self.compose(m, s, dt, true)
+    }
+}
+
+impl<B> Yoshida4<B> {
+    /// The three substeps of a step of `dt` (checked) from `s`: signed steps of the base, or
+    /// signed steps of a run (`run`).
+    fn compose<T, M, const N: usize>(
+        &mut self,
+        m: &M,
+        s: &State<T, N>,
+        dt: T,
+        run: bool,
+    ) -> Result<State<T, N>, Error>
+    where
+        T: Real,
+        M: Mechanism<T, N>,
+        B: SymmetricBase<T, N, M>,
+    {
         let mut next = *s;
         let mut work = Work::default();
         for w in YOSHIDA4_WEIGHTS {
-            next = self.base.signed_step(m, &next, dt * T::from_f64(w))?;
+            // A substep that overflows (`w dt` near `T::MAX`) would end in a time that is not
+            // finite, as `state.t + dt` past `T::MAX` would.
+            let h = dt * T::from_f64(w);
+            if !h.is_finite() {
+                return Err(Error::NonFiniteState);
+            }
+            next = if run {
+                self.base.signed_run_step(m, &next, h)?
+            } else {
+                self.base.signed_step(m, &next, h)?
+            };
             let done = self.base.last_step();
             work.evaluations += done.evaluations;
             work.jacobians += done.jacobians;

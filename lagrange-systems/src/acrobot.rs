@@ -3,7 +3,8 @@
 use crate::small_solve::solve_sym2;
 use lagrange_core::nalgebra::{Matrix2, SVector, Vector2};
 use lagrange_core::{
-    validate, Controlled, Error, GeneralizedForce, Lagrangian, Mechanism, Real, Scalar, State,
+    free_law_force, validate, Controlled, Error, GeneralizedForce, Lagrangian, Lanes, Mechanism,
+    Real, Scalar, State,
 };
 
 /// Spong's acrobot: two rigid links in a vertical plane, the first hinged to a fixed pivot
@@ -74,8 +75,11 @@ impl<T: Real> Acrobot<T> {
     /// needs inertia about its hinge: `m1 lc1^2 + i1 > 0` and `m2 lc2^2 + i2 > 0`.
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] naming the first parameter out of range or not finite, or
-    /// `i1` (`i2`) when link 1 (2) has no inertia about its hinge.
+    /// [`Error::InvalidParameter`] naming the first parameter out of range or not finite,
+    /// `i1` (`i2`) when link 1 (2) has no inertia about its hinge, or the parameter most
+    /// responsible when a quantity formed from them leaves the range of `T` (the hinge
+    /// inertias, the entries of the mass matrix, its determinant at its smallest and largest,
+    /// the weight terms).
     #[allow(clippy::too_many_arguments)] // the nine parameters of the conventions, in order
     pub fn new(
         m1: T,
@@ -100,14 +104,56 @@ impl<T: Real> Acrobot<T> {
             gravity: validate::non_negative("gravity", gravity)?,
             torque: T::zero(),
         };
-        let hinge_inertia = |name, i: T, m: T, lc: T| {
-            validate::positive(name, i + m * lc * lc).map_err(|_| Error::InvalidParameter {
-                name,
-                reason: "the link needs inertia about its hinge: i + m lc^2 must be positive",
-            })
+        let f = |name, x, power| (name, x, power);
+        let hinge_inertia = |name, i: T, m: T, lc: T, m_name, lc_name| {
+            let factors = [f(m_name, m, 1), f(lc_name, lc, 2), f(name, i, 1)];
+            validate::derived(m * lc * lc, &factors[..2])?;
+            let hinge = i + m * lc * lc;
+            if hinge > T::zero() {
+                validate::divisor(hinge, &factors)
+            } else {
+                Err(Error::InvalidParameter {
+                    name,
+                    reason: "the link needs inertia about its hinge: i + m lc^2 must be positive",
+                })
+            }
         };
-        hinge_inertia("i1", a.i1, a.m1, a.lc1)?;
-        hinge_inertia("i2", a.i2, a.m2, a.lc2)?;
+        let i1h = hinge_inertia("i1", a.i1, a.m1, a.lc1, "m1", "lc1")?;
+        let d22 = hinge_inertia("i2", a.i2, a.m2, a.lc2, "m2", "lc2")?;
+        // The mass matrix: d22, k cos, d11 up to d11_max; its determinant from
+        // i1h d22 (a lower bound) to d11_max d22; the weights; the potential's range.
+        let (m1, m2, l1, lc1, lc2, i1, i2, g) = (
+            f("m1", a.m1, 1),
+            f("m2", a.m2, 1),
+            f("l1", a.l1, 1),
+            f("lc1", a.lc1, 1),
+            f("lc2", a.lc2, 1),
+            f("i1", a.i1, 1),
+            f("i2", a.i2, 1),
+            f("gravity", a.gravity, 1),
+        );
+        let k = validate::derived(a.m2 * a.l1 * a.lc2, &[m2, l1, lc2])?;
+        let reach = validate::derived(a.m2 * a.l1 * a.l1, &[m2, f("l1", a.l1, 2)])?;
+        let all = [
+            m1,
+            m2,
+            f("l1", a.l1, 2),
+            f("lc1", a.lc1, 2),
+            f("lc2", a.lc2, 2),
+            i1,
+            i2,
+        ];
+        let d11_max = validate::derived(i1h + reach + d22 + T::TWO * k, &all)?;
+        validate::derived(d11_max * d22, &all)?;
+        validate::divisor(i1h * d22, &all)?;
+        let w = validate::derived(a.m1 * a.lc1 + a.m2 * a.l1, &[m1, lc1, m2, l1])?;
+        validate::derived(w * a.gravity, &[m1, lc1, m2, l1, g])?;
+        validate::derived(a.m2 * a.lc2 * a.gravity, &[m2, lc2, g])?;
+        let reach2 = validate::derived(a.m2 * (a.l1 + a.lc2), &[m2, l1, lc2])?;
+        validate::derived(
+            a.gravity * (a.m1 * a.lc1 + reach2),
+            &[g, m1, lc1, m2, l1, lc2],
+        )?;
         Ok(a)
     }
 
@@ -168,7 +214,8 @@ impl<T: Real> Acrobot<T> {
         self.torque = validate::finite("torque", torque)?;
         Ok(())
     }
-    /// Position `(x, y)` of the tip of link 2 relative to the pivot, m.
+    /// Position `(x, y)` of the tip of link 2 relative to the pivot, m. (No error channel: NaN
+    /// for angles that are not finite.)
     #[must_use]
     pub fn tip(&self, s: &State<T, 2>) -> (T, T) {
         let (s1, c1) = s.q[0].sin_cos();
@@ -208,6 +255,22 @@ impl<T: Real> Controlled<T> for Acrobot<T> {
 }
 
 impl<T: Real> Mechanism<T, 2> for Acrobot<T> {
+    /// Lane by lane: every parameter gathered.
+    fn gather<const L: usize>(instances: [&Self; L]) -> Option<impl Mechanism<Lanes<T, L>, 2>> {
+        let lanes = |field: fn(&Self) -> T| Lanes::gather(&instances, field);
+        Some(Acrobot {
+            m1: lanes(|m| m.m1),
+            m2: lanes(|m| m.m2),
+            l1: lanes(|m| m.l1),
+            l2: lanes(|m| m.l2),
+            lc1: lanes(|m| m.lc1),
+            lc2: lanes(|m| m.lc2),
+            i1: lanes(|m| m.i1),
+            i2: lanes(|m| m.i2),
+            gravity: lanes(|m| m.gravity),
+            torque: lanes(|m| m.torque),
+        })
+    }
     fn mass_matrix(&self, s: &State<T, 2>) -> Matrix2<T> {
         self.terms(s).0
     }
@@ -228,6 +291,13 @@ impl<T: Real> Mechanism<T, 2> for Acrobot<T> {
             &mass,
             &extra.added_to(s, f + self.non_conservative_force(s)),
         )
+    }
+    fn law_force<F: GeneralizedForce<T, 2>>(
+        &self,
+        s: &State<T, 2>,
+        extra: &F,
+    ) -> Result<SVector<T, 2>, Error> {
+        free_law_force(self, s, extra)
     }
 }
 

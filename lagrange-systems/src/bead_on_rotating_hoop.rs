@@ -1,7 +1,10 @@
 //! [`BeadOnRotatingHoop`]: a bead sliding on a vertical hoop driven to spin about the vertical.
 
+use crate::small_solve::finite;
 use lagrange_core::nalgebra::{Matrix1, SMatrix, SVector, Vector1};
-use lagrange_core::{validate, Error, Lagrangian, Mechanism, Real, Scalar, State};
+use lagrange_core::{
+    free_law_force, validate, Error, GeneralizedForce, Lagrangian, Mechanism, Real, Scalar, State,
+};
 
 /// A bead of mass `m` sliding without friction on a vertical hoop of radius `R` that is driven
 /// at constant angular speed `omega` about the vertical axis through its centre.
@@ -42,13 +45,30 @@ impl<T: Real> BeadOnRotatingHoop<T> {
     /// any finite sign) in `gravity` (m/s^2, >= 0).
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] naming the first parameter out of range or not finite.
+    /// [`Error::InvalidParameter`] naming the first parameter out of range or not finite, or
+    /// the one most responsible when a quantity formed from them leaves the range of `T`
+    /// (`m R^2`, which the motion divides by, `m R^2 omega^2`, `m g R`).
     pub fn new(mass: T, radius: T, omega: T, gravity: T) -> Result<Self, Error> {
+        let mass = validate::positive("mass", mass)?;
+        let radius = validate::positive("radius", radius)?;
+        let omega = validate::finite("omega", omega)?;
+        let gravity = validate::non_negative("gravity", gravity)?;
+        let (m, r2, w2) = (
+            ("mass", mass, 1),
+            ("radius", radius, 2),
+            ("omega", omega, 2),
+        );
+        let inertia = validate::divisor(mass * radius * radius, &[m, r2])?;
+        validate::derived(inertia * (omega * omega), &[m, r2, w2])?;
+        validate::derived(
+            mass * gravity * radius,
+            &[m, ("gravity", gravity, 1), ("radius", radius, 1)],
+        )?;
         Ok(Self {
-            mass: validate::positive("mass", mass)?,
-            radius: validate::positive("radius", radius)?,
-            omega: validate::finite("omega", omega)?,
-            gravity: validate::non_negative("gravity", gravity)?,
+            mass,
+            radius,
+            omega,
+            gravity,
         })
     }
     /// Mass, kg.
@@ -72,6 +92,8 @@ impl<T: Real> BeadOnRotatingHoop<T> {
         self.gravity
     }
     /// The conserved Jacobi integral `m R^2 (th'^2 - omega^2 sin^2 th)/2 - m g R cos th`.
+    /// (No error channel: NaN or infinite for a state that is not finite or so extreme that
+    /// it overflows.)
     #[must_use]
     pub fn jacobi_integral(&self, s: &State<T, 1>) -> T {
         let sin = s.q[0].sin();
@@ -95,7 +117,14 @@ impl<T: Real> Mechanism<T, 1> for BeadOnRotatingHoop<T> {
         Vector1::new(self.inertia() * w2 * sin * cos - self.mass * self.gravity * self.radius * sin)
     }
     fn solve_mass(&self, _s: &State<T, 1>, b: &SVector<T, 1>) -> Result<SVector<T, 1>, Error> {
-        Ok(b / self.inertia())
+        finite(b / self.inertia(), Error::NonFiniteState)
+    }
+    fn law_force<F: GeneralizedForce<T, 1>>(
+        &self,
+        s: &State<T, 1>,
+        extra: &F,
+    ) -> Result<SVector<T, 1>, Error> {
+        free_law_force(self, s, extra)
     }
 }
 

@@ -3,7 +3,8 @@
 use crate::small_solve::solve_sym2;
 use lagrange_core::nalgebra::{Matrix2, SVector, Vector2};
 use lagrange_core::{
-    validate, Controlled, Error, GeneralizedForce, Lagrangian, Mechanism, Real, Scalar, State,
+    free_law_force, validate, Controlled, Error, GeneralizedForce, Lagrangian, Lanes, Mechanism,
+    Real, Scalar, State,
 };
 
 /// The cart-pole: a cart of mass `M` on a frictionless horizontal track, driven by a horizontal
@@ -62,13 +63,38 @@ impl<T: Real> CartPole<T> {
     /// `pole_half_length` (m, > 0), in `gravity` (m/s^2, >= 0), with no force applied.
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] naming the first parameter out of range or not finite.
+    /// [`Error::InvalidParameter`] naming the first parameter out of range or not finite, or
+    /// the one most responsible when a quantity formed from them leaves the range of `T`: the
+    /// entries of the mass matrix, its determinant at its smallest and largest (the motion
+    /// divides by it) and the weight terms `m g l`.
     pub fn new(cart_mass: T, pole_mass: T, pole_half_length: T, gravity: T) -> Result<Self, Error> {
+        let cart_mass = validate::positive("cart_mass", cart_mass)?;
+        let pole_mass = validate::positive("pole_mass", pole_mass)?;
+        let pole_half_length = validate::positive("pole_half_length", pole_half_length)?;
+        let gravity = validate::non_negative("gravity", gravity)?;
+        let (mc, m, l, g) = (
+            ("cart_mass", cart_mass, 1),
+            ("pole_mass", pole_mass, 1),
+            ("pole_half_length", pole_half_length, 1),
+            ("gravity", gravity, 1),
+        );
+        let (m2, l2) = (
+            ("pole_mass", pole_mass, 2),
+            ("pole_half_length", pole_half_length, 2),
+        );
+        let total = validate::divisor(cart_mass + pole_mass, &[mc, m])?;
+        let ml = validate::derived(pole_mass * pole_half_length, &[m, l])?;
+        let m11 = validate::divisor(T::from_f64(4.0 / 3.0) * ml * pole_half_length, &[m, l2])?;
+        validate::derived(ml * gravity, &[m, l, g])?;
+        validate::derived(pole_mass * gravity * pole_half_length, &[m, g, l])?;
+        // det M = total m11 - (ml cos)^2, smallest at cos^2 = 1: m l^2 (4/3 mc + m/3) > 0.
+        let top = validate::derived(total * m11, &[mc, m2, l2])?;
+        validate::divisor(top - ml * ml, &[mc, m2, l2])?;
         Ok(Self {
-            cart_mass: validate::positive("cart_mass", cart_mass)?,
-            pole_mass: validate::positive("pole_mass", pole_mass)?,
-            pole_half_length: validate::positive("pole_half_length", pole_half_length)?,
-            gravity: validate::non_negative("gravity", gravity)?,
+            cart_mass,
+            pole_mass,
+            pole_half_length,
+            gravity,
             force: T::zero(),
         })
     }
@@ -137,6 +163,17 @@ impl<T: Real> Controlled<T> for CartPole<T> {
 }
 
 impl<T: Real> Mechanism<T, 2> for CartPole<T> {
+    /// Lane by lane: every parameter gathered.
+    fn gather<const L: usize>(instances: [&Self; L]) -> Option<impl Mechanism<Lanes<T, L>, 2>> {
+        let lanes = |field: fn(&Self) -> T| Lanes::gather(&instances, field);
+        Some(CartPole {
+            cart_mass: lanes(|m| m.cart_mass),
+            pole_mass: lanes(|m| m.pole_mass),
+            pole_half_length: lanes(|m| m.pole_half_length),
+            gravity: lanes(|m| m.gravity),
+            force: lanes(|m| m.force),
+        })
+    }
     fn mass_matrix(&self, s: &State<T, 2>) -> Matrix2<T> {
         self.terms(s).0
     }
@@ -157,6 +194,13 @@ impl<T: Real> Mechanism<T, 2> for CartPole<T> {
             &mass,
             &extra.added_to(s, f + self.non_conservative_force(s)),
         )
+    }
+    fn law_force<F: GeneralizedForce<T, 2>>(
+        &self,
+        s: &State<T, 2>,
+        extra: &F,
+    ) -> Result<SVector<T, 2>, Error> {
+        free_law_force(self, s, extra)
     }
 }
 

@@ -53,12 +53,27 @@ impl<T: Real> CartesianPendulum<T> {
     /// A bob of `mass` (kg, > 0) on a rod of `length` (m, > 0) in `gravity` (m/s^2, >= 0).
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] naming the first parameter out of range or not finite.
+    /// [`Error::InvalidParameter`] naming the first parameter out of range or not finite, or
+    /// the one most responsible when `1 / m`, the weight `m g`, `l^2` or `1 / (2 l)` leaves the
+    /// range of `T`.
     pub fn new(mass: T, length: T, gravity: T) -> Result<Self, Error> {
+        let mass = validate::positive("mass", mass)?;
+        let length = validate::positive("length", length)?;
+        let gravity = validate::non_negative("gravity", gravity)?;
+        validate::divisor(mass, &[("mass", mass, 1)])?;
+        validate::derived(
+            mass * gravity,
+            &[("mass", mass, 1), ("gravity", gravity, 1)],
+        )?;
+        // The rows divide by l and 2 l, and phi holds l^2.
+        let l = ("length", length, 1);
+        validate::divisor(length, &[l])?;
+        validate::divisor(T::TWO * length, &[l])?;
+        validate::derived(length * length, &[("length", length, 2)])?;
         Ok(Self {
-            mass: validate::positive("mass", mass)?,
-            length: validate::positive("length", length)?,
-            gravity: validate::non_negative("gravity", gravity)?,
+            mass,
+            length,
+            gravity,
         })
     }
 
@@ -79,7 +94,8 @@ impl<T: Real> CartesianPendulum<T> {
     }
 
     /// The consistent state at time `t` of angle `th` from the downward vertical and angular
-    /// rate `thd`.
+    /// rate `thd`. (No error channel: not finite where an argument is not, or where `l thd`
+    /// overflows; check it with [`State::is_finite`].)
     #[must_use]
     pub fn state_from_angle(&self, t: T, th: T, thd: T) -> State<T, 2> {
         let (s, c) = th.sin_cos();
@@ -88,6 +104,8 @@ impl<T: Real> CartesianPendulum<T> {
     }
 
     /// The angle from the downward vertical and its rate, `(atan2(x, -y), (x y' - y x') / r^2)`.
+    /// (No error channel: the rate is NaN at the pivot, `r = 0`, and both are NaN or infinite
+    /// for a state that is not finite.)
     #[must_use]
     pub fn angle(&self, state: &State<T, 2>) -> (T, T) {
         let (x, y) = (state.q[0], state.q[1]);
@@ -104,7 +122,12 @@ impl<T: Real> Mechanism<T, 2> for CartesianPendulum<T> {
         Vector2::new(T::zero(), -self.mass * self.gravity)
     }
     fn solve_mass(&self, _s: &State<T, 2>, b: &Vector2<T>) -> Result<Vector2<T>, Error> {
-        Ok(b / self.mass)
+        let x = b / self.mass;
+        if x.iter().all(|v| v.is_finite()) {
+            Ok(x)
+        } else {
+            Err(Error::NonFiniteState)
+        }
     }
 }
 

@@ -3,7 +3,8 @@
 use crate::small_solve::solve_sym2_det;
 use lagrange_core::nalgebra::{Matrix2, SVector, Vector2};
 use lagrange_core::{
-    validate, Error, GeneralizedForce, Lagrangian, Mechanism, Real, Scalar, State,
+    free_law_force, validate, Error, GeneralizedForce, Lagrangian, Lanes, Mechanism, Real, Scalar,
+    State,
 };
 
 /// Point masses `m1`, `m2` on massless rods `l1`, `l2`: the first hangs from a fixed pivot,
@@ -67,22 +68,34 @@ impl<T: Real> DoublePendulum<T> {
     /// Masses `m1`, `m2` (kg, > 0), rod lengths `l1`, `l2` (m, > 0), `gravity` (m/s^2, >= 0).
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] naming the first parameter out of range or not finite.
+    /// [`Error::InvalidParameter`] naming the first parameter out of range or not finite, or
+    /// the one most responsible when a quantity formed from them leaves the range of `T`
+    /// (the entries of `M`, the weights `(m1 + m2) g l1` and `m2 g l2`, and `det M`, which
+    /// the motion divides by, at its smallest and largest).
     pub fn new(m1: T, m2: T, l1: T, l2: T, gravity: T) -> Result<Self, Error> {
         let m1 = validate::positive("m1", m1)?;
         let m2 = validate::positive("m2", m2)?;
         let l1 = validate::positive("l1", l1)?;
         let l2 = validate::positive("l2", l2)?;
         let gravity = validate::non_negative("gravity", gravity)?;
-        let mu = m1 + m2;
+        let f = |name, x, power| (name, x, power);
+        let (a1, a2, g) = (f("m1", m1, 1), f("m2", m2, 1), f("gravity", gravity, 1));
+        let mu = validate::derived(m1 + m2, &[a1, a2])?;
         let k = Coefficients {
-            m11: mu * l1 * l1,
-            m22: m2 * l2 * l2,
-            coupling: m2 * l1 * l2,
-            weight1: mu * gravity * l1,
-            weight2: m2 * gravity * l2,
-            det_scale: m2 * l1 * l1 * l2 * l2,
+            m11: validate::divisor(mu * l1 * l1, &[a1, a2, f("l1", l1, 2)])?,
+            m22: validate::divisor(m2 * l2 * l2, &[a2, f("l2", l2, 2)])?,
+            coupling: validate::derived(m2 * l1 * l2, &[a2, f("l1", l1, 1), f("l2", l2, 1)])?,
+            weight1: validate::derived(mu * gravity * l1, &[a1, a2, g, f("l1", l1, 1)])?,
+            weight2: validate::derived(m2 * gravity * l2, &[a2, g, f("l2", l2, 1)])?,
+            det_scale: validate::derived(
+                m2 * l1 * l1 * l2 * l2,
+                &[a2, f("l1", l1, 2), f("l2", l2, 2)],
+            )?,
         };
+        // det M = det_scale (m1 + m2 sin^2): from det_scale m1 (sin = 0) to det_scale mu.
+        let det = [a2, f("l1", l1, 2), f("l2", l2, 2)];
+        validate::divisor(k.det_scale * m1, &[det[0], det[1], det[2], a1])?;
+        validate::derived(k.det_scale * mu, &[det[0], det[1], det[2], a1, a2])?;
         Ok(Self {
             m1,
             m2,
@@ -136,6 +149,25 @@ impl<T: Real> DoublePendulum<T> {
 }
 
 impl<T: Real> Mechanism<T, 2> for DoublePendulum<T> {
+    /// Lane by lane: every parameter gathered.
+    fn gather<const L: usize>(instances: [&Self; L]) -> Option<impl Mechanism<Lanes<T, L>, 2>> {
+        let lanes = |field: fn(&Self) -> T| Lanes::gather(&instances, field);
+        Some(DoublePendulum {
+            m1: lanes(|m| m.m1),
+            m2: lanes(|m| m.m2),
+            l1: lanes(|m| m.l1),
+            l2: lanes(|m| m.l2),
+            gravity: lanes(|m| m.gravity),
+            k: Coefficients {
+                m11: lanes(|m| m.k.m11),
+                m22: lanes(|m| m.k.m22),
+                coupling: lanes(|m| m.k.coupling),
+                weight1: lanes(|m| m.k.weight1),
+                weight2: lanes(|m| m.k.weight2),
+                det_scale: lanes(|m| m.k.det_scale),
+            },
+        })
+    }
     fn mass_matrix(&self, s: &State<T, 2>) -> Matrix2<T> {
         self.mass((s.q[0] - s.q[1]).cos())
     }
@@ -157,6 +189,13 @@ impl<T: Real> Mechanism<T, 2> for DoublePendulum<T> {
     ) -> Result<SVector<T, 2>, Error> {
         let (m, f, det) = self.terms(s);
         solve_sym2_det(&m, det, &extra.added_to(s, f))
+    }
+    fn law_force<F: GeneralizedForce<T, 2>>(
+        &self,
+        s: &State<T, 2>,
+        extra: &F,
+    ) -> Result<SVector<T, 2>, Error> {
+        free_law_force(self, s, extra)
     }
 }
 

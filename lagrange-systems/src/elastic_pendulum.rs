@@ -2,7 +2,9 @@
 
 use crate::small_solve::{positive_radius, solve_diagonal2};
 use lagrange_core::nalgebra::{Matrix2, SVector, Vector2};
-use lagrange_core::{validate, Error, Lagrangian, Mechanism, Real, Scalar, State};
+use lagrange_core::{
+    free_law_force, validate, Error, GeneralizedForce, Lagrangian, Mechanism, Real, Scalar, State,
+};
 
 /// What [`ElasticPendulum`] reports at `r <= 0`.
 const SPRING_COLLAPSED: &str = "spring length r <= 0";
@@ -56,13 +58,23 @@ impl<T: Real> ElasticPendulum<T> {
     /// in `gravity` (m/s^2, >= 0).
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] naming the first parameter out of range or not finite.
+    /// [`Error::InvalidParameter`] naming the first parameter out of range or not finite, or
+    /// the one most responsible when `1 / m` or the weight `m g` overflows.
     pub fn new(mass: T, stiffness: T, rest_length: T, gravity: T) -> Result<Self, Error> {
+        let mass = validate::positive("mass", mass)?;
+        let stiffness = validate::positive("stiffness", stiffness)?;
+        let rest_length = validate::non_negative("rest_length", rest_length)?;
+        let gravity = validate::non_negative("gravity", gravity)?;
+        validate::divisor(mass, &[("mass", mass, 1)])?;
+        validate::derived(
+            mass * gravity,
+            &[("mass", mass, 1), ("gravity", gravity, 1)],
+        )?;
         Ok(Self {
-            mass: validate::positive("mass", mass)?,
-            stiffness: validate::positive("stiffness", stiffness)?,
-            rest_length: validate::non_negative("rest_length", rest_length)?,
-            gravity: validate::non_negative("gravity", gravity)?,
+            mass,
+            stiffness,
+            rest_length,
+            gravity,
         })
     }
     /// Mass, kg.
@@ -105,6 +117,15 @@ impl<T: Real> Mechanism<T, 2> for ElasticPendulum<T> {
         let r = s.q[0];
         positive_radius(s, SPRING_COLLAPSED)?;
         solve_diagonal2(s, [self.mass, self.mass * r * r], b, SPRING_COLLAPSED)
+    }
+    fn law_force<F: GeneralizedForce<T, 2>>(
+        &self,
+        s: &State<T, 2>,
+        extra: &F,
+    ) -> Result<SVector<T, 2>, Error> {
+        // The law refuses r <= 0, and so does its force.
+        positive_radius(s, SPRING_COLLAPSED)?;
+        free_law_force(self, s, extra)
     }
 }
 

@@ -22,17 +22,31 @@ pub fn elliptic_k<T: Real>(k: T) -> Result<T, Error> {
 /// Landen (AGM) scheme.
 ///
 /// # Errors
-/// [`Error::InvalidParameter`] `k` outside `[0, 1)`, or `u` not finite.
+/// [`Error::InvalidParameter`] `k` outside `[0, 1)`, or `u` not finite or so large that the
+/// scheme's phase `2^n a_n u` overflows.
 pub fn jacobi_sn_cn<T: Real>(u: T, k: T) -> Result<(T, T), Error> {
     let k = modulus(k)?;
     let u = validate::finite("u", u)?;
+    sn_cn(u, k).ok_or(Error::InvalidParameter {
+        name: "u",
+        reason: "so large that the phase 2^n a_n u of the Landen scheme overflows",
+    })
+}
+
+/// `(sn(u, k), cn(u, k))` for a valid modulus and a finite `u`; `None` when the phase of the
+/// Landen scheme overflows.
+fn sn_cn<T: Real>(u: T, k: T) -> Option<(T, T)> {
     let (a, c, n) = agm(k);
     // phi_n = 2^n a_n u, then phi_{j-1} = (phi_j + asin(c_j / a_j sin phi_j)) / 2.
     let mut phi = u * a[n] * T::TWO.powi(i32::try_from(n).unwrap_or(0));
+    if !phi.is_finite() {
+        return None;
+    }
     for j in (1..=n).rev() {
         phi = T::HALF * (phi + (c[j] / a[j] * phi.sin()).asin());
     }
-    Ok(phi.sin_cos())
+    let (sn, cn) = phi.sin_cos();
+    (sn.is_finite() && cn.is_finite()).then_some((sn, cn))
 }
 
 /// `k` when it is a valid modulus.
@@ -76,7 +90,9 @@ fn agm<T: Real>(k: T) -> ([T; MAX_AGM_STEPS], [T; MAX_AGM_STEPS], usize) {
 /// ```
 ///
 /// # Errors
-/// [`Error::InvalidParameter`] for `|theta0| >= pi`, `omega <= 0` or a non-finite argument.
+/// [`Error::InvalidParameter`] for `|theta0| >= pi` (or so close to `pi` that the modulus
+/// rounds to 1), `omega <= 0` or a non-finite argument; `omega` or `t` when the phase
+/// `omega t` overflows (the one most responsible), `omega` when the rate `2 omega` does.
 ///
 /// ```
 /// use lagrange_systems::exact::pendulum_from_rest;
@@ -86,8 +102,21 @@ fn agm<T: Real>(k: T) -> ([T; MAX_AGM_STEPS], [T; MAX_AGM_STEPS], usize) {
 /// # Ok::<(), lagrange_core::Error>(())
 /// ```
 pub fn pendulum_from_rest<T: Real>(theta0: T, omega: T, t: T) -> Result<(T, T), Error> {
-    let omega = validate::positive("omega", omega)?;
+    let (k, omega) = amplitude(theta0, omega)?;
     let t = validate::finite("t", t)?;
+    // th' is at most 2 omega; the phase K - omega t must stay finite.
+    validate::derived(T::TWO * omega, &[("omega", omega, 1)])?;
+    let phase = [("omega", omega, 1), ("t", t, 1)];
+    let u = validate::derived(elliptic_k(k.abs())? - omega * t, &phase)?;
+    let (sn, cn) = sn_cn(u, k.abs()).ok_or_else(|| validate::overflowed(&phase))?;
+    // For a negative start the motion is the mirror image.
+    Ok((T::TWO * (k * sn).asin(), -T::TWO * k * omega * cn))
+}
+
+/// `(sin(theta0 / 2), omega)` when `theta0` is an amplitude strictly between `-pi`
+/// and `pi` whose modulus `sin(theta0 / 2)` is below 1 in magnitude, and `omega > 0`.
+fn amplitude<T: Real>(theta0: T, omega: T) -> Result<(T, T), Error> {
+    let omega = validate::positive("omega", omega)?;
     let theta0 = validate::finite("theta0", theta0)?;
     if theta0.abs() >= T::PI {
         return Err(Error::InvalidParameter {
@@ -96,19 +125,25 @@ pub fn pendulum_from_rest<T: Real>(theta0: T, omega: T, t: T) -> Result<(T, T), 
         });
     }
     let k = (T::HALF * theta0).sin();
-    let (sn, cn) = jacobi_sn_cn(elliptic_k(k.abs())? - omega * t, k.abs())?;
-    // For a negative start the motion is the mirror image.
-    Ok((T::TWO * (k * sn).asin(), -T::TWO * k * omega * cn))
+    if k.abs() >= T::one() {
+        return Err(Error::InvalidParameter {
+            name: "theta0",
+            reason: "so close to pi that the modulus sin(theta0 / 2) rounds to 1",
+        });
+    }
+    Ok((k, omega))
 }
 
 /// The period `4 K(sin(theta0/2)) / omega` of a pendulum of amplitude `theta0`.
 ///
 /// # Errors
-/// As [`pendulum_from_rest`].
+/// [`Error::InvalidParameter`] for `|theta0| >= pi` (or so close to `pi` that the modulus
+/// rounds to 1), `omega <= 0`, a non-finite argument, or `omega` so small that the period
+/// overflows.
 pub fn pendulum_period<T: Real>(theta0: T, omega: T) -> Result<T, Error> {
-    let omega = validate::positive("omega", omega)?;
-    let k = (T::HALF * validate::finite("theta0", theta0)?).sin().abs();
-    Ok(T::from_f64(4.0) * elliptic_k(k)? / omega)
+    let (k, omega) = amplitude(theta0, omega)?;
+    let period = T::from_f64(4.0) * elliptic_k(k.abs())? / omega;
+    validate::derived(period, &[("omega", omega, -1)])
 }
 
 mod damped_oscillator;

@@ -1,7 +1,11 @@
 //! [`FallingParticle`]: a point mass in uniform gravity.
 
+use crate::small_solve::finite;
 use lagrange_core::nalgebra::{Matrix1, SMatrix, SVector, Vector1};
-use lagrange_core::{validate, Error, Lagrangian, Mechanism, Real, Scalar, State};
+use lagrange_core::{
+    free_law_force, validate, Error, GeneralizedForce, Lagrangian, Lanes, Mechanism, Real, Scalar,
+    State,
+};
 
 /// A point mass `m` falling in uniform gravity `g` along -y.
 ///
@@ -32,12 +36,17 @@ impl<T: Real> FallingParticle<T> {
     /// A particle of `mass` (kg, > 0) in `gravity` (m/s^2, >= 0).
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] naming `mass` or `gravity`.
+    /// [`Error::InvalidParameter`] naming `mass` or `gravity` when out of range or not finite,
+    /// or the one most responsible when the weight `m g` overflows or `1 / m` does.
     pub fn new(mass: T, gravity: T) -> Result<Self, Error> {
-        Ok(Self {
-            mass: validate::positive("mass", mass)?,
-            gravity: validate::non_negative("gravity", gravity)?,
-        })
+        let mass = validate::positive("mass", mass)?;
+        let gravity = validate::non_negative("gravity", gravity)?;
+        validate::divisor(mass, &[("mass", mass, 1)])?;
+        validate::derived(
+            mass * gravity,
+            &[("mass", mass, 1), ("gravity", gravity, 1)],
+        )?;
+        Ok(Self { mass, gravity })
     }
     /// Mass, kg.
     #[must_use]
@@ -52,6 +61,14 @@ impl<T: Real> FallingParticle<T> {
 }
 
 impl<T: Real> Mechanism<T, 1> for FallingParticle<T> {
+    /// Lane by lane: every parameter gathered.
+    fn gather<const L: usize>(instances: [&Self; L]) -> Option<impl Mechanism<Lanes<T, L>, 1>> {
+        let lanes = |field: fn(&Self) -> T| Lanes::gather(&instances, field);
+        Some(FallingParticle {
+            mass: lanes(|m| m.mass),
+            gravity: lanes(|m| m.gravity),
+        })
+    }
     fn mass_matrix(&self, _s: &State<T, 1>) -> SMatrix<T, 1, 1> {
         Matrix1::new(self.mass)
     }
@@ -59,7 +76,14 @@ impl<T: Real> Mechanism<T, 1> for FallingParticle<T> {
         Vector1::new(-self.mass * self.gravity)
     }
     fn solve_mass(&self, _s: &State<T, 1>, b: &SVector<T, 1>) -> Result<SVector<T, 1>, Error> {
-        Ok(b / self.mass)
+        finite(b / self.mass, Error::NonFiniteState)
+    }
+    fn law_force<F: GeneralizedForce<T, 1>>(
+        &self,
+        s: &State<T, 1>,
+        extra: &F,
+    ) -> Result<SVector<T, 1>, Error> {
+        free_law_force(self, s, extra)
     }
 }
 

@@ -76,21 +76,67 @@ impl<T: Real> FourBarLinkage<T> {
     /// `lengths = [ground d, crank a, coupler b, rocker c]` (m, each > 0),
     /// `masses = [crank, coupler, rocker]` (kg, each > 0), `gravity` (m/s^2, >= 0).
     ///
+    /// The loop closes at some crank angle exactly when no link is longer than the other three
+    /// together (the polygon inequality): the distance from the crank tip to the rocker pivot
+    /// ranges over `[|d - a|, d + a]`, and the coupler and rocker reach `[|b - c|, b + c]`.
+    ///
     /// # Errors
-    /// [`Error::InvalidParameter`] `lengths`, `masses` or `gravity` when out of range or not
-    /// finite.
+    /// [`Error::InvalidParameter`] naming the first entry out of range or not finite
+    /// (`lengths[i]`, `masses[i]`) or `gravity`; the longest link (`lengths[i]`) when it is
+    /// longer than the other three together, so that the loop closes at no crank angle; or
+    /// the parameter most responsible when a quantity formed from them leaves the range of
+    /// `T` (the inertias and the determinant of the mass matrix, which the motion divides
+    /// by, the coupling, the weights and the sum of the lengths).
     pub fn new(lengths: [T; 4], masses: [T; 3], gravity: T) -> Result<Self, Error> {
-        for l in lengths {
-            validate::positive("lengths", l)?;
+        const LENGTHS: [&str; 4] = ["lengths[0]", "lengths[1]", "lengths[2]", "lengths[3]"];
+        const MASSES: [&str; 3] = ["masses[0]", "masses[1]", "masses[2]"];
+        for (name, l) in LENGTHS.into_iter().zip(lengths) {
+            validate::positive(name, l)?;
         }
-        for m in masses {
-            validate::positive("masses", m)?;
+        for (name, m) in MASSES.into_iter().zip(masses) {
+            validate::positive(name, m)?;
         }
-        Ok(Self {
+        let gravity = validate::non_negative("gravity", gravity)?;
+        let linkage = Self {
             lengths,
             masses,
-            gravity: validate::non_negative("gravity", gravity)?,
-        })
+            gravity,
+        };
+        let f = |i: usize, power| (LENGTHS[i], lengths[i], power);
+        let mf = |i: usize| (MASSES[i], masses[i], 1);
+        let all_lengths = [f(0, 1), f(1, 1), f(2, 1), f(3, 1)];
+        let total = validate::derived(lengths.iter().fold(T::zero(), |a, &l| a + l), &all_lengths)?;
+        // Squares of lengths and of distances between joints (assemble's law of cosines).
+        let squares = [f(0, 2), f(1, 2), f(2, 2), f(3, 2)];
+        validate::derived(total * total, &squares)?;
+        let longest = (0..4).fold(0, |a, i| if lengths[i] > lengths[a] { i } else { a });
+        if lengths[longest] > total - lengths[longest] {
+            return Err(Error::InvalidParameter {
+                name: LENGTHS[longest],
+                reason:
+                    "longer than the other three links together: the loop closes at no crank angle",
+            });
+        }
+        let (i1, i2, i3, k) = linkage.inertias();
+        let (a2, b2, c2) = (f(1, 2), f(2, 2), f(3, 2));
+        validate::divisor(i1, &[mf(0), mf(1), a2])?;
+        validate::divisor(i2, &[mf(1), b2])?;
+        validate::divisor(i3, &[mf(2), c2])?;
+        validate::derived(k, &[mf(1), f(1, 1), f(2, 1)])?;
+        // det of the crank-coupler block: i1 i2 - k^2 cos^2, at least m2 a^2 b^2 (m1/9 + m2/12).
+        let block = [mf(0), mf(1), mf(1), a2, b2];
+        validate::derived(i1 * i2, &block)?;
+        validate::divisor(i1 * i2 - k * k, &block)?;
+        let [w1, w2, w3] = linkage.weights();
+        let g = ("gravity", gravity, 1);
+        validate::derived(w1, &[g, mf(0), mf(1), f(1, 1)])?;
+        validate::derived(w2, &[g, mf(1), f(2, 1)])?;
+        validate::derived(w3, &[g, mf(2), f(3, 1)])?;
+        validate::derived(
+            w1 + w2 + w3,
+            &[g, mf(0), mf(1), mf(2), f(1, 1), f(2, 1), f(3, 1)],
+        )?;
+        Ok(linkage)
     }
 
     /// `[ground, crank, coupler, rocker]` lengths, m.
@@ -116,8 +162,9 @@ impl<T: Real> FourBarLinkage<T> {
     /// # Errors
     /// [`Error::InvalidParameter`] `crank` when the loop cannot close at this angle (the
     /// distance from `B` to `D` is outside `[|b - c|, b + c]`) or `crank`, `crank_rate` or `t`
-    /// is not finite; [`Error::Singularity`] at a toggle (coupler and rocker in line), where
-    /// the rates are not determined by the crank's.
+    /// is not finite, `crank_rate` when the coupler's or rocker's rate overflows;
+    /// [`Error::Singularity`] at a toggle (coupler and rocker in line), where the rates are
+    /// not determined by the crank's.
     pub fn assemble(
         &self,
         t: T,
@@ -160,6 +207,9 @@ impl<T: Real> FourBarLinkage<T> {
         let (r0, r1) = (-crank_rate * a * c1, -crank_rate * a * s1);
         let w2 = (-c * s3 * r0 + c * c3 * r1) / det;
         let w3 = (-b * s2 * r0 + b * c2 * r1) / det;
+        let rate = [("crank_rate", crank_rate, 1)];
+        validate::derived(w2, &rate)?;
+        validate::derived(w3, &rate)?;
         Ok(State::new(t, [crank, th2, th3], [crank_rate, w2, w3]))
     }
 
@@ -200,11 +250,19 @@ impl<T: Real> FourBarLinkage<T> {
         if !det.is_finite() {
             return Err(Error::NonFiniteState);
         }
-        Ok(Vector3::new(
+        if det <= T::zero() {
+            return Err(Error::SingularMassMatrix { pivot: 1 });
+        }
+        let x = Vector3::new(
             (i2 * b[0] - kc * b[1]) / det,
             (i1 * b[1] - kc * b[0]) / det,
             b[2] / i3,
-        ))
+        );
+        if x.iter().all(|v| v.is_finite()) {
+            Ok(x)
+        } else {
+            Err(Error::NonFiniteState)
+        }
     }
 
     /// `phi`.

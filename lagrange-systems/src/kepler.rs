@@ -2,7 +2,9 @@
 
 use crate::small_solve::{positive_radius, solve_diagonal2};
 use lagrange_core::nalgebra::{Matrix2, SVector, Vector2};
-use lagrange_core::{validate, Error, Lagrangian, Mechanism, Real, Scalar, State};
+use lagrange_core::{
+    free_law_force, validate, Error, GeneralizedForce, Lagrangian, Mechanism, Real, Scalar, State,
+};
 
 /// What [`Kepler`] reports at `r <= 0`.
 const AT_CENTRE: &str = "radius r <= 0: orbiting body at the centre of attraction";
@@ -66,7 +68,8 @@ impl<T: Real> Kepler<T> {
     pub fn mu(&self) -> T {
         self.mu
     }
-    /// The conserved angular momentum per unit mass, `h = r^2 phi'`.
+    /// The conserved angular momentum per unit mass, `h = r^2 phi'`. (No error channel: NaN
+    /// or infinite for a state that is not finite or so extreme that it overflows.)
     #[must_use]
     pub fn angular_momentum(&self, s: &State<T, 2>) -> T {
         s.q[0] * s.q[0] * s.qd[1]
@@ -86,6 +89,15 @@ impl<T: Real> Mechanism<T, 2> for Kepler<T> {
         let r = s.q[0];
         positive_radius(s, AT_CENTRE)?;
         solve_diagonal2(s, [T::one(), r * r], b, AT_CENTRE)
+    }
+    fn law_force<F: GeneralizedForce<T, 2>>(
+        &self,
+        s: &State<T, 2>,
+        extra: &F,
+    ) -> Result<SVector<T, 2>, Error> {
+        // The law refuses r <= 0, and so does its force.
+        positive_radius(s, AT_CENTRE)?;
+        free_law_force(self, s, extra)
     }
 }
 

@@ -3,7 +3,7 @@
 use crate::small_solve::finite;
 use lagrange_core::nalgebra::{SMatrix, SVector};
 use lagrange_core::{
-    validate, Error, GeneralizedForce, Lagrangian, Mechanism, Real, Scalar, State,
+    free_law_force, validate, Error, GeneralizedForce, Lagrangian, Mechanism, Real, Scalar, State,
 };
 
 /// A planar chain of `N` point masses `m_j` on massless rods of lengths `l_j`: rod 1 hangs from
@@ -93,38 +93,72 @@ impl<T: Real, const N: usize> NLinkPendulum<T, N> {
     /// end of rod `j` counted from the pivot, in `gravity` (m/s^2, >= 0).
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] naming `masses`, `lengths` or `gravity` when an entry is out
-    /// of range or not finite, `masses` when a mass is too small to invert or the total
-    /// overflows, `lengths` when a length is too small to invert.
+    /// [`Error::InvalidParameter`] naming the first entry out of range or not finite
+    /// (`masses[j]`, `lengths[j]`; past the 32nd entry the whole array) or `gravity`, or the
+    /// entry most responsible when a quantity formed from the parameters leaves the range of
+    /// `T`: each `1/m_j` and `1/l_j` (the tension recursion divides by the masses and the
+    /// lengths), the total mass and length, the diagonal `mu_j l_j^2` of the mass matrix (it
+    /// bounds the rest), the weights `g mu_j l_j` and `g m_j`, and `g mu_1 sum l_j`, which
+    /// bounds the potential energy.
     pub fn new(masses: [T; N], lengths: [T; N], gravity: T) -> Result<Self, Error> {
         const { assert!(N > 0, "an N-link pendulum needs at least one link") };
-        for m in masses {
-            validate::positive("masses", m)?;
+        const MASSES: [&str; 32] = lagrange_core::entry_names!("masses");
+        const LENGTHS: [&str; 32] = lagrange_core::entry_names!("lengths");
+        let mass_name = |j| validate::entry(&MASSES, j, "masses");
+        let length_name = |j| validate::entry(&LENGTHS, j, "lengths");
+        for (j, m) in masses.iter().enumerate() {
+            validate::positive(mass_name(j), *m)?;
         }
-        for l in lengths {
-            validate::positive("lengths", l)?;
+        for (j, l) in lengths.iter().enumerate() {
+            validate::positive(length_name(j), *l)?;
         }
         let gravity = validate::non_negative("gravity", gravity)?;
+        let g = ("gravity", gravity, 1);
+        // mu_j and its blame: the masses from j on.
         let mut mu = masses;
         let mut below = T::zero();
-        for m in mu.iter_mut().rev() {
+        for (j, m) in mu.iter_mut().enumerate().rev() {
             below += *m;
             *m = below;
+            // A sum overflows through its largest term.
+            let largest = (j..N).fold(j, |a, i| if masses[i] > masses[a] { i } else { a });
+            let heaviest = (mass_name(largest), masses[largest], 1);
+            validate::derived(below, &[heaviest])?;
+            let l = (length_name(j), lengths[j], 2);
+            validate::derived(below * lengths[j] * lengths[j], &[heaviest, l])?;
+            let l1 = (length_name(j), lengths[j], 1);
+            validate::derived(gravity * below * lengths[j], &[g, heaviest, l1])?;
         }
+        let mut total_length = T::zero();
+        let mut longest = 0;
+        for (j, (m, l)) in masses.iter().zip(&lengths).enumerate() {
+            validate::divisor(*m, &[(mass_name(j), *m, 1)])?;
+            validate::divisor(*l, &[(length_name(j), *l, 1)])?;
+            validate::derived(*m * gravity, &[(mass_name(j), *m, 1), g])?;
+            if j > 0 {
+                let pair = [
+                    (mass_name(j), *m, -1),
+                    (mass_name(j - 1), masses[j - 1], -1),
+                ];
+                validate::derived(m.recip() + masses[j - 1].recip(), &pair)?;
+            }
+            if *l > lengths[longest] {
+                longest = j;
+            }
+            total_length += *l;
+            validate::derived(total_length, &[(length_name(longest), lengths[longest], 1)])?;
+        }
+        let heaviest = (0..N).fold(0, |a, i| if masses[i] > masses[a] { i } else { a });
+        validate::derived(
+            gravity * below * total_length,
+            &[
+                g,
+                (mass_name(heaviest), masses[heaviest], 1),
+                (length_name(longest), lengths[longest], 1),
+            ],
+        )?;
         let inv_masses = masses.map(T::recip);
-        if !(below.is_finite() && inv_masses.iter().all(|x| x.is_finite())) {
-            return Err(Error::InvalidParameter {
-                name: "masses",
-                reason: "each 1/m and the total mass must be finite",
-            });
-        }
         let inv_lengths = lengths.map(T::recip);
-        if !inv_lengths.iter().all(|x| x.is_finite()) {
-            return Err(Error::InvalidParameter {
-                name: "lengths",
-                reason: "each 1/l must be finite",
-            });
-        }
         Ok(Self {
             masses,
             lengths,
@@ -150,6 +184,7 @@ impl<T: Real, const N: usize> NLinkPendulum<T, N> {
         self.gravity
     }
     /// Positions `(x, y)` of the masses relative to the pivot, m, from the pivot outwards.
+    /// (No error channel: NaN for angles that are not finite.)
     #[must_use]
     pub fn positions(&self, q: &SVector<T, N>) -> [(T, T); N] {
         let (sin, cos) = sin_cos(q);
@@ -300,11 +335,21 @@ impl<T: Real, const N: usize> Mechanism<T, N> for NLinkPendulum<T, N> {
     ) -> Result<SVector<T, N>, Error> {
         let down = [-self.gravity; N];
         let free = self.tension_solve(sin_cos(&s.q), &s.qd, ([T::zero(); N], down))?;
-        Ok(if F::IS_ZERO {
-            free
+        if F::IS_ZERO {
+            Ok(free)
         } else {
-            free + self.solve_mass(s, &extra.force(s))?
-        })
+            finite(
+                free + self.solve_mass(s, &extra.force(s))?,
+                Error::NonFiniteState,
+            )
+        }
+    }
+    fn law_force<F: GeneralizedForce<T, N>>(
+        &self,
+        s: &State<T, N>,
+        extra: &F,
+    ) -> Result<SVector<T, N>, Error> {
+        free_law_force(self, s, extra)
     }
 }
 

@@ -54,12 +54,19 @@ impl<T: Real> RollingDisk<T> {
     /// A disk of `mass` (kg, > 0) and `radius` (m, > 0).
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] naming the first parameter out of range or not finite.
+    /// [`Error::InvalidParameter`] naming the first parameter out of range or not finite, or
+    /// the one most responsible when an inertia the motion divides by (`m`, `m r^2 / 4`,
+    /// `m r^2 / 2`) leaves the range of `T`.
     pub fn new(mass: T, radius: T) -> Result<Self, Error> {
-        Ok(Self {
-            mass: validate::positive("mass", mass)?,
-            radius: validate::positive("radius", radius)?,
-        })
+        let mass = validate::positive("mass", mass)?;
+        let radius = validate::positive("radius", radius)?;
+        let disk = Self { mass, radius };
+        // The motion divides by every inertia; the smallest is m r^2 / 4.
+        let (m, r2) = (("mass", mass, 1), ("radius", radius, 2));
+        validate::divisor(mass, &[m])?;
+        validate::divisor(disk.inertias()[2], &[m, r2])?;
+        validate::divisor(disk.inertias()[3], &[m, r2])?;
+        Ok(disk)
     }
 
     /// Mass, kg.
@@ -78,7 +85,8 @@ impl<T: Real> RollingDisk<T> {
     /// `y' = R sin psi phi'`.
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] naming `t`, `q`, `turn_rate` or `roll_rate` when not finite.
+    /// [`Error::InvalidParameter`] naming `t`, an entry `q[i]`, `turn_rate` or `roll_rate` when
+    /// not finite, or `roll_rate` when the rolling speed `R roll_rate` overflows.
     pub fn rolling(
         &self,
         t: T,
@@ -86,14 +94,15 @@ impl<T: Real> RollingDisk<T> {
         turn_rate: T,
         roll_rate: T,
     ) -> Result<State<T, 4>, Error> {
+        const Q: [&str; 32] = lagrange_core::entry_names!("q");
         validate::finite("t", t)?;
-        for x in q {
-            validate::finite("q", x)?;
+        for (i, x) in q.into_iter().enumerate() {
+            validate::finite(validate::entry(&Q, i, "q"), x)?;
         }
         let turn_rate = validate::finite("turn_rate", turn_rate)?;
         let roll_rate = validate::finite("roll_rate", roll_rate)?;
         let (s, c) = q[2].sin_cos();
-        let v = self.radius * roll_rate;
+        let v = validate::derived(self.radius * roll_rate, &[("roll_rate", roll_rate, 1)])?;
         Ok(State::new(t, q, [v * c, v * s, turn_rate, roll_rate]))
     }
 
@@ -112,7 +121,12 @@ impl<T: Real> Mechanism<T, 4> for RollingDisk<T> {
         Vector4::zeros()
     }
     fn solve_mass(&self, _s: &State<T, 4>, b: &Vector4<T>) -> Result<Vector4<T>, Error> {
-        Ok(b.component_div(&self.inertias()))
+        let x = b.component_div(&self.inertias());
+        if x.iter().all(|v| v.is_finite()) {
+            Ok(x)
+        } else {
+            Err(Error::NonFiniteState)
+        }
     }
 }
 

@@ -1,8 +1,10 @@
 //! [`SimplePendulum`]: a point mass on a massless rod, with optional viscous damping.
 
+use crate::small_solve::finite;
 use lagrange_core::nalgebra::{Matrix1, SMatrix, SVector, Vector1};
 use lagrange_core::{
-    validate, Error, GeneralizedForce, Lagrangian, Mechanism, Real, Scalar, State,
+    free_law_force, validate, Error, GeneralizedForce, Lagrangian, Lanes, Mechanism, Real, Scalar,
+    State,
 };
 
 /// A point mass `m` on a massless rod of length `l` about a fixed pivot, in gravity `g`, with
@@ -45,20 +47,35 @@ impl<T: Real> SimplePendulum<T> {
     /// `damping` (N m s/rad, >= 0).
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] naming the first parameter out of range or not finite.
+    /// [`Error::InvalidParameter`] naming the first parameter out of range or not finite, or
+    /// the one most responsible when a quantity formed from them leaves the range of `T`
+    /// (`m l^2` and its inverse, `m g l`, `g / l`, `b / (m l^2)`).
     pub fn new(mass: T, length: T, gravity: T, damping: T) -> Result<Self, Error> {
         let mass = validate::positive("mass", mass)?;
         let length = validate::positive("length", length)?;
         let gravity = validate::non_negative("gravity", gravity)?;
         let damping = validate::non_negative("damping", damping)?;
-        let inv_inertia = T::one() / (mass * length * length);
+        let (m, l, g, b) = (
+            ("mass", mass, 1),
+            ("length", length, 2),
+            ("gravity", gravity, 1),
+            ("damping", damping, 1),
+        );
+        let inertia = validate::divisor(mass * length * length, &[m, l])?;
+        let inv_inertia = T::one() / inertia;
+        validate::derived(mass * gravity * length, &[m, g, ("length", length, 1)])?;
+        let w2 = validate::derived(gravity / length, &[g, ("length", length, -1)])?;
+        let rate = validate::derived(
+            damping * inv_inertia,
+            &[b, ("mass", mass, -1), ("length", length, -2)],
+        )?;
         Ok(Self {
             mass,
             length,
             gravity,
             damping,
-            w2: gravity / length,
-            rate: damping * inv_inertia,
+            w2,
+            rate,
             inv_inertia,
         })
     }
@@ -89,6 +106,19 @@ impl<T: Real> SimplePendulum<T> {
 }
 
 impl<T: Real> Mechanism<T, 1> for SimplePendulum<T> {
+    /// Lane by lane: every parameter gathered.
+    fn gather<const L: usize>(instances: [&Self; L]) -> Option<impl Mechanism<Lanes<T, L>, 1>> {
+        let lanes = |field: fn(&Self) -> T| Lanes::gather(&instances, field);
+        Some(SimplePendulum {
+            mass: lanes(|m| m.mass),
+            length: lanes(|m| m.length),
+            gravity: lanes(|m| m.gravity),
+            damping: lanes(|m| m.damping),
+            w2: lanes(|m| m.w2),
+            rate: lanes(|m| m.rate),
+            inv_inertia: lanes(|m| m.inv_inertia),
+        })
+    }
     fn mass_matrix(&self, _s: &State<T, 1>) -> SMatrix<T, 1, 1> {
         Matrix1::new(self.inertia())
     }
@@ -96,20 +126,31 @@ impl<T: Real> Mechanism<T, 1> for SimplePendulum<T> {
         Vector1::new(-self.mass * self.gravity * self.length * s.q[0].sin())
     }
     fn solve_mass(&self, _s: &State<T, 1>, b: &SVector<T, 1>) -> Result<SVector<T, 1>, Error> {
-        Ok(b * self.inv_inertia)
+        finite(b * self.inv_inertia, Error::NonFiniteState)
     }
     /// The closed form.
+    // Inlined into the integrators' stages: returned through memory, the accelerations of
+    // pendulums stepped in lanes stall the loads that read them back.
+    #[inline(always)]
     fn law<F: GeneralizedForce<T, 1>>(
         &self,
         s: &State<T, 1>,
         extra: &F,
     ) -> Result<SVector<T, 1>, Error> {
         let free = Vector1::new(-self.w2 * s.q[0].sin() - self.rate * s.qd[0]);
-        Ok(if F::IS_ZERO {
+        let qdd = if F::IS_ZERO {
             free
         } else {
             free + extra.force(s) * self.inv_inertia
-        })
+        };
+        finite(qdd, Error::NonFiniteState)
+    }
+    fn law_force<F: GeneralizedForce<T, 1>>(
+        &self,
+        s: &State<T, 1>,
+        extra: &F,
+    ) -> Result<SVector<T, 1>, Error> {
+        free_law_force(self, s, extra)
     }
 }
 

@@ -2,7 +2,9 @@
 
 use crate::small_solve::solve_diagonal2;
 use lagrange_core::nalgebra::{Matrix2, SVector, Vector2};
-use lagrange_core::{validate, Error, Lagrangian, Mechanism, Real, Scalar, State};
+use lagrange_core::{
+    free_law_force, validate, Error, GeneralizedForce, Lagrangian, Mechanism, Real, Scalar, State,
+};
 
 /// What [`SphericalPendulum`] reports on the vertical axis.
 const ON_AXIS: &str = "sin(th) = 0: spherical pendulum on the vertical axis";
@@ -60,12 +62,21 @@ impl<T: Real> SphericalPendulum<T> {
     /// A pendulum of `mass` (kg, > 0) and `length` (m, > 0) in `gravity` (m/s^2, >= 0).
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] naming the first parameter out of range or not finite.
+    /// [`Error::InvalidParameter`] naming the first parameter out of range or not finite, or
+    /// the one most responsible when `m l^2` (which the motion divides by) or `m g l` leaves
+    /// the range of `T`.
     pub fn new(mass: T, length: T, gravity: T) -> Result<Self, Error> {
+        let mass = validate::positive("mass", mass)?;
+        let length = validate::positive("length", length)?;
+        let gravity = validate::non_negative("gravity", gravity)?;
+        let m = ("mass", mass, 1);
+        validate::divisor(mass * length * length, &[m, ("length", length, 2)])?;
+        let g = ("gravity", gravity, 1);
+        validate::derived(mass * gravity * length, &[m, g, ("length", length, 1)])?;
         Ok(Self {
-            mass: validate::positive("mass", mass)?,
-            length: validate::positive("length", length)?,
-            gravity: validate::non_negative("gravity", gravity)?,
+            mass,
+            length,
+            gravity,
         })
     }
     /// Mass, kg.
@@ -84,7 +95,9 @@ impl<T: Real> SphericalPendulum<T> {
         self.gravity
     }
     /// The conserved momentum conjugate to the azimuth, `p_phi = m l^2 sin^2 th phi'`
-    /// (kg m^2/s): the angular momentum about the vertical axis through the pivot.
+    /// (kg m^2/s): the angular momentum about the vertical axis through the pivot. (No error
+    /// channel: NaN or infinite for a state that is not finite or so extreme that it
+    /// overflows.)
     #[must_use]
     pub fn angular_momentum(&self, s: &State<T, 2>) -> T {
         let sin = s.q[0].sin();
@@ -115,6 +128,13 @@ impl<T: Real> Mechanism<T, 2> for SphericalPendulum<T> {
         let sin = s.q[0].sin();
         let i = self.inertia();
         solve_diagonal2(s, [i, i * sin * sin], b, ON_AXIS)
+    }
+    fn law_force<F: GeneralizedForce<T, 2>>(
+        &self,
+        s: &State<T, 2>,
+        extra: &F,
+    ) -> Result<SVector<T, 2>, Error> {
+        free_law_force(self, s, extra)
     }
 }
 

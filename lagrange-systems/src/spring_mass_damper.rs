@@ -2,7 +2,10 @@
 
 use crate::small_solve::finite;
 use lagrange_core::nalgebra::{Matrix1, SMatrix, SVector, Vector1};
-use lagrange_core::{validate, Error, Lagrangian, Mechanism, Real, Scalar, State};
+use lagrange_core::{
+    free_law_force, validate, Error, GeneralizedForce, Lagrangian, Lanes, Mechanism, Real, Scalar,
+    State,
+};
 
 /// A mass `m` on a linear spring of stiffness `k` and a viscous damper `c`, no gravity.
 ///
@@ -38,12 +41,17 @@ impl<T: Real> SpringMassDamper<T> {
     /// A `mass` (kg, > 0) on a spring of `stiffness` (N/m, >= 0) with `damping` (N s/m, >= 0).
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] naming the first parameter out of range or not finite.
+    /// [`Error::InvalidParameter`] naming the first parameter out of range or not finite, or
+    /// `mass` when `1 / m` overflows.
     pub fn new(mass: T, stiffness: T, damping: T) -> Result<Self, Error> {
+        let mass = validate::positive("mass", mass)?;
+        let stiffness = validate::non_negative("stiffness", stiffness)?;
+        let damping = validate::non_negative("damping", damping)?;
+        validate::divisor(mass, &[("mass", mass, 1)])?;
         Ok(Self {
-            mass: validate::positive("mass", mass)?,
-            stiffness: validate::non_negative("stiffness", stiffness)?,
-            damping: validate::non_negative("damping", damping)?,
+            mass,
+            stiffness,
+            damping,
         })
     }
     /// Mass, kg.
@@ -64,6 +72,15 @@ impl<T: Real> SpringMassDamper<T> {
 }
 
 impl<T: Real> Mechanism<T, 1> for SpringMassDamper<T> {
+    /// Lane by lane: every parameter gathered.
+    fn gather<const L: usize>(instances: [&Self; L]) -> Option<impl Mechanism<Lanes<T, L>, 1>> {
+        let lanes = |field: fn(&Self) -> T| Lanes::gather(&instances, field);
+        Some(SpringMassDamper {
+            mass: lanes(|m| m.mass),
+            stiffness: lanes(|m| m.stiffness),
+            damping: lanes(|m| m.damping),
+        })
+    }
     fn mass_matrix(&self, _s: &State<T, 1>) -> SMatrix<T, 1, 1> {
         Matrix1::new(self.mass)
     }
@@ -72,6 +89,13 @@ impl<T: Real> Mechanism<T, 1> for SpringMassDamper<T> {
     }
     fn solve_mass(&self, _s: &State<T, 1>, b: &SVector<T, 1>) -> Result<SVector<T, 1>, Error> {
         finite(b / self.mass, Error::NonFiniteState)
+    }
+    fn law_force<F: GeneralizedForce<T, 1>>(
+        &self,
+        s: &State<T, 1>,
+        extra: &F,
+    ) -> Result<SVector<T, 1>, Error> {
+        free_law_force(self, s, extra)
     }
 }
 

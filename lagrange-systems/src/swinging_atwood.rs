@@ -2,7 +2,9 @@
 
 use crate::small_solve::{positive_radius, solve_diagonal2};
 use lagrange_core::nalgebra::{Matrix2, SVector, Vector2};
-use lagrange_core::{validate, Error, Lagrangian, Mechanism, Real, Scalar, State};
+use lagrange_core::{
+    free_law_force, validate, Error, GeneralizedForce, Lagrangian, Mechanism, Real, Scalar, State,
+};
 
 /// What [`SwingingAtwood`] reports at `r <= 0`.
 const AT_PULLEY: &str = "string length r <= 0: swinging mass at the pulley";
@@ -63,12 +65,26 @@ impl<T: Real> SwingingAtwood<T> {
     /// (m/s^2, >= 0).
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] naming the first parameter out of range or not finite.
+    /// [`Error::InvalidParameter`] naming the first parameter out of range or not finite, or
+    /// the one most responsible when the total mass (which the motion divides by), `1 / m` or
+    /// a weight `M g`, `m g` overflows.
     pub fn new(big_mass: T, small_mass: T, gravity: T) -> Result<Self, Error> {
+        let big_mass = validate::positive("big_mass", big_mass)?;
+        let small_mass = validate::positive("small_mass", small_mass)?;
+        let gravity = validate::non_negative("gravity", gravity)?;
+        let (big, small, g) = (
+            ("big_mass", big_mass, 1),
+            ("small_mass", small_mass, 1),
+            ("gravity", gravity, 1),
+        );
+        validate::divisor(big_mass + small_mass, &[big, small])?;
+        validate::divisor(small_mass, &[small])?;
+        validate::derived(gravity * big_mass, &[g, big])?;
+        validate::derived(small_mass * gravity, &[small, g])?;
         Ok(Self {
-            big_mass: validate::positive("big_mass", big_mass)?,
-            small_mass: validate::positive("small_mass", small_mass)?,
-            gravity: validate::non_negative("gravity", gravity)?,
+            big_mass,
+            small_mass,
+            gravity,
         })
     }
     /// The hanging mass `M`, kg.
@@ -116,6 +132,15 @@ impl<T: Real> Mechanism<T, 2> for SwingingAtwood<T> {
             b,
             AT_PULLEY,
         )
+    }
+    fn law_force<F: GeneralizedForce<T, 2>>(
+        &self,
+        s: &State<T, 2>,
+        extra: &F,
+    ) -> Result<SVector<T, 2>, Error> {
+        // The law refuses r <= 0, and so does its force.
+        positive_radius(s, AT_PULLEY)?;
+        free_law_force(self, s, extra)
     }
 }
 

@@ -304,10 +304,56 @@ fn bad_settings_and_calls_are_refused<T: Real>() -> Result<(), Error> {
     Ok(())
 }
 
+/// A run whose state overflows: a free particle (no gravity) from `y = MAX / 2` at speed
+/// `MAX / 4`, which passes `MAX` at `t = 2`. Its acceleration (zero) does not read the
+/// state, so every stage is finite, and the error estimate of a uniform motion vanishes:
+/// only the check of the new state stops the step that overflows. A run to `t = 100` is an
+/// error, never an `Ok` holding infinity, through every way to call either pair, and the
+/// steps before it are finite. (Before the check, the run ended `Ok` with `y = inf`.)
+fn overflow_is_rejected<const S: usize, const R: usize, P: EmbeddedPair<S, R>, T: Real>(
+) -> Result<(), Error> {
+    use lagrange_integrators::Integrator;
+    let particle = lagrange_systems::FallingParticle::new(T::one(), T::zero())?;
+    let start = State::new(T::zero(), [T::MAX * T::HALF], [T::MAX / T::from_f64(4.0)]);
+    // Up to the rounding of `MAX` the last finite state may reach.
+    let (end, overflow) = (T::from_f64(100.0), T::from_f64(2.01));
+    let settings = AdaptiveSettings::new(T::from_f64(1e-4), T::from_f64(1e-4))?;
+    let mut rk = EmbeddedRungeKutta::<T, 1, S, R, P>::new(settings);
+    let result = rk.integrate_to(&particle, &start, end);
+    assert!(
+        result.is_err_and(|f| f.last.is_finite() && f.last.t <= overflow),
+        "{result:?}"
+    );
+    let mut rk = EmbeddedRungeKutta::<T, 1, S, R, P>::new(settings);
+    let mut s = start;
+    while s.t < end {
+        match rk.next_step(&particle, &s, end) {
+            Ok(next) => {
+                assert!(next.is_finite() && next.t <= overflow, "{next:?}");
+                s = next;
+            }
+            Err(_) => break,
+        }
+    }
+    let mut rk = EmbeddedRungeKutta::<T, 1, S, R, P>::new(settings);
+    let result = rk.integrate(&particle, &start, T::HALF, 200);
+    assert!(
+        result.is_err_and(|f| f.last.is_finite() && f.last.t <= overflow),
+        "{result:?}"
+    );
+    Ok(())
+}
+
+fn adaptive_overflow_is_rejected<T: Real>() -> Result<(), Error> {
+    overflow_is_rejected::<7, 1, lagrange_integrators::Dopri5Pair, T>()?;
+    overflow_is_rejected::<16, 4, lagrange_integrators::Dop853Pair, T>()
+}
+
 for_f32_and_f64!(
     adaptive_in_both_precisions,
     impossible_runs_are_errors,
-    bad_settings_and_calls_are_refused
+    bad_settings_and_calls_are_refused,
+    adaptive_overflow_is_rejected
 );
 
 /// An input changed between calls: after `restart` the next call starts afresh from the

@@ -55,7 +55,7 @@ fn constructors_name_the_bad_parameter<T: Real>() -> Result<(), Error> {
         refuses(DoublePendulum::new(one, one, one, one, bad), "gravity");
         refuses(
             ViscousDamping::<T, 2>::new([T::zero(), bad]),
-            "coefficients",
+            "coefficients[1]",
         );
         refuses(ViscousDamping::<T, 2>::uniform(bad), "coefficient");
     }

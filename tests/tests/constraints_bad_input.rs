@@ -37,11 +37,11 @@ fn parameters_are_checked<T: Real>() -> Result<(), Error> {
         refuses(CartesianPendulum::new(one, bad, one), "length");
         refuses(
             FourBarLinkage::new([one, one, bad, one], [one; 3], one),
-            "lengths",
+            "lengths[2]",
         );
         refuses(
             FourBarLinkage::new([one; 4], [one, bad, one], one),
-            "masses",
+            "masses[1]",
         );
         refuses(RollingDisk::new(bad, one), "mass");
         refuses(RollingDisk::new(one, bad), "radius");
@@ -57,6 +57,9 @@ fn parameters_are_checked<T: Real>() -> Result<(), Error> {
         refuses(FourBarLinkage::new([one; 4], [one; 3], bad), "gravity");
     }
     refuses(Projection::new(small, 0), "max_iterations");
+    refuses(Projection::new(small, 1001), "max_iterations");
+    refuses(Projection::new(small, u32::MAX), "max_iterations");
+    Projection::new(small, 1000)?;
     Stabilization::baumgarte(T::zero(), T::zero())?;
     Ok(())
 }

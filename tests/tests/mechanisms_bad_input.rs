@@ -39,8 +39,14 @@ fn refuses<V: core::fmt::Debug>(result: Result<V, Error>, expected: &str) {
 fn positive_parameters_are_named<T: Real>() -> Result<(), Error> {
     let (one, g) = (T::one(), T::from_f64(9.81));
     for bad in not_positive::<T>() {
-        refuses(NLinkPendulum::new([one, bad, one], [one; 3], g), "masses");
-        refuses(NLinkPendulum::new([one; 3], [one, one, bad], g), "lengths");
+        refuses(
+            NLinkPendulum::new([one, bad, one], [one; 3], g),
+            "masses[1]",
+        );
+        refuses(
+            NLinkPendulum::new([one; 3], [one, one, bad], g),
+            "lengths[2]",
+        );
         refuses(SpringMassDamper::new(bad, one, one), "mass");
         refuses(ElasticPendulum::new(bad, one, one, g), "mass");
         refuses(ElasticPendulum::new(one, bad, one, g), "stiffness");
@@ -105,11 +111,17 @@ fn non_negative_parameters_are_named<T: Real>() -> Result<(), Error> {
 fn chain_refuses_a_mass_it_cannot_invert() {
     refuses(
         NLinkPendulum::new([1.0f32, 1e-45], [1.0; 2], 9.81),
-        "masses",
+        "masses[1]",
     );
+    // A total that overflows names the heaviest mass (the first of equals)...
+    refuses(
+        NLinkPendulum::new([1e308f64, 1e308], [1.0; 2], 0.0),
+        "masses[0]",
+    );
+    // ...and in gravity the last link's weight g m l overflows first.
     refuses(
         NLinkPendulum::new([1e308f64, 1e308], [1.0; 2], 9.81),
-        "masses",
+        "masses[1]",
     );
 }
 

@@ -1,5 +1,6 @@
-//! `cargo xtask cross`: the library crates built for a Cortex-M4F, and the size of a linked
-//! `no_std` binary that uses them with no global allocator.
+//! `cargo xtask cross`: the library crates (and the generated mechanisms) built for a
+//! Cortex-M4F, and the size of a linked `no_std` binary that uses them with no global
+//! allocator.
 //!
 //! Each library crate is built on its own with `-p`, so that workspace feature unification (a
 //! `std` feature turned on by `tests` or `xtask`) cannot hide a `no_std` failure. The smoke
@@ -10,6 +11,10 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use crate::cmd;
+
+/// The mechanisms `cargo xtask derive` generated (`derive/generated`), built for [`TARGET`]
+/// too: generated code must be `no_std` like the library (it has no features).
+const GENERATED: &str = "lagrange-generated";
 
 /// The embedded target every build in this task uses.
 pub(crate) const TARGET: &str = "thumbv7em-none-eabihf";
@@ -47,6 +52,11 @@ pub fn run() -> Result<(), String> {
                 failures.push(e);
             }
         }
+    }
+    if let Err(e) =
+        cmd::run(cmd::cargo().args(["build", "--quiet", "-p", GENERATED, "--target", TARGET]))
+    {
+        failures.push(e);
     }
     match build_smoke() {
         Ok(elf) => match section_sizes(&elf) {

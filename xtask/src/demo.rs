@@ -1,16 +1,17 @@
 //! `cargo xtask demo`: runs the examples of `examples/`, optimised, one after the other: the
 //! origin's pendulum with every integrator, the chaotic double pendulum's energy, your own
-//! mechanism, every standard mechanism, constraints, impacts and a game loop. Their figures go
-//! to `target/lagrange-demo/`.
+//! mechanism, every standard mechanism, a mechanism SymPy derived (`cargo xtask derive`),
+//! constraints, impacts and a game loop. Their figures go to `target/lagrange-demo/`.
 
 use crate::cmd;
 
 /// The examples, in the order the demo runs them.
-const EXAMPLES: [&str; 7] = [
+const EXAMPLES: [&str; 8] = [
     "origin_pendulum",
     "double_pendulum_energy",
     "own_mechanism",
     "mechanisms",
+    "derived",
     "four_bar",
     "impacts",
     "game_loop",

@@ -16,17 +16,26 @@
 //!   image; installs QEMU and `defmt-print` when missing.
 //! - `trig-fit`: derives the polynomials and constants of `lagrange_core::fast_trig` and
 //!   checks the library's against them.
+//! - `derive SPEC.py [--out FILE.rs] [--name TypeName] [--tests]`: the origin's workflow,
+//!   SymPy derives the Euler-Lagrange equations of a spec's `T` and `V` and this writes a
+//!   `no_std` Rust mechanism (see `derive.rs`); `derive --check` regenerates the committed
+//!   ones under `derive/generated/` and checks that bad specs are refused.
 //! - `mutants`: mutation testing of the numerical core with `cargo-mutants`, a report per file
 //!   under `target/mutants/` (hours; not part of `ci`).
+//! - `fuzz [CALLS] [--seed S]`: the hostile-input campaign (`tests/tests/hostile`) in release,
+//!   10^7 calls by default (its 10^5-call run is part of `test` and `ci`).
 //! - `ci`: format check, clippy with `-D warnings`, the library crates' docs (warnings denied)
-//!   and packages, test, cross, qemu.
+//!   and packages, test, `derive --check`, cross, qemu.
 
 mod cmd;
 mod cross;
 mod demo;
+mod derive;
+mod fuzz;
 mod mutants;
 mod qemu;
 mod trig_fit;
+mod venv;
 
 use std::process::ExitCode;
 
@@ -39,11 +48,13 @@ fn main() -> ExitCode {
         "bench" => bench(&std::env::args().skip(2).collect::<Vec<_>>()),
         "qemu" => qemu::run(),
         "mutants" => mutants::run(&std::env::args().skip(2).collect::<Vec<_>>()),
+        "derive" => derive::run(&std::env::args().skip(2).collect::<Vec<_>>()),
+        "fuzz" => fuzz::run(&std::env::args().skip(2).collect::<Vec<_>>()),
         "ci" => ci(),
         "trig-fit" => trig_fit::run(),
         _ => {
             eprintln!(
-                "usage: cargo xtask <demo | test | cross | bench | qemu | mutants | trig-fit | ci>"
+                "usage: cargo xtask <demo | test | cross | bench | qemu | derive | mutants | fuzz | trig-fit | ci>"
             );
             return ExitCode::from(2);
         }
@@ -163,6 +174,7 @@ fn ci() -> Result<(), String> {
         cmd::run_all(&TEST),
         cmd::run_all(&DOC_TEST),
         cmd::run_all(&LONG_TEST),
+        derive::check(),
         cross::run(),
         qemu::run(),
     ]

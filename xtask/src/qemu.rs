@@ -22,7 +22,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, ExitStatus, Stdio};
 use std::time::{Duration, Instant};
 
-use lagrange_cases::{CASES, KERNELS, KERNEL_CALLS, SLEEPERS, STEPS};
+use lagrange_cases::{CASES, KERNELS, KERNEL_CALLS, LANE_INSTANCES, SLEEPERS, STEPS};
 
 use crate::cmd;
 use crate::cross::{self, TARGET};
@@ -529,6 +529,7 @@ fn lockstep(elf: &Path, decoder: &Path) -> Result<Vec<String>, String> {
         _ => failures.push("no f32 RK4 pendulum cost to check against its budget".into()),
     }
     failures.extend(asleep_cost(&per_step));
+    lane_cost(&per_step);
     failures.extend(kernels(&log, per_tick));
     Ok(failures)
 }
@@ -554,6 +555,30 @@ fn asleep_cost(per_step: &BTreeMap<usize, f64>) -> Option<String> {
     (each > ASLEEP_BUDGET).then(|| {
         format!("an asleep instance costs {each:.2} instructions per frame, over {ASLEEP_BUDGET}")
     })
+}
+
+/// Prints what 16 pendulums cost per instance and step one by one and in lanes of 4 on the
+/// M4F (whose scenes step one by one: it has no vector unit).
+fn lane_cost(per_step: &BTreeMap<usize, f64>) {
+    let find = |system: &str| {
+        CASES
+            .iter()
+            .position(|c| c.system == system)
+            .and_then(|id| per_step.get(&id).copied())
+    };
+    if let (Some(alone), Some(lanes)) = (
+        find("16 pendulums, one by one"),
+        find("16 pendulums, in lanes"),
+    ) {
+        let n = LANE_INSTANCES as f64;
+        println!(
+            "f32 RK4 pendulums on the M4F: {:.1} instructions per instance and step one by one, \
+             {:.1} in lanes of 4 ({:.2}x); scenes step one by one here",
+            alone / n,
+            lanes / n,
+            lanes / alone
+        );
+    }
 }
 
 /// Compares the kernels' digests with the host's and prints instructions per call (the

@@ -8,6 +8,8 @@
 //! - A mixed scene ([`mixed`]): pendulums, double pendulums, cart-poles (some pushed), four-bar
 //!   linkages and balls bouncing to rest on a floor, at its start (all awake) and once
 //!   settled.
+//! - Lanes ([`lanes`]): 1,024 `f32` pendulums and double pendulums stepped by RK4 one by one,
+//!   in lanes of 8, and by a scene's bank (which uses the lanes).
 //! - The constant-mass skip of the automatic path ([`constant_mass`]): ns per acceleration of
 //!   a spring chain (N = 2, 5, 10) with the skip and without, and how far apart they are.
 //!
@@ -17,6 +19,7 @@
 
 mod constant_mass;
 mod frames;
+mod lanes;
 mod mixed;
 mod pendulums;
 mod report;
@@ -109,6 +112,8 @@ fn run(args: &[String]) -> Result<(), String> {
     let mut ratios = Vec::new();
     println!("== 1000 damped pendulums at 1/120 s");
     pendulums::measure(budget, &mut rows, &mut ratios).map_err(|e| e.to_string())?;
+    println!("\n== lanes");
+    lanes::measure(budget, &mut rows, &mut ratios).map_err(|e| e.to_string())?;
     println!("\n== mixed scene");
     mixed::measure(budget, &mut rows).map_err(|e| e.to_string())?;
     println!("\n== constant-mass skip");

@@ -6,6 +6,10 @@
 //! origin [`Origin::SciPy`]; the energy error is not measured for them (SciPy's solves are
 //! timed whole, with no observer).
 
+/// Virtual environments under `target/`, shared with xtask.
+#[path = "../../../xtask/src/venv.rs"]
+mod venv;
+
 use super::method::{Kind, Origin, Tableau};
 use super::problem::{state_error, Problem, ProblemVisitor};
 use super::sweep::{Row, Sweeps};
@@ -53,48 +57,16 @@ pub fn run(opts: &Options, venv: &Path, sweeps: &mut Sweeps) -> Result<(), Strin
     Ok(())
 }
 
-/// The venv's Python, after creating the venv and installing SciPy if needed.
+/// The venv's Python, after creating the venv and installing SciPy if needed (the same
+/// environment maker as `cargo xtask derive`'s SymPy).
 fn environment(venv: &Path) -> Result<PathBuf, String> {
-    let python = venv.join("bin").join("python");
-    let has_scipy = |py: &Path| {
-        Command::new(py)
-            .args(["-c", "import scipy, numpy"])
-            .output()
-            .is_ok_and(|o| o.status.success())
-    };
-    if has_scipy(&python) {
-        return Ok(python);
+    venv::Venv {
+        dir: venv.to_path_buf(),
+        packages: &["numpy", "scipy"],
+        probe: "import scipy, numpy",
+        user: "--peers",
     }
-    println!("\n== --peers: creating {} with SciPy", venv.display());
-    run_checked(Command::new("python3").args(["-m", "venv"]).arg(venv))
-        .map_err(|e| format!("--peers needs python3 with venv: {e}"))?;
-    run_checked(Command::new(&python).args([
-        "-m",
-        "pip",
-        "install",
-        "--quiet",
-        "--disable-pip-version-check",
-        "numpy",
-        "scipy",
-    ]))?;
-    if has_scipy(&python) {
-        Ok(python)
-    } else {
-        Err(format!("SciPy did not import in {}", venv.display()))
-    }
-}
-
-/// Runs `cmd`, failing with its stderr.
-fn run_checked(cmd: &mut Command) -> Result<(), String> {
-    let out = cmd.output().map_err(|e| format!("{cmd:?}: {e}"))?;
-    if out.status.success() {
-        Ok(())
-    } else {
-        Err(format!(
-            "{cmd:?} failed: {}",
-            String::from_utf8_lossy(&out.stderr)
-        ))
-    }
+    .python()
 }
 
 /// Visits the problems.

@@ -26,6 +26,7 @@
 
 mod case;
 mod kernels;
+mod lanes;
 mod libm_trig_pendulum;
 mod scenes;
 mod setups;
@@ -33,6 +34,7 @@ mod spring_chain;
 
 pub use case::{Case, Outcome, Precision, MAX_WORDS};
 pub use kernels::{Kernel, KERNELS, KERNEL_CALLS};
+pub use lanes::{pendulums_alone, pendulums_in_lanes, LANE_INSTANCES};
 pub use libm_trig_pendulum::LibmTrigPendulum;
 pub use scenes::{many_sleepers, no_sleepers, scripted, with_sleepers, SLEEPERS};
 pub use setups::{
@@ -58,7 +60,7 @@ pub const STEPS: u32 = 1000;
 /// Stormer-Verlet (symmetric, with an implicit kick), and by the variational midpoint rule,
 /// symplectic for any Lagrangian (on the automatic Euler-Lagrange path, Newton iterations in
 /// dual numbers).
-pub const CASES: [Case; 22] = [
+pub const CASES: [Case; 24] = [
     Case::new::<f32, 1, PendulumSetup, Rk4>(),
     Case::new::<f64, 1, PendulumSetup, Rk4>(),
     Case::new::<f32, 1, PendulumSetup, VelocityVerlet>(),
@@ -93,6 +95,14 @@ pub const CASES: [Case; 22] = [
     ),
     Case::scripted("scene, 1 awake", "RK4", "f32", 4, no_sleepers),
     Case::scripted("scene, 1 awake + 64 asleep", "RK4", "f32", 4, many_sleepers),
+    Case::scripted("16 pendulums, one by one", "RK4", "f32", 1, pendulums_alone),
+    Case::scripted(
+        "16 pendulums, in lanes",
+        "RK4",
+        "f32",
+        1,
+        pendulums_in_lanes,
+    ),
 ];
 
 #[cfg(test)]
@@ -115,6 +125,13 @@ mod tests {
                 );
             }
         }
+        Ok(())
+    }
+
+    /// The pendulums in lanes end with the bits of the pendulums one by one.
+    #[test]
+    fn lanes_give_the_bits_of_one_by_one() -> Result<(), lagrange_core::Error> {
+        assert_eq!(pendulums_in_lanes(STEPS)?, pendulums_alone(STEPS)?);
         Ok(())
     }
 }

@@ -2,7 +2,7 @@
 //! mechanism wrapper, and [`Stabilization`] (Baumgarte) against drift.
 
 use super::{Constraints, Schur};
-use crate::mechanism::finite;
+use crate::mechanism::{finite, finite_jacobian};
 use crate::{
     validate, Error, GeneralizedForce, Jacobian, Lagrangian, Mechanism, NoForce, Real, Scalar,
     State,
@@ -66,21 +66,25 @@ impl<T: Real> Stabilization<T> {
     /// Baumgarte stabilisation with gains `alpha` and `beta` (1/s, each >= 0).
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] `alpha` or `beta` when negative or not finite.
+    /// [`Error::InvalidParameter`] `alpha` or `beta` when negative or not finite, or so large
+    /// that the gains the equation uses, `2 alpha` and `beta^2`, overflow.
     pub fn baumgarte(alpha: T, beta: T) -> Result<Self, Error> {
-        Ok(Self::Baumgarte {
-            alpha: validate::non_negative("alpha", alpha)?,
-            beta: validate::non_negative("beta", beta)?,
-        })
+        let alpha = validate::non_negative("alpha", alpha)?;
+        let beta = validate::non_negative("beta", beta)?;
+        validate::derived(T::TWO * alpha, &[("alpha", alpha, 1)])?;
+        validate::derived(beta * beta, &[("beta", beta, 2)])?;
+        Ok(Self::Baumgarte { alpha, beta })
     }
 
     /// Critically damped Baumgarte stabilisation, `alpha = beta = rate` (1/s, > 0): a
     /// constraint error decays like `(1 + rate t) exp(-rate t)`.
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] `rate` when not positive and finite.
+    /// [`Error::InvalidParameter`] `rate` when not positive and finite, or so large that
+    /// `rate^2` overflows.
     pub fn critical(rate: T) -> Result<Self, Error> {
         let rate = validate::positive("rate", rate)?;
+        validate::derived(rate * rate, &[("rate", rate, 2)])?;
         Ok(Self::Baumgarte {
             alpha: rate,
             beta: rate,
@@ -94,10 +98,16 @@ impl<T: Real> Stabilization<T> {
     /// own frequency (see the table above).
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] `dt` when not positive and finite.
+    /// [`Error::InvalidParameter`] `dt` when not positive and finite, or so small that the
+    /// rate (or its square) overflows.
     pub fn for_step(dt: T) -> Result<Self, Error> {
         let dt = validate::positive("dt", dt)?;
-        Self::critical(T::from_f64(RATE_TIMES_STEP) / dt)
+        let rate = T::from_f64(RATE_TIMES_STEP) / dt;
+        validate::derived(rate * rate, &[("dt", dt, -2)])?;
+        Ok(Self::Baumgarte {
+            alpha: rate,
+            beta: rate,
+        })
     }
 }
 
@@ -376,7 +386,7 @@ where
         self.parts.rhs(state)
     }
     fn solve_mass(&self, state: &State<T, N>, b: &SVector<T, N>) -> Result<SVector<T, N>, Error> {
-        self.parts.solve_mass(state, b)
+        finite(self.parts.solve_mass(state, b)?)
     }
     fn law<F: GeneralizedForce<T, N>>(
         &self,
@@ -393,7 +403,7 @@ where
     ) -> Result<SVector<T, N>, Error> {
         let lambda = self.solve_with(state, extra)?.multipliers;
         let rows = self.parts.jacobian(&state.q);
-        Ok(self.parts.law_force(state, extra)? + rows.transpose() * lambda)
+        finite(self.parts.law_force(state, extra)? + rows.transpose() * lambda)
     }
     /// The free jump `M^-1 p` less what would break the velocity constraints: with
     /// `S mu = -J M^-1 p`, `dq' = M^-1 (p + J^T mu)`, so that `J dq' = 0` (the rows' reaction
@@ -476,29 +486,30 @@ impl<T: Real, const N: usize, M: Mechanism<T, N>, K> Mechanism<T, N> for Held<M,
     fn rhs(&self, state: &State<T, N>) -> SVector<T, N> {
         self.mechanism.rhs(state)
     }
+    // Each hook checks what it passes on from the (possibly a user's) mechanism.
     fn solve_mass(&self, state: &State<T, N>, b: &SVector<T, N>) -> Result<SVector<T, N>, Error> {
-        self.mechanism.solve_mass(state, b)
+        finite(self.mechanism.solve_mass(state, b)?)
     }
     fn law<F: GeneralizedForce<T, N>>(
         &self,
         state: &State<T, N>,
         extra: &F,
     ) -> Result<SVector<T, N>, Error> {
-        self.mechanism.law(state, extra)
+        finite(self.mechanism.law(state, extra)?)
     }
     fn law_jacobian<F: GeneralizedForce<T, N>>(
         &self,
         state: &State<T, N>,
         extra: &F,
     ) -> Result<(SVector<T, N>, Jacobian<T, N>), Error> {
-        self.mechanism.law_jacobian(state, extra)
+        finite_jacobian(self.mechanism.law_jacobian(state, extra)?)
     }
     fn law_force<F: GeneralizedForce<T, N>>(
         &self,
         state: &State<T, N>,
         extra: &F,
     ) -> Result<SVector<T, N>, Error> {
-        self.mechanism.law_force(state, extra)
+        finite(self.mechanism.law_force(state, extra)?)
     }
     fn velocity_jump(
         &self,

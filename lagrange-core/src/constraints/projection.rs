@@ -4,6 +4,9 @@ use super::{max_abs, Constraints, Schur};
 use crate::{validate, Error, Mechanism, Real, State};
 use nalgebra::SVector;
 
+/// Most Newton iterations a projection may be allowed.
+const MAX_ITERATIONS_CAP: u32 = 1000;
+
 /// Projection of a state onto its constraints after a step: positions by bounded Newton
 /// iterations, then velocities exactly, both in the metric of the mass matrix:
 ///
@@ -32,16 +35,18 @@ pub struct Projection<T> {
 
 impl<T: Real> Projection<T> {
     /// Newton on positions until `max_i |phi_i| <= tolerance` (> 0), in at most
-    /// `max_iterations` (>= 1) iterations.
+    /// `max_iterations` (1 to 1000) iterations: Newton converges quadratically, so a
+    /// projection that has not converged in a thousand never will (its tolerance is below the
+    /// rounding of `phi`), and the limit bounds the cost of a projection whatever is asked.
     ///
     /// # Errors
     /// [`Error::InvalidParameter`] `tolerance` when not positive and finite,
-    /// `max_iterations` when zero.
+    /// `max_iterations` when zero or above 1000.
     pub fn new(tolerance: T, max_iterations: u32) -> Result<Self, Error> {
-        if max_iterations == 0 {
+        if !(1..=MAX_ITERATIONS_CAP).contains(&max_iterations) {
             return Err(Error::InvalidParameter {
                 name: "max_iterations",
-                reason: "must be at least 1",
+                reason: "must be from 1 to 1000",
             });
         }
         Ok(Self {

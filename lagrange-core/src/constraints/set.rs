@@ -25,6 +25,10 @@ use nalgebra::{SMatrix, SVector};
 /// The rows' units are the user's: residuals and tolerances are in them.
 pub trait Constraints<T: Real, const N: usize, const C: usize> {
     /// The position residual `phi(q)`; zero for Pfaffian rows (the default: all rows Pfaffian).
+    ///
+    /// This and the other row functions have no error channel: for coordinates that are not
+    /// finite or so extreme that a term overflows they give NaN or infinities (never a
+    /// panic), which every solve that uses them refuses ([`Error::NonFiniteState`]).
     fn position_residual(&self, q: &SVector<T, N>) -> SVector<T, C> {
         let _ = q;
         SVector::zeros()
@@ -38,7 +42,8 @@ pub trait Constraints<T: Real, const N: usize, const C: usize> {
     fn velocity_product(&self, q: &SVector<T, N>, qd: &SVector<T, N>) -> SVector<T, C>;
 
     /// The residuals at `state`: `max_i |phi_i|` and `max_i |(J q')_i|`. Computed only when
-    /// asked.
+    /// asked. No error channel: a residual that is NaN or infinite (a state that is not
+    /// finite) is reported as that, never as small.
     fn residual(&self, state: &State<T, N>) -> Residual<T> {
         let phi = self.position_residual(&state.q);
         let w = self.jacobian(&state.q) * state.qd;

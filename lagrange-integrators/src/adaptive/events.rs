@@ -62,14 +62,15 @@ where
 {
     /// Computes the dense coefficients of the last step, evaluating its extra stages.
     pub(super) fn prepare_dense<M: Mechanism<T, N>>(&mut self, m: &M) -> Result<(), Error> {
-        if self.hermite.is_some() {
+        if self.stages.hermite.is_some() {
             return Ok(());
         }
+        self.protect();
         let (y0, h) = (self.previous, self.h_last);
         for i in P::FSAL + 1..S {
             let s = self.stage_state(&y0, h, i);
-            self.kq[i] = s.qd;
-            self.kv[i] = self.eval(m, &s)?;
+            self.stages.kq[i] = s.qd;
+            self.stages.kv[i] = self.eval(m, &s)?;
         }
         // The step's end, recomputed from the stages (a state cut by an event is not it).
         let y1 = self.stage_state(&y0, h, P::FSAL);
@@ -78,13 +79,14 @@ where
             [dy, c3, dy - k1 * h - c3]
         };
         let f = P::FSAL;
-        self.hermite = Some((
-            hermite(y1.q - y0.q, self.kq[0], self.kq[f]),
-            hermite(y1.qd - y0.qd, self.kv[0], self.kv[f]),
+        let k = &mut self.stages;
+        k.hermite = Some((
+            hermite(y1.q - y0.q, k.kq[0], k.kq[f]),
+            hermite(y1.qd - y0.qd, k.kv[0], k.kv[f]),
         ));
         for (r, row) in P::DENSE.iter().enumerate() {
-            self.rows_q[r] = combine(row, &self.kq) * h;
-            self.rows_v[r] = combine(row, &self.kv) * h;
+            k.rows_q[r] = combine(row, &k.kq) * h;
+            k.rows_v[r] = combine(row, &k.kv) * h;
         }
         Ok(())
     }
@@ -109,11 +111,11 @@ where
             }
             acc
         };
-        match &self.hermite {
+        match &self.stages.hermite {
             Some((hq, hv)) => State {
                 t,
-                q: y0.q + fold(hq, &self.rows_q),
-                qd: y0.qd + fold(hv, &self.rows_v),
+                q: y0.q + fold(hq, &self.stages.rows_q),
+                qd: y0.qd + fold(hv, &self.stages.rows_v),
             },
             None => self.state,
         }
@@ -124,7 +126,7 @@ where
     /// is prepared ([`EmbeddedRungeKutta::next_step`] prepares it); `None` otherwise.
     #[must_use]
     pub fn dense_interval(&self) -> Option<(T, T)> {
-        (self.h_last > T::zero() && self.hermite.is_some())
+        (self.h_last > T::zero() && self.stages.hermite.is_some())
             .then_some((self.previous.t, self.dense_end))
     }
 
@@ -166,8 +168,23 @@ where
     ///
     /// # Errors
     /// As [`EmbeddedRungeKutta::integrate_to`]; [`Error::InvalidParameter`] `guard` when it
-    /// returns NaN.
+    /// returns NaN. A call that fails leaves the integrator as it found it.
     pub fn integrate_until_event<M, G>(
+        &mut self,
+        mechanism: &M,
+        state: &State<T, N>,
+        t_end: T,
+        guard: G,
+    ) -> Result<Stop<T, N>, Failure<T, N>>
+    where
+        M: Mechanism<T, N>,
+        G: FnMut(&State<T, N>) -> T,
+    {
+        self.call(|rk| rk.run_until_event(mechanism, state, t_end, guard))
+    }
+
+    /// The steps of [`EmbeddedRungeKutta::integrate_until_event`].
+    fn run_until_event<M, G>(
         &mut self,
         mechanism: &M,
         state: &State<T, N>,
@@ -232,6 +249,7 @@ where
         M: Mechanism<T, N>,
         G: FnMut(&State<T, N>) -> T,
     {
+        self.protect();
         if g1 != T::zero() {
             let t = self.locate(m, guard, start, g1)?;
             self.state = self.evaluate_dense(t);

@@ -5,7 +5,7 @@ use super::{NeverSleeps, Sleep, Sleeps};
 use crate::Integrator;
 use heapless::Vec;
 use lagrange_core::nalgebra::SVector;
-use lagrange_core::{Controlled, Error, Mechanism, Real, State};
+use lagrange_core::{divergences, Controlled, Error, Lanes, Mechanism, Real, State};
 
 /// A handle to an instance of a [`Bank`], given by [`Bank::add`]. It stays valid until the
 /// instance is removed; after that it names nothing ([`Error::NoSuchInstance`]), even when
@@ -101,7 +101,7 @@ impl<T: Real, const N: usize, M: Mechanism<T, N>, I: Integrator<T, N, M>> Slot<T
     /// then untouched and the error kept).
     #[inline(always)]
     fn advance(&mut self, dt: T, t: T) -> bool {
-        match self.integrator.step(&self.mechanism, &self.current, dt) {
+        match self.integrator.run_step(&self.mechanism, &self.current, dt) {
             Ok(mut next) => {
                 next.t = t;
                 self.previous = self.current;
@@ -132,6 +132,97 @@ struct Entry {
     place: u32,
     /// The generation of the id now (or next) given out for this index.
     generation: u32,
+}
+
+/// Instances stepped side by side where the mechanism and the method allow it
+/// ([`Mechanism::gather`], [`Integrator::step_lanes`]): 8 on x86_64 and aarch64 (two or one
+/// vector registers of `f32`); none elsewhere, where there is no vector unit to use (the
+/// Cortex-M4F) and lanes would only add work.
+#[cfg(any(target_arch = "x86_64", target_arch = "aarch64"))]
+const LANES: usize = 8;
+/// See above.
+#[cfg(not(any(target_arch = "x86_64", target_arch = "aarch64")))]
+const LANES: usize = 1;
+
+/// Steps every slot by `dt`, landing at `t`: [`LANES`] at a time where the mechanism gathers
+/// and the method steps lanes, the others (and any chunk whose lanes diverged or failed) one
+/// by one, which gives the same bits. Returns how many failed.
+#[inline(always)]
+fn step_all<T, const N: usize, M, I>(slots: &mut [Slot<T, N, M, I>], dt: T, t: T) -> u32
+where
+    T: Real,
+    M: Mechanism<T, N>,
+    I: Integrator<T, N, M>,
+{
+    let mut failed = 0;
+    let mut rest = slots;
+    if LANES > 1 {
+        let mut chunks = rest.chunks_exact_mut(LANES);
+        for chunk in &mut chunks {
+            if step_lanes::<T, N, M, I, LANES>(chunk, dt, t).is_none() {
+                failed += step_each(chunk, dt, t);
+            }
+        }
+        rest = chunks.into_remainder();
+    }
+    failed + step_each(rest, dt, t)
+}
+
+/// Steps every slot alone; how many failed.
+#[inline(always)]
+fn step_each<T, const N: usize, M, I>(slots: &mut [Slot<T, N, M, I>], dt: T, t: T) -> u32
+where
+    T: Real,
+    M: Mechanism<T, N>,
+    I: Integrator<T, N, M>,
+{
+    let mut failed = 0;
+    for slot in slots {
+        if !slot.advance(dt, t) {
+            failed += 1;
+        }
+    }
+    failed
+}
+
+/// Steps `L` slots side by side in lanes; `None`, with nothing changed, where the mechanism
+/// does not gather, the method does not step lanes, a step fails or the lanes diverged.
+#[inline(always)]
+fn step_lanes<T, const N: usize, M, I, const L: usize>(
+    chunk: &mut [Slot<T, N, M, I>],
+    dt: T,
+    t: T,
+) -> Option<()>
+where
+    T: Real,
+    M: Mechanism<T, N>,
+    I: Integrator<T, N, M>,
+{
+    let slots: &mut [Slot<T, N, M, I>; L] = chunk.try_into().ok()?;
+    let before = divergences()?;
+    // The gathered mechanism borrows the slots: stepped in a block of its own.
+    let next = {
+        let lanes = M::gather::<L>(core::array::from_fn(|i| &slots[i].mechanism))?;
+        let states: [&State<T, N>; L] = core::array::from_fn(|i| &slots[i].current);
+        let state = State {
+            t: Lanes::gather(&states, |s| s.t),
+            q: SVector::from_fn(|j, _| Lanes::gather(&states, |s| s.q[j])),
+            qd: SVector::from_fn(|j, _| Lanes::gather(&states, |s| s.qd[j])),
+        };
+        slots[0].integrator.step_lanes(&lanes, &state, dt)?.ok()?
+    };
+    if divergences()? != before {
+        return None;
+    }
+    for (i, slot) in slots.iter_mut().enumerate() {
+        slot.previous = slot.current;
+        slot.current = State {
+            t,
+            q: next.q.map(|x| x.0[i]),
+            qd: next.qd.map(|x| x.0[i]),
+        };
+    }
+    Some(())
 }
 
 /// Up to `K` instances of the mechanism type `M`, each with its own parameters and input
@@ -546,13 +637,8 @@ where
     /// and are set aside: [`Status::Failed`]).
     pub(crate) fn step(&mut self, dt: T, t: T) -> u32 {
         self.time = t;
-        let mut failed = 0;
         let awake = self.slots.get_mut(..self.awake).unwrap_or_default();
-        for slot in awake {
-            if !slot.advance(dt, t) {
-                failed += 1;
-            }
-        }
+        let failed = step_all(awake, dt, t);
         if failed > 0 {
             self.set_aside_failures();
         }

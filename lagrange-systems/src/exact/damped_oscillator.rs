@@ -26,7 +26,10 @@ const SERIES_TERMS: usize = 12;
 ///
 /// # Errors
 /// [`Error::InvalidParameter`] naming `mass` (not > 0), `stiffness` or `damping` (not >= 0),
-/// or `x0`, `v0`, `t` (not finite).
+/// or `x0`, `v0`, `t` (not finite); the one most responsible when a quantity formed from them
+/// overflows (`c / (2 m)`, `k / m`, `(c / (2 m))^2`, `v0 + gamma x0`, `gamma v0 + w0^2 x0`),
+/// `t` when the phase `w t` does; [`Error::NonFiniteState`] when the state at `t` overflows
+/// (a negative time of a damped motion, an over-damped one far back).
 ///
 /// ```
 /// use lagrange_systems::exact::damped_oscillator;
@@ -50,33 +53,48 @@ pub fn damped_oscillator<T: Real>(
     let x0 = validate::finite("x0", x0)?;
     let v0 = validate::finite("v0", v0)?;
     let t = validate::finite("t", t)?;
-    let gamma = c / (T::TWO * m);
-    let w0_2 = k / m;
-    let lambda = w0_2 - gamma * gamma;
+    let f = |name, x, power| (name, x, power);
+    let (fm, fc, fk) = (f("mass", m, -1), f("damping", c, 1), f("stiffness", k, 1));
+    let gamma = validate::derived(c / (T::TWO * m), &[fc, fm])?;
+    let w0_2 = validate::derived(k / m, &[fk, fm])?;
+    let gamma_2 = validate::derived(gamma * gamma, &[f("damping", c, 2), f("mass", m, -2)])?;
+    let lambda = w0_2 - gamma_2;
     // x = e^(-gamma t) (x0 C + b S), x' = e^(-gamma t) (v0 C - d S).
-    let b = v0 + gamma * x0;
-    let d = gamma * v0 + w0_2 * x0;
+    let (fx, fv) = (f("x0", x0, 1), f("v0", v0, 1));
+    let b = validate::derived(v0 + gamma * x0, &[fv, fc, fm, fx])?;
+    let d = validate::derived(gamma * v0 + w0_2 * x0, &[fc, fm, fv, fk, fx])?;
     let z = lambda * t * t;
-    if z.abs() < T::one() {
+    let (x, v) = if z.abs() < T::one() {
         let (cc, ss) = series(z, t);
         let decay = (-gamma * t).exp();
-        return Ok((decay * (x0 * cc + b * ss), decay * (v0 * cc - d * ss)));
-    }
-    if lambda > T::zero() {
+        (decay * (x0 * cc + b * ss), decay * (v0 * cc - d * ss))
+    } else if lambda > T::zero() {
         let w = lambda.sqrt();
-        let (sin, cos) = (w * t).sin_cos();
+        let phase = w * t;
+        if !phase.is_finite() {
+            return Err(Error::InvalidParameter {
+                name: "t",
+                reason: "so large that the phase w t overflows",
+            });
+        }
+        let (sin, cos) = phase.sin_cos();
         let decay = (-gamma * t).exp();
         let ss = sin / w;
-        Ok((decay * (x0 * cos + b * ss), decay * (v0 * cos - d * ss)))
+        (decay * (x0 * cos + b * ss), decay * (v0 * cos - d * ss))
     } else {
         // e^(-gamma t) cosh(s t) = (e^((s - gamma) t) + e^(-(s + gamma) t)) / 2, and sinh alike.
         let s = (-lambda).sqrt();
         let slow = ((s - gamma) * t).exp() * T::HALF;
         let fast = (-(s + gamma) * t).exp() * T::HALF;
-        Ok((
+        (
             (x0 + b / s) * slow + (x0 - b / s) * fast,
             (v0 - d / s) * slow + (v0 + d / s) * fast,
-        ))
+        )
+    };
+    if x.is_finite() && v.is_finite() {
+        Ok((x, v))
+    } else {
+        Err(Error::NonFiniteState)
     }
 }
 

@@ -80,32 +80,75 @@ impl<T: Real> DrivenOscillator<T> {
     /// force `amplitude cos(omega t)` (`amplitude` finite, `omega` > 0, rad/s).
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] naming the first parameter out of range or not finite.
+    /// [`Error::InvalidParameter`] naming the first parameter out of range or not finite, or
+    /// the one most responsible when a quantity formed from them leaves the range of `T`: the
+    /// free motion's `c / (2 m)`, `k / m` and `(c / (2 m))^2`, the drive's `m w^2`, `c w`
+    /// (which the steady state divides by when `c > 0`) and `F0 / m`.
     pub fn new(mass: T, stiffness: T, damping: T, amplitude: T, omega: T) -> Result<Self, Error> {
+        let mass = validate::positive("mass", mass)?;
+        let stiffness = validate::non_negative("stiffness", stiffness)?;
+        let damping = validate::non_negative("damping", damping)?;
+        let amplitude = validate::finite("amplitude", amplitude)?;
+        let omega = validate::positive("omega", omega)?;
+        let f = |name, x, power| (name, x, power);
+        let (m, k, c, w) = (
+            f("mass", mass, 1),
+            f("stiffness", stiffness, 1),
+            f("damping", damping, 1),
+            f("omega", omega, 1),
+        );
+        let per_mass = f("mass", mass, -1);
+        let gamma = validate::derived(damping / (T::TWO * mass), &[c, per_mass])?;
+        validate::derived(
+            gamma * gamma,
+            &[f("damping", damping, 2), f("mass", mass, -2)],
+        )?;
+        validate::derived(stiffness / mass, &[k, per_mass])?;
+        validate::derived(mass * omega * omega, &[m, f("omega", omega, 2)])?;
+        if damping > T::zero() {
+            validate::divisor(damping * omega, &[c, w])?;
+        }
+        validate::derived(amplitude / mass, &[f("amplitude", amplitude, 1), per_mass])?;
         Ok(Self {
-            mass: validate::positive("mass", mass)?,
-            stiffness: validate::non_negative("stiffness", stiffness)?,
-            damping: validate::non_negative("damping", damping)?,
-            amplitude: validate::finite("amplitude", amplitude)?,
-            omega: validate::positive("omega", omega)?,
+            mass,
+            stiffness,
+            damping,
+            amplitude,
+            omega,
         })
     }
 
     /// The exact `(x(t), x'(t))` from `x(0) = x0`, `x'(0) = v0`.
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] naming `x0`, `v0` or `t` when not finite;
-    /// [`Error::NonFiniteState`] when the motion overflows (a damping so light that the
-    /// steady-state amplitude at resonance exceeds the largest finite value).
+    /// [`Error::InvalidParameter`] naming `x0`, `v0` or `t` when not finite, `t` when so large
+    /// that a phase `w t` overflows; [`Error::NonFiniteState`] when the motion overflows (a
+    /// damping so light that the steady-state amplitude at resonance exceeds the largest
+    /// finite value, a start so large that the free motion does, a negative time of a damped
+    /// motion).
     pub fn state(&self, x0: T, v0: T, t: T) -> Result<(T, T), Error> {
         let x0 = validate::finite("x0", x0)?;
         let v0 = validate::finite("v0", v0)?;
         let t = validate::finite("t", t)?;
+        for phase in [self.omega * t, (self.stiffness / self.mass).sqrt() * t] {
+            if !phase.is_finite() {
+                return Err(Error::InvalidParameter {
+                    name: "t",
+                    reason: "so large that the phase w t overflows",
+                });
+            }
+        }
         let (x, v) = if self.damping > T::zero() {
-            self.damped(x0, v0, t)?
+            self.damped(x0, v0, t)
         } else {
-            self.undamped(x0, v0, t)?
-        };
+            self.undamped(x0, v0, t)
+        }
+        // The free part is the damped oscillator from a start of its own: a quantity it
+        // refuses overflowed here, from this call's arguments.
+        .map_err(|e| match e {
+            Error::InvalidParameter { name: "t", .. } => e,
+            _ => Error::NonFiniteState,
+        })?;
         if x.is_finite() && v.is_finite() {
             Ok((x, v))
         } else {

@@ -80,7 +80,10 @@ fn eccentricity_in_range<T: Real>(e: T) -> Result<T, Error> {
 ///
 /// # Errors
 /// [`Error::InvalidParameter`] naming `mu` or `semi_major_axis` (not > 0), `eccentricity`
-/// (outside `[0, 1)`) or `t` (not finite); as [`eccentric_anomaly`].
+/// (outside `[0, 1)`) or `t` (not finite), or the one most responsible when the mean motion
+/// `n`, the mean anomaly `n t` or `mu a` leaves the range of `T`; [`Error::NoConvergence`] as
+/// [`eccentric_anomaly`]; [`Error::NonFiniteState`] when the state overflows (`phi'` near
+/// the periapsis of a tiny, very eccentric orbit).
 ///
 /// ```
 /// use lagrange_systems::exact::kepler_orbit;
@@ -100,8 +103,14 @@ pub fn kepler_orbit<T: Real>(
     let a = validate::positive("semi_major_axis", semi_major_axis)?;
     let e = eccentricity_in_range(eccentricity)?;
     let t = validate::finite("t", t)?;
-    let n = (mu / (a * a * a)).sqrt();
-    let big_e = eccentric_anomaly(n * t, e)?;
+    // The mean motion n = sqrt(mu / a^3) and the mean anomaly n t, blamed on their factors
+    // (powers doubled: n^2 = mu a^-3).
+    let (fmu, fa) = (("mu", mu, 1), ("semi_major_axis", a, 3));
+    let cube = validate::derived(a * a * a, &[fa])?;
+    let n = validate::divisor((mu / cube).sqrt(), &[fmu, ("semi_major_axis", a, -3)])?;
+    let mean_anomaly = validate::derived(n * t, &[fmu, ("semi_major_axis", a, -3), ("t", t, 2)])?;
+    validate::derived(mu * a, &[("mu", mu, 1), ("semi_major_axis", a, 1)])?;
+    let big_e = eccentric_anomaly(mean_anomaly, e)?;
     let (sin, cos) = big_e.sin_cos();
     let r = a * (T::one() - e * cos);
     // E/2 is in [-pi/2, pi/2] after removing whole turns, so atan2 needs no branch fix-up;
@@ -114,5 +123,7 @@ pub fn kepler_orbit<T: Real>(
         T::TWO * ((T::one() + e).sqrt() * sh).atan2((T::one() - e).sqrt() * ch) + turns * two_pi;
     let rd = (mu * a).sqrt() * e * sin / r;
     let phid = (mu * a * (T::one() - e * e)).sqrt() / (r * r);
-    Ok(State::new(t, [r, phi], [rd, phid]))
+    let s = State::new(t, [r, phi], [rd, phid]);
+    // What is left to overflow is r^2 near periapsis of a tiny, very eccentric orbit.
+    s.check_finite().map(|()| s)
 }

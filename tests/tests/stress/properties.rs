@@ -402,7 +402,7 @@ fn constructors_refuse<T: Real>(
         |[m1, m2, l1, l2, g]| DoublePendulum::new(m1, m2, l1, l2, g),
     )?;
     refuses::<T, _, 2>(
-        ["coefficients", "coefficients"],
+        ["coefficients[0]", "coefficients[1]"],
         [NonNegative, NonNegative],
         [a, b],
         broken,

@@ -504,7 +504,7 @@ fn constructors_refuse<T: Real>(p: [f64; 9], which: (usize, usize)) -> Result<()
     )?;
     refuses::<T, _, 1>(["mu"], [Positive], [a], which, |[mu]| Kepler::new(mu))?;
     refuses::<T, _, 3>(
-        ["masses", "lengths", "gravity"],
+        ["masses[1]", "lengths[0]", "gravity"],
         [Positive, Positive, NonNegative],
         [a, b, c],
         which,

@@ -4,6 +4,7 @@
 
 use super::{ContactModel, Contacts};
 use crate::constraints::{constrained_acceleration, ConstrainedAcceleration, Schur, Stabilization};
+use crate::mechanism::{finite, finite_jacobian};
 use crate::nalgebra::{SMatrix, SVector};
 use crate::{
     Borrowed, Error, GeneralizedForce, Input, Jacobian, Lagrangian, Mechanism, Real, Scalar, State,
@@ -244,7 +245,7 @@ where
         self.mechanism.rhs(state)
     }
     fn solve_mass(&self, state: &State<T, N>, b: &SVector<T, N>) -> Result<SVector<T, N>, Error> {
-        self.mechanism.solve_mass(state, b)
+        finite(self.mechanism.solve_mass(state, b)?)
     }
     /// The rows in force as constraints; in free flight (no row in force) the mechanism's own,
     /// possibly closed-form, law.
@@ -256,7 +257,7 @@ where
         if self.active.iter().any(|&on| on) {
             Ok(self.solve(state, extra)?.0.acceleration)
         } else {
-            self.mechanism.law(state, extra)
+            finite(self.mechanism.law(state, extra)?)
         }
     }
     /// In free flight the mechanism's own Jacobian (exact where it has one); with rows in
@@ -269,7 +270,7 @@ where
         if self.active.iter().any(|&on| on) {
             crate::jacobian_by_differences(self, state, extra)
         } else {
-            self.mechanism.law_jacobian(state, extra)
+            finite_jacobian(self.mechanism.law_jacobian(state, extra)?)
         }
     }
 }

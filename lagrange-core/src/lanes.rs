@@ -1,0 +1,343 @@
+//! [`Lanes`]: `L` values of a [`Real`] side by side, one per lane, so that any mechanism and
+//! any integrator written for a [`Real`] steps `L` instances at once, each lane bit for bit
+//! what the same code gives for that instance alone.
+//!
+//! Arithmetic and every function act lane by lane with the scalar's own operation (the lane
+//! sine and cosine of `f32` are [`fast_trig::sin_cos_lanes`](crate::fast_trig::sin_cos_lanes),
+//! bit for bit the scalar ones): plain arrays, which the compiler vectorizes, no fused
+//! multiply-add. What cannot act lane by lane is a branch: code that compares values takes one
+//! branch for all lanes. A comparison is therefore true when it holds in every lane, false
+//! when in none, and when the lanes disagree it answers false and counts a divergence
+//! ([`divergences`]). A caller that steps lanes reads the count before and after: unchanged,
+//! every lane took the branch its instance alone would have taken and the result is exact;
+//! changed, it discards the result and steps the instances one by one.
+
+use crate::scalar::{powi_by_squaring, sin_cos_each, Real, Scalar};
+use core::cmp::Ordering;
+use core::fmt;
+use core::ops::{Add, AddAssign, Div, DivAssign, Mul, MulAssign, Neg, Sub, SubAssign};
+use num_traits::{One, Zero};
+
+/// `L` values side by side: a [`Real`] whose every operation acts lane by lane, each lane with
+/// the bits the scalar operation gives. A comparison holds when it holds in every lane; where
+/// the lanes disagree it is false and counts a divergence ([`divergences`]), so that a caller
+/// stepping lanes can tell that one branch was taken for lanes that needed different ones, and
+/// step the instances one by one instead.
+///
+/// ```
+/// use lagrange_core::{Lanes, Real, Scalar};
+/// let x = Lanes([0.5f32, 1.0, 2.0, 3.0]);
+/// let y = x.sin() * 2.0 + Lanes::splat(1.0);
+/// for (lane, &xi) in x.0.iter().enumerate() {
+///     assert_eq!(y.0[lane], xi.sin() * 2.0 + 1.0); // bit for bit
+/// }
+/// ```
+#[derive(Debug, Clone, Copy)]
+pub struct Lanes<T, const L: usize>(pub [T; L]);
+
+impl<T: Real, const L: usize> Lanes<T, L> {
+    /// `x` in every lane.
+    #[must_use]
+    pub const fn splat(x: T) -> Self {
+        Self([x; L])
+    }
+
+    /// `f` of each lane's index.
+    #[must_use]
+    pub fn from_fn(f: impl FnMut(usize) -> T) -> Self {
+        Self(core::array::from_fn(f))
+    }
+
+    /// One field of `L` instances, lane `i` from `instances[i]`: how a mechanism gathers its
+    /// parameters ([`Mechanism::gather`](crate::Mechanism::gather)).
+    #[must_use]
+    #[inline(always)]
+    pub fn gather<M>(instances: &[&M; L], field: impl Fn(&M) -> T) -> Self {
+        Self(core::array::from_fn(|i| field(instances[i])))
+    }
+
+    /// `f` of each lane.
+    #[inline(always)]
+    fn map(self, mut f: impl FnMut(T) -> T) -> Self {
+        let mut out = self.0;
+        for x in &mut out {
+            *x = f(*x);
+        }
+        Self(out)
+    }
+
+    /// `f` of each pair of lanes.
+    #[inline(always)]
+    fn zip(self, other: Self, mut f: impl FnMut(T, T) -> T) -> Self {
+        let mut out = self.0;
+        for (x, y) in out.iter_mut().zip(other.0) {
+            *x = f(*x, y);
+        }
+        Self(out)
+    }
+
+    /// `test` in every lane, in none, or (a divergence, counted) in some.
+    #[inline(always)]
+    fn all(self, other: Self, test: impl Fn(T, T) -> bool) -> bool {
+        let (mut every, mut any) = (true, false);
+        for (x, y) in self.0.into_iter().zip(other.0) {
+            let yes = test(x, y);
+            every &= yes;
+            any |= yes;
+        }
+        if any && !every {
+            diverged();
+        }
+        every
+    }
+}
+
+#[cfg(target_has_atomic = "32")]
+static DIVERGENCES: core::sync::atomic::AtomicU32 = core::sync::atomic::AtomicU32::new(0);
+
+/// Counts a comparison on which the lanes disagreed.
+#[cold]
+fn diverged() {
+    #[cfg(target_has_atomic = "32")]
+    DIVERGENCES.fetch_add(1, core::sync::atomic::Ordering::Relaxed);
+}
+
+/// Comparisons on which the lanes of some [`Lanes`] disagreed, so far, in this program (any
+/// thread; it wraps). `None` on a target without 32-bit atomics, where divergences cannot be
+/// counted and lanes must not be used to step instances.
+#[must_use]
+pub fn divergences() -> Option<u32> {
+    #[cfg(target_has_atomic = "32")]
+    {
+        Some(DIVERGENCES.load(core::sync::atomic::Ordering::Relaxed))
+    }
+    #[cfg(not(target_has_atomic = "32"))]
+    {
+        None
+    }
+}
+
+impl<T: Real, const L: usize> Default for Lanes<T, L> {
+    fn default() -> Self {
+        Self::splat(T::zero())
+    }
+}
+
+/// Equal in every lane; lanes that disagree count a divergence.
+impl<T: Real, const L: usize> PartialEq for Lanes<T, L> {
+    fn eq(&self, other: &Self) -> bool {
+        self.all(*other, |x, y| x == y)
+    }
+}
+
+/// An order that holds in every lane; lanes that disagree count a divergence and compare as
+/// unordered.
+impl<T: Real, const L: usize> PartialOrd for Lanes<T, L> {
+    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
+        let mut orders = self.0.iter().zip(&other.0).map(|(x, y)| x.partial_cmp(y));
+        let first = orders.next().flatten();
+        if orders.all(|o| o == first) {
+            first
+        } else {
+            diverged();
+            None
+        }
+    }
+    fn lt(&self, other: &Self) -> bool {
+        self.all(*other, |x, y| x < y)
+    }
+    fn le(&self, other: &Self) -> bool {
+        self.all(*other, |x, y| x <= y)
+    }
+    fn gt(&self, other: &Self) -> bool {
+        self.all(*other, |x, y| x > y)
+    }
+    fn ge(&self, other: &Self) -> bool {
+        self.all(*other, |x, y| x >= y)
+    }
+}
+
+impl<T: Real, const L: usize> fmt::Display for Lanes<T, L> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str("[")?;
+        for (i, x) in self.0.iter().enumerate() {
+            if i > 0 {
+                f.write_str(", ")?;
+            }
+            fmt::Display::fmt(x, f)?;
+        }
+        f.write_str("]")
+    }
+}
+
+impl<T: Real, const L: usize> fmt::LowerExp for Lanes<T, L> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str("[")?;
+        for (i, x) in self.0.iter().enumerate() {
+            if i > 0 {
+                f.write_str(", ")?;
+            }
+            fmt::LowerExp::fmt(x, f)?;
+        }
+        f.write_str("]")
+    }
+}
+
+/// The arithmetic operators, lane by lane, with lanes and with a plain value on the right.
+macro_rules! lane_ops {
+    ($($op:ident $method:ident $assign:ident $assign_method:ident),*) => {$(
+        impl<T: Real, const L: usize> $op for Lanes<T, L> {
+            type Output = Self;
+            #[inline(always)]
+            fn $method(self, other: Self) -> Self {
+                self.zip(other, |x, y| $op::$method(x, y))
+            }
+        }
+        impl<T: Real, const L: usize> $op<T> for Lanes<T, L> {
+            type Output = Self;
+            #[inline(always)]
+            fn $method(self, other: T) -> Self {
+                self.map(|x| $op::$method(x, other))
+            }
+        }
+        impl<T: Real, const L: usize> $assign for Lanes<T, L> {
+            #[inline(always)]
+            fn $assign_method(&mut self, other: Self) {
+                *self = $op::$method(*self, other);
+            }
+        }
+        impl<T: Real, const L: usize> $assign<T> for Lanes<T, L> {
+            #[inline(always)]
+            fn $assign_method(&mut self, other: T) {
+                *self = $op::$method(*self, other);
+            }
+        }
+    )*};
+}
+
+lane_ops!(
+    Add add AddAssign add_assign,
+    Sub sub SubAssign sub_assign,
+    Mul mul MulAssign mul_assign,
+    Div div DivAssign div_assign
+);
+
+impl<T: Real, const L: usize> Neg for Lanes<T, L> {
+    type Output = Self;
+    #[inline(always)]
+    fn neg(self) -> Self {
+        self.map(|x| -x)
+    }
+}
+
+impl<T: Real, const L: usize> Zero for Lanes<T, L> {
+    fn zero() -> Self {
+        Self::splat(T::zero())
+    }
+    fn is_zero(&self) -> bool {
+        self.all(*self, |x, _| x.is_zero())
+    }
+}
+
+impl<T: Real, const L: usize> One for Lanes<T, L> {
+    fn one() -> Self {
+        Self::splat(T::one())
+    }
+}
+
+/// A function of one argument, lane by lane.
+macro_rules! lane_fns {
+    ($($name:ident),*) => {$(
+        #[inline(always)]
+        fn $name(self) -> Self {
+            self.map(|x| x.$name())
+        }
+    )*};
+}
+
+impl<T: Real, const L: usize> Scalar for Lanes<T, L> {
+    type Real = Self;
+    fn from_real(x: Self) -> Self {
+        x
+    }
+    fn from_f64(x: f64) -> Self {
+        Self::splat(T::from_f64(x))
+    }
+    fn value(self) -> Self {
+        self
+    }
+    #[inline(always)]
+    fn sin(self) -> Self {
+        Self(T::sin_cos_lanes(self.0).0)
+    }
+    #[inline(always)]
+    fn cos(self) -> Self {
+        Self(T::sin_cos_lanes(self.0).1)
+    }
+    #[inline(always)]
+    fn sin_cos(self) -> (Self, Self) {
+        let (s, c) = T::sin_cos_lanes(self.0);
+        (Self(s), Self(c))
+    }
+    lane_fns!(tan, sqrt, exp, ln, abs, recip);
+    fn powi(self, n: i32) -> Self {
+        powi_by_squaring(self, n)
+    }
+    fn atan2(self, x: Self) -> Self {
+        self.zip(x, |y, x| y.atan2(x))
+    }
+}
+
+impl<T: Real, const L: usize> crate::scalar::sealed::Sealed for Lanes<T, L> {}
+
+impl<T: Real, const L: usize> Real for Lanes<T, L> {
+    const HALF: Self = Self::splat(T::HALF);
+    const TWO: Self = Self::splat(T::TWO);
+    const PI: Self = Self::splat(T::PI);
+    const EPSILON: Self = Self::splat(T::EPSILON);
+    const INFINITY: Self = Self::splat(T::INFINITY);
+    const MAX: Self = Self::splat(T::MAX);
+    const MIN_POSITIVE: Self = Self::splat(T::MIN_POSITIVE);
+    const CBRT_EPSILON: Self = Self::splat(T::CBRT_EPSILON);
+
+    /// Finite in every lane (lanes that disagree count a divergence).
+    fn is_finite(self) -> bool {
+        self.all(self, |x, _| x.is_finite())
+    }
+    /// The first lane (lanes that differ count a divergence: a report of one lane only).
+    fn to_f64(self) -> f64 {
+        self.first_if_uniform().to_f64()
+    }
+    /// The first lane (lanes that differ count a divergence).
+    fn to_f32(self) -> f32 {
+        self.first_if_uniform().to_f32()
+    }
+    fn from_f32(x: f32) -> Self {
+        Self::splat(T::from_f32(x))
+    }
+    fn max(self, other: Self) -> Self {
+        self.zip(other, Real::max)
+    }
+    fn min(self, other: Self) -> Self {
+        self.zip(other, Real::min)
+    }
+    lane_fns!(floor, round, asin, acos, atan);
+    fn powf(self, e: Self) -> Self {
+        self.zip(e, Real::powf)
+    }
+    fn sin_cos_lanes<const K: usize>(x: [Self; K]) -> ([Self; K], [Self; K]) {
+        sin_cos_each(x)
+    }
+}
+
+impl<T: Real, const L: usize> Lanes<T, L> {
+    /// The first lane, counting a divergence when another lane differs.
+    fn first_if_uniform(self) -> T {
+        let first = self.0.first().copied().unwrap_or_else(T::zero);
+        let same = self.0.iter().filter(|&&x| x == first).count();
+        if same != L {
+            diverged();
+        }
+        first
+    }
+}

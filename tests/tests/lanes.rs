@@ -1,0 +1,240 @@
+//! Lanes: `L` instances stepped side by side give, bit for bit, what each gives alone, for
+//! every mechanism that gathers and every method that steps lanes, in `f32` and `f64`; the
+//! lane sine and cosine equal the scalar ones bit for bit; a law that branches differently in
+//! different lanes is caught (a divergence) and a bank then steps its instances one by one.
+
+use lagrange_core::nalgebra::SVector;
+use lagrange_core::{divergences, fast_trig, Error, Lanes, Mechanism, Real, State};
+use lagrange_integrators::scene::{Bank, NeverSleeps, Scene};
+use lagrange_integrators::{
+    ExplicitEuler, FixedTimestep, Integrator, Rk4, SemiImplicitEuler, VelocityVerlet,
+};
+use lagrange_systems::{
+    Acrobot, CartPole, DoublePendulum, FallingParticle, SimplePendulum, SpringMassDamper,
+};
+use lagrange_tests::{for_f32_and_f64, Rng};
+
+/// Lanes per group in these tests (the scene's width on x86_64).
+const L: usize = 8;
+
+/// Steps per comparison: long enough for a chaotic double pendulum to amplify any bit.
+const STEPS: usize = 400;
+
+/// The lane sine and cosine against the scalar ones, bit for bit, over sweeps of every range
+/// (tiny, small, medium, the large reduction, the boundaries between them) and the special
+/// values.
+#[test]
+fn lane_trig_is_the_scalar_trig() {
+    let mut rng = Rng::new(7);
+    let special = [
+        0.0,
+        -0.0,
+        f32::MIN_POSITIVE,
+        1e-40,
+        f32::from_bits(0x3980_0000),
+        f32::from_bits(0x397f_ffff),
+        f32::from_bits(0x3f49_0fda),
+        f32::from_bits(0x3f49_0fdb),
+        511.999_97,
+        512.0,
+        -512.0,
+        1e30,
+        f32::MAX,
+        f32::INFINITY,
+        f32::NEG_INFINITY,
+        f32::NAN,
+    ];
+    let mut inputs: Vec<f32> = special.to_vec();
+    for scale in [1e-5, 0.5, 0.8, 3.0, 100.0, 600.0, 1e6] {
+        for _ in 0..2000 {
+            inputs.push(rng.uniform::<f32>(-scale, scale));
+        }
+    }
+    let mut checked = 0;
+    for group in inputs.chunks(L) {
+        let mut x = [0.25f32; L];
+        x[..group.len()].copy_from_slice(group);
+        let (s, c) = fast_trig::sin_cos_lanes(x);
+        for (i, &xi) in x.iter().enumerate() {
+            let (es, ec) = fast_trig::sin_cos(xi);
+            assert_eq!(
+                (s[i].to_bits(), c[i].to_bits()),
+                (es.to_bits(), ec.to_bits()),
+                "x = {xi:e}"
+            );
+            checked += 1;
+        }
+    }
+    assert!(checked > 14_000);
+}
+
+/// `L` instances built by `make`, started from `start`, stepped by `integrator` in lanes
+/// and alone for [`STEPS`] steps of `dt`: every lane equal to its instance alone, bit for bit,
+/// and no divergence.
+fn lanes_equal_alone<T, const N: usize, M, I>(
+    integrator: I,
+    dt: f64,
+    make: impl Fn(&mut Rng) -> Result<(M, State<T, N>), Error>,
+    seed: u64,
+) -> Result<(), Error>
+where
+    T: Real,
+    M: Mechanism<T, N>,
+    I: Integrator<T, N, M> + Clone,
+{
+    let mut rng = Rng::new(seed);
+    let built: Vec<(M, State<T, N>)> = (0..L).map(|_| make(&mut rng)).collect::<Result<_, _>>()?;
+    let instances: [&M; L] = core::array::from_fn(|i| &built[i].0);
+    let lanes = M::gather(instances).ok_or(Error::InvalidParameter {
+        name: "mechanism",
+        reason: "gathers no lanes",
+    })?;
+    let dt = T::from_f64(dt);
+    let mut alone: Vec<State<T, N>> = built.iter().map(|(_, s)| *s).collect();
+    let states: [&State<T, N>; L] = core::array::from_fn(|i| &built[i].1);
+    let mut side = State {
+        t: Lanes::gather(&states, |s| s.t),
+        q: SVector::from_fn(|j, _| Lanes::gather(&states, |s| s.q[j])),
+        qd: SVector::from_fn(|j, _| Lanes::gather(&states, |s| s.qd[j])),
+    };
+    let before = divergences();
+    for step in 0..STEPS {
+        side = integrator
+            .step_lanes(&lanes, &side, dt)
+            .ok_or(Error::InvalidParameter {
+                name: "integrator",
+                reason: "steps no lanes",
+            })??;
+        for (i, (s, (m, _))) in alone.iter_mut().zip(&built).enumerate() {
+            *s = integrator.clone().run_step(m, s, dt)?;
+            let lane = (side.t.0[i], side.q.map(|x| x.0[i]), side.qd.map(|x| x.0[i]));
+            assert!(
+                lane.0 == s.t && lane.1 == s.q && lane.2 == s.qd,
+                "{} step {step}, lane {i}: {lane:?} alone {s:?}",
+                I::NAME
+            );
+        }
+    }
+    assert_eq!(divergences(), before, "{}", I::NAME);
+    Ok(())
+}
+
+/// Every lane-stepping method on one mechanism.
+fn every_method<T, const N: usize, M>(
+    dt: f64,
+    make: impl Fn(&mut Rng) -> Result<(M, State<T, N>), Error> + Copy,
+) -> Result<(), Error>
+where
+    T: Real,
+    M: Mechanism<T, N>,
+{
+    lanes_equal_alone(Rk4, dt, make, 1)?;
+    lanes_equal_alone(ExplicitEuler, dt, make, 2)?;
+    lanes_equal_alone(SemiImplicitEuler, dt, make, 3)?;
+    lanes_equal_alone(VelocityVerlet, dt, make, 4)?;
+    Ok(())
+}
+
+/// A value of `T` uniform in `[lo, hi)`.
+fn u<T: Real>(rng: &mut Rng, lo: f64, hi: f64) -> T {
+    rng.uniform(lo, hi)
+}
+
+/// Pendulums of different lengths and damping, from small and from large angles (some beyond
+/// the lane trig's fast range), and the standard mechanisms with parameters of their own.
+fn every_gathering_mechanism<T: Real>() -> Result<(), Error> {
+    every_method(1e-2, |r| {
+        let p = SimplePendulum::new(
+            u(r, 0.5, 2.0),
+            u(r, 0.3, 3.0),
+            T::from_f64(9.81),
+            u(r, 0.0, 1.0),
+        )?;
+        let th = if r.unit() < 0.5 {
+            u(r, -0.7, 0.7)
+        } else {
+            u(r, -700.0, 700.0)
+        };
+        Ok((p, State::new(T::zero(), [th], [u(r, -2.0, 2.0)])))
+    })?;
+    every_method(1e-2, |r| {
+        let p = DoublePendulum::new(
+            u(r, 0.5, 2.0),
+            u(r, 0.5, 2.0),
+            u(r, 0.5, 2.0),
+            u(r, 0.5, 2.0),
+            T::from_f64(9.81),
+        )?;
+        Ok((p, State::at_rest([u(r, -3.0, 3.0), u(r, -3.0, 3.0)])))
+    })?;
+    every_method(1e-2, |r| {
+        let mut p = CartPole::new(
+            u(r, 0.5, 2.0),
+            u(r, 0.05, 0.5),
+            u(r, 0.2, 1.0),
+            T::from_f64(9.8),
+        )?;
+        p.set_force(u(r, -5.0, 5.0))?;
+        Ok((p, State::at_rest([u(r, -1.0, 1.0), u(r, -3.0, 3.0)])))
+    })?;
+    every_method(1e-2, |r| {
+        let mut p = Acrobot::<T>::spong();
+        p.set_torque(u(r, -2.0, 2.0))?;
+        Ok((p, State::at_rest([u(r, -2.0, 2.0), u(r, -2.0, 2.0)])))
+    })?;
+    every_method(1e-2, |r| {
+        let p = SpringMassDamper::new(u(r, 0.5, 2.0), u(r, 1.0, 50.0), u(r, 0.0, 1.0))?;
+        Ok((
+            p,
+            State::new(T::zero(), [u(r, -1.0, 1.0)], [u(r, -1.0, 1.0)]),
+        ))
+    })?;
+    every_method(1e-2, |r| {
+        let p = FallingParticle::new(u(r, 0.5, 2.0), T::from_f64(9.81))?;
+        Ok((
+            p,
+            State::new(T::zero(), [u(r, 0.0, 10.0)], [u(r, -1.0, 1.0)]),
+        ))
+    })?;
+    Ok(())
+}
+
+/// A bank of pendulums that is not a multiple of the lane width, stepped by a scene, equals
+/// a `FixedTimestep` per pendulum, bit for bit (interpolated states too).
+fn a_bank_in_lanes_equals_its_instances_alone<T: Real>() -> Result<(), Error> {
+    const K: usize = 3 * L + 5;
+    let mut rng = Rng::new(11);
+    let dt = T::from_f64(1.0 / 120.0);
+    let mut bank: Bank<T, 2, K, DoublePendulum<T>, Rk4> = Bank::new(Rk4, NeverSleeps)?;
+    let mut alone = Vec::new();
+    for _ in 0..K {
+        let p = DoublePendulum::new(
+            u(&mut rng, 0.5, 2.0),
+            T::one(),
+            T::one(),
+            u(&mut rng, 0.5, 2.0),
+            T::from_f64(9.81),
+        )?;
+        let s = State::at_rest([u(&mut rng, -3.0, 3.0), u(&mut rng, -3.0, 3.0)]);
+        let id = bank.add(p, s)?;
+        alone.push((id, p, FixedTimestep::new(Rk4, dt, 4, s)?));
+    }
+    let mut scene = Scene::new(bank, dt, 4)?;
+    for frame in 0..600 {
+        let frame_time = T::from_f64([1.0 / 60.0, 1.0 / 144.0, 0.03][frame % 3]);
+        scene.advance(frame_time)?;
+        for (id, p, clock) in &mut alone {
+            clock.advance(p, frame_time)?;
+            let (mine, theirs) = (scene.banks().state(*id)?, clock.current());
+            assert!(mine.q == theirs.q && mine.qd == theirs.qd, "frame {frame}");
+            let drawn = scene.banks().interpolated(*id, scene.alpha())?;
+            assert!(drawn.q == clock.interpolated().q);
+        }
+    }
+    Ok(())
+}
+
+for_f32_and_f64!(
+    every_gathering_mechanism,
+    a_bank_in_lanes_equals_its_instances_alone
+);

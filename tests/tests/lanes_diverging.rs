@@ -1,0 +1,95 @@
+//! A law that branches differently in different lanes: the divergence is counted and a bank
+//! steps its instances one by one, with the bits of each alone. (A test binary of its own:
+//! the divergence count is per process, and the other lane tests assert it does not move.)
+
+use lagrange_core::nalgebra::SVector;
+use lagrange_core::{
+    divergences, Error, GeneralizedForce, Lagrangian, Lanes, Mechanism, Real, Scalar, State,
+};
+use lagrange_integrators::scene::{Bank, NeverSleeps, Scene};
+use lagrange_integrators::{FixedTimestep, Rk4};
+use lagrange_tests::for_f32_and_f64;
+
+/// Lanes per group (the scene's width on x86_64).
+const L: usize = 8;
+
+/// A spring whose stiffness doubles where `x < 0`: a law that branches on the state, so that
+/// lanes on both sides of zero take different branches.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct KinkedSpring<T> {
+    k: T,
+}
+
+impl<T: Real> Lagrangian<T, 1> for KinkedSpring<T> {
+    fn kinetic<S: Scalar<Real = T>>(&self, _t: S, _q: &SVector<S, 1>, qd: &SVector<S, 1>) -> S {
+        qd[0] * qd[0] * T::HALF
+    }
+    fn potential<S: Scalar<Real = T>>(&self, _t: S, q: &SVector<S, 1>) -> S {
+        let k = if q[0].value() < T::zero() {
+            self.k * T::TWO
+        } else {
+            self.k
+        };
+        q[0] * q[0] * (k * T::HALF)
+    }
+}
+
+impl<T: Real> Mechanism<T, 1> for KinkedSpring<T> {
+    fn mass_matrix(&self, _s: &State<T, 1>) -> lagrange_core::nalgebra::SMatrix<T, 1, 1> {
+        lagrange_core::nalgebra::SMatrix::identity()
+    }
+    fn rhs(&self, s: &State<T, 1>) -> SVector<T, 1> {
+        let k = if s.q[0] < T::zero() {
+            self.k * T::TWO
+        } else {
+            self.k
+        };
+        SVector::from([-k * s.q[0]])
+    }
+    fn law<F: GeneralizedForce<T, 1>>(
+        &self,
+        s: &State<T, 1>,
+        extra: &F,
+    ) -> Result<SVector<T, 1>, Error> {
+        Ok(extra.added_to(s, self.rhs(s)))
+    }
+    fn gather<const W: usize>(instances: [&Self; W]) -> Option<impl Mechanism<Lanes<T, W>, 1>> {
+        Some(KinkedSpring {
+            k: Lanes::gather(&instances, |m| m.k),
+        })
+    }
+}
+
+/// Springs swinging through their kink: their lanes diverge, the divergence is counted, and a
+/// bank steps them one by one: every instance equals its `FixedTimestep` run bit for bit.
+fn diverging_lanes_fall_back<T: Real>() -> Result<(), Error> {
+    const K: usize = 2 * L;
+    let dt = T::from_f64(1e-2);
+    let mut bank: Bank<T, 1, K, KinkedSpring<T>, Rk4> = Bank::new(Rk4, NeverSleeps)?;
+    let mut alone = Vec::new();
+    for i in 0..K {
+        // Stiffnesses of their own: a kinked spring's period does not depend on its
+        // amplitude, so equal springs would cross the kink together.
+        let m = KinkedSpring {
+            k: T::from_f64(4.0 + 0.37 * i as f64),
+        };
+        let s = State::new(T::zero(), [T::from_f64(0.1 * i as f64 - 0.75)], [T::zero()]);
+        let id = bank.add(m, s)?;
+        alone.push((id, m, FixedTimestep::new(Rk4, dt, 1, s)?));
+    }
+    let mut scene = Scene::new(bank, dt, 1)?;
+    let before = divergences();
+    for _ in 0..500 {
+        scene.advance(dt)?;
+        for (id, m, clock) in &mut alone {
+            clock.advance(m, dt)?;
+            assert_eq!(scene.banks().state(*id)?.q, clock.current().q);
+        }
+    }
+    if cfg!(any(target_arch = "x86_64", target_arch = "aarch64")) {
+        assert_ne!(divergences(), before, "the kink never split the lanes");
+    }
+    Ok(())
+}
+
+for_f32_and_f64!(diverging_lanes_fall_back);
