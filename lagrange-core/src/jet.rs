@@ -684,7 +684,7 @@ mod tests {
     /// A chain-like function of six coordinates: every part agrees with nested duals over all
     /// twelve variables.
     #[test]
-    fn spans_agree_with_nested_duals() {
+    fn chain_agrees_with_nested_duals() {
         const M: usize = 6;
         type Big = Dual<Dual<f64, 12>, 12>;
         fn chain<S: Scalar<Real = f64>>(q: &[S; M], p: &[S; M]) -> S {

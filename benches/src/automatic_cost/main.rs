@@ -327,7 +327,7 @@ fn markdown(quick: bool, rows: &[Row]) -> String {
         out.push_str("A `--quick` smoke run: few rounds, noisy figures.\n\n");
     }
     out.push_str(
-        "ns per acceleration, f64, medians over rounds in which the three were timed in turn \
+        "ns per acceleration, f64, medians over rounds in which each was timed in turn \
          over the same states; ratios are medians of the per-round ratios. Generated: the mechanism \
          `cargo xtask derive` made from a spec in derive/specs, where one exists (`-` where \
          none).\n\n\
