@@ -456,14 +456,6 @@ impl<S: Scalar<Real = R>, const N: usize, R: Real> DivAssign for Jet<S, N, R> {
 /// `a op b` from `a op= b`, for jets and for plain numbers on the right.
 macro_rules! by_value {
     ($op:ident, $f:ident, $assign:ident, $fa:ident) => {
-        impl<S: Scalar<Real = R>, const N: usize, R: Real> $op for Jet<S, N, R> {
-            type Output = Self;
-            #[inline(always)]
-            fn $f(mut self, o: Self) -> Self {
-                $assign::$fa(&mut self, o);
-                self
-            }
-        }
         impl<S: Scalar<Real = R>, const N: usize, R: Real> $op<R> for Jet<S, N, R> {
             type Output = Self;
             #[inline(always)]
@@ -473,12 +465,55 @@ macro_rules! by_value {
             }
         }
     };
+    ($op:ident, $f:ident, $assign:ident, $fa:ident, jets) => {
+        by_value!($op, $f, $assign, $fa);
+        impl<S: Scalar<Real = R>, const N: usize, R: Real> $op for Jet<S, N, R> {
+            type Output = Self;
+            #[inline(always)]
+            fn $f(mut self, o: Self) -> Self {
+                $assign::$fa(&mut self, o);
+                self
+            }
+        }
+    };
 }
 
+by_value!(Sub, sub, SubAssign, sub_assign, jets);
+by_value!(Div, div, DivAssign, div_assign, jets);
 by_value!(Add, add, AddAssign, add_assign);
-by_value!(Sub, sub, SubAssign, sub_assign);
 by_value!(Mul, mul, MulAssign, mul_assign);
-by_value!(Div, div, DivAssign, div_assign);
+
+/// `c + x` with `c` a constant (a parameter, a literal) returns `x`'s own storage with `c`
+/// added to its value: a jet of a long chain is kilobytes, not worth writing again.
+impl<S: Scalar<Real = R>, const N: usize, R: Real> Add for Jet<S, N, R> {
+    type Output = Self;
+    #[inline(always)]
+    fn add(mut self, mut o: Self) -> Self {
+        if self.parts == 0 {
+            o.v = self.v + o.v;
+            o
+        } else {
+            self.add_jet::<true>(&o);
+            self
+        }
+    }
+}
+
+/// `c * x` with `c` a constant (the usual order in a kinetic energy: `S::from_real(m) * ...`)
+/// scales `x`'s own storage in place, as `x * c` does.
+impl<S: Scalar<Real = R>, const N: usize, R: Real> Mul for Jet<S, N, R> {
+    type Output = Self;
+    #[inline(always)]
+    fn mul(mut self, mut o: Self) -> Self {
+        if self.parts == 0 {
+            o.scale_by(self.v);
+            o
+        } else {
+            self.mul_jet(&o);
+            self
+        }
+    }
+}
 
 impl<S: Scalar<Real = R>, const N: usize, R: Real> Neg for Jet<S, N, R> {
     type Output = Self;
@@ -563,13 +598,13 @@ impl<S: Scalar<Real = R>, const N: usize, R: Real> Scalar for Jet<S, N, R> {
         self
     }
     #[inline(always)]
-    fn sin_cos(self) -> (Self, Self) {
+    fn sin_cos(mut self) -> (Self, Self) {
+        // One copy: the cosine takes `self`'s own storage.
         let (s, c) = self.v.sin_cos();
-        let mut cos = self;
         let mut sin = self;
         sin.chain(s, c, -s);
-        cos.chain(c, -s, -c);
-        (sin, cos)
+        self.chain(c, -s, -c);
+        (sin, self)
     }
     fn tan(mut self) -> Self {
         let t = self.v.tan();
