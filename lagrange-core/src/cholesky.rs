@@ -37,11 +37,18 @@ pub fn solve_spd<T: Real, const N: usize>(
     }
 }
 
-/// The Cholesky factor `L` of a symmetric positive definite matrix, `m = L L^T`: factored once,
-/// it solves `m x = b` for any number of right-hand sides (a constant mass matrix).
+/// The Cholesky factorisation of a symmetric positive definite matrix, factored once to solve
+/// `m x = b` for any number of right-hand sides (a constant mass matrix).
+///
+/// Kept square-root free, `m = L D L^T` with `L` unit lower triangular and `D` diagonal (the
+/// squares of the usual Cholesky factor's diagonal), with the reciprocals of `D`: factoring
+/// costs `N` divisions and no square root, solving only multiplications and additions.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Cholesky<T: Real, const N: usize> {
+    /// `L` below the diagonal, `D` on it.
     l: SMatrix<T, N, N>,
+    /// `1 / D`.
+    inv_d: SVector<T, N>,
 }
 
 impl<T: Real, const N: usize> Cholesky<T, N> {
@@ -51,10 +58,15 @@ impl<T: Real, const N: usize> Cholesky<T, N> {
     /// As [`solve_spd`].
     pub fn factor(m: &SMatrix<T, N, N>) -> Result<Self, Error> {
         let mut l = SMatrix::<T, N, N>::zeros();
+        let mut inv_d = SVector::<T, N>::zeros();
+        // Column j: w_k = L_jk D_k, D_j = m_jj - sum_k L_jk w_k, then
+        // L_ij = (m_ij - sum_k L_ik w_k) / D_j below it.
+        let mut w = [T::zero(); N];
         for j in 0..N {
             let mut d = m[(j, j)];
             for k in 0..j {
-                d -= l[(j, k)] * l[(j, k)];
+                w[k] = l[(j, k)] * l[(k, k)];
+                d -= l[(j, k)] * w[k];
             }
             if !d.is_finite() {
                 return Err(Error::NonFiniteState);
@@ -62,21 +74,22 @@ impl<T: Real, const N: usize> Cholesky<T, N> {
             if d <= m[(j, j)].abs() * T::EPSILON {
                 return Err(Error::SingularMassMatrix { pivot: j });
             }
-            let ljj = d.sqrt();
-            l[(j, j)] = ljj;
+            let inv = d.recip();
+            l[(j, j)] = d;
+            inv_d[j] = inv;
             for i in j + 1..N {
                 let mut s = m[(i, j)];
                 for k in 0..j {
-                    s -= l[(i, k)] * l[(j, k)];
+                    s -= l[(i, k)] * w[k];
                 }
-                l[(i, j)] = s / ljj;
+                l[(i, j)] = s * inv;
             }
         }
-        Ok(Self { l })
+        Ok(Self { l, inv_d })
     }
 
-    /// `x` with `m x = b`: forward substitution `L y = b`, then back substitution
-    /// `L^T x = y`, in place.
+    /// `x` with `m x = b`: `L y = b` forward, `x = D^-1 y`, then `L^T x = ...` backward, in
+    /// place.
     #[must_use]
     pub fn solve(&self, b: &SVector<T, N>) -> SVector<T, N> {
         let l = &self.l;
@@ -86,14 +99,14 @@ impl<T: Real, const N: usize> Cholesky<T, N> {
             for k in 0..i {
                 s -= l[(i, k)] * x[k];
             }
-            x[i] = s / l[(i, i)];
+            x[i] = s;
         }
         for i in (0..N).rev() {
-            let mut s = x[i];
+            let mut s = x[i] * self.inv_d[i];
             for k in i + 1..N {
                 s -= l[(k, i)] * x[k];
             }
-            x[i] = s / l[(i, i)];
+            x[i] = s;
         }
         x
     }

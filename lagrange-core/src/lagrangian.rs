@@ -1,6 +1,7 @@
 //! Automatic Euler-Lagrange: write `T` and `V` once, generic over a [`Scalar`], and get the
-//! equations of motion by differentiating them with nested [`Dual`] numbers.
+//! equations of motion by differentiating them with forward-mode dual numbers.
 
+use crate::jet::Jet;
 use crate::mechanism::finite;
 use crate::{
     central_difference_jacobian, solve_spd, Cholesky, Dual, Error, GeneralizedForce, Jacobian,
@@ -43,7 +44,9 @@ use nalgebra::{SMatrix, SVector};
 /// ```
 pub trait Lagrangian<T: Real, const N: usize> {
     /// True when the kinetic energy depends on `t` explicitly (a driven mechanism written in
-    /// a fixed frame), so that `d2L/dq'dt` is needed: one more dual evaluation per call.
+    /// a fixed frame), so that `d2L/dq'dt` is needed: [`EulerLagrange`] then moves time along
+    /// with the coordinates in its one evaluation of `T` (no extra evaluation; with
+    /// [`Lagrangian::CONSTANT_MASS`], one evaluation of `T` that it would otherwise skip).
     const EXPLICIT_TIME: bool = false;
 
     /// True when the mass matrix `d2T/dq'2` is the same at every state (masses and inertias
@@ -92,10 +95,6 @@ pub trait Lagrangian<T: Real, const N: usize> {
     }
 }
 
-/// First derivatives along `N` directions, over the scalar `S`.
-type D1<S, const N: usize> = Dual<S, N>;
-/// Second derivatives: an outer direction over an inner one.
-type D2<S, const N: usize> = Dual<Dual<S, N>, N>;
 /// One directional derivative: what the exact Jacobian seeds, one coordinate at a time.
 type Directional<T> = Dual<T, 1>;
 
@@ -106,17 +105,26 @@ type Directional<T> = Dual<T, 1>;
 /// f   = dT/dq - dV/dq - (d2T/dq'dq) q' - d2T/dq'dt
 /// ```
 ///
-/// each entry exact to rounding, from forward-mode dual numbers: one nested evaluation of `T`
-/// for `M`, one nested evaluation of `T` and one plain dual evaluation of `V` for `f` (and one
-/// more of `T` when [`Lagrangian::EXPLICIT_TIME`]). No symbolic step, no heap. This is both the
-/// general path for a user's own mechanism and the oracle the hand-derived systems are tested
-/// against.
+/// each entry exact to rounding, from forward-mode derivatives: one evaluation of `T` over a
+/// second-order jet and one of `V` over a [`Dual`] number give both. The jet carries `T`'s
+/// gradients in `q` and `q'`, the upper half of its Hessian in `q'` (that is `M`), and the
+/// derivative of its velocity gradient along `(dq, dt) = (q', 1)` (the mixed and time terms
+/// at once, `O(N)` per operation instead of a second Hessian); parts that are exactly zero (a
+/// parameter, a function of `q` alone, a value linear in `q'`) are skipped. `M q'' = f + Q`
+/// is then solved by Cholesky ([`solve_spd`]). No symbolic step, no heap. This is both the general path for a
+/// user's own mechanism and the oracle the hand-derived systems are tested against.
+///
+/// Cost: for a kinetic energy of `K` operations, up to `K N^2 / 2` for `M` (less where parts
+/// are zero) and `K N` for `f`, plus `N^3 / 6` for the solve; a jet holds
+/// `N^2 + 3 N + 2` numbers, which for a long chain (kilobytes at `N = 20`) makes copying them
+/// a large part of the cost.
 ///
 /// Its [`Mechanism::law_jacobian`] is exact too: differentiating `M q'' = f + Q + extra` gives
 /// `M dq''/dx = d(f + Q + extra)/dx - (dM/dx) q''`, with `dM/dx` and `df/dx` from `M` and `f`
 /// computed once more per coordinate and per velocity over a one-direction dual number (third
-/// derivatives of `T`, `2 N` evaluations of `M` and `f` at about twice their plain cost, which
-/// keeps the stack use of a long chain at that of `M` itself), then `2 N` mass solves. Only the
+/// derivatives of `T`, `2 N` evaluations of the jet over `Dual<T, 1>` at about twice their
+/// plain cost, which keeps the stack use of a long chain at about twice that of one
+/// acceleration), then `2 N` mass solves. Only the
 /// Lagrangian's [`Lagrangian::non_conservative_force`] is differentiated by central
 /// differences, and an extra force by its own [`GeneralizedForce::jacobian`].
 ///
@@ -154,13 +162,58 @@ impl<T: Real, const N: usize, L: defmt::Format> defmt::Format for EulerLagrange<
     }
 }
 
-/// `x` as a second-order dual constant.
-fn d2_constant<S: Scalar, const N: usize>(x: S) -> D2<S, N> {
-    D2::constant(D1::constant(x))
+/// `M = d2T/dq'dq'` and `T`'s part of `f`, `dT/dq - (d2T/dq'dq) q' - d2T/dq'dt`, from `T` at
+/// `(t, q, q')` over a [`Jet`] (velocities seeded, coordinates seeded and moving at `q'`, and
+/// time at unit rate where [`Lagrangian::EXPLICIT_TIME`], so that the jet's directional parts
+/// give the mixed and time terms).
+///
+/// The one place that evaluates `T` over a jet, for every use (the law, `M` alone, `f`
+/// alone, the time term), and kept out of line, so that each scalar's `T` over a jet has this
+/// one caller: the compiler may then inline it here, where every seed's flags are known, and
+/// fold the jet's tests of them away. (Whether it does depends on the size of `T`; the
+/// automatic-cost bench measured no difference from two callers on this machine.)
+#[inline(never)]
+fn kinetic_jet<T, S, L, const N: usize>(
+    l: &L,
+    t: S,
+    q: &SVector<S, N>,
+    qd: &SVector<S, N>,
+) -> (SMatrix<S, N, N>, SVector<S, N>)
+where
+    T: Real,
+    S: Scalar<Real = T>,
+    L: Lagrangian<T, N>,
+{
+    let t = if L::EXPLICIT_TIME {
+        Jet::time(t)
+    } else {
+        Jet::constant(t)
+    };
+    let jq = SVector::<Jet<S, N>, N>::from_fn(|k, _| Jet::coordinate(q[k], k, qd[k]));
+    let jqd = SVector::<Jet<S, N>, N>::from_fn(|k, _| Jet::velocity(qd[k], k));
+    let r = l.kinetic(t, &jq, &jqd);
+    (
+        SMatrix::from_fn(|i, k| r.hessian(i, k)),
+        SVector::from_fn(|i, _| r.gq[i] - r.dp[i]),
+    )
 }
 
-/// `M = d2T/dq'dq'` evaluated over any scalar `S` (plain for the mass matrix, a dual number
-/// for its derivatives).
+/// `dV/dq` over any scalar `S`, from one evaluation of `V` over `Dual<S, N>`.
+fn potential_gradient<T, S, L, const N: usize>(l: &L, t: S, q: &SVector<S, N>) -> SVector<S, N>
+where
+    T: Real,
+    S: Scalar<Real = T>,
+    L: Lagrangian<T, N>,
+{
+    let v = l.potential(
+        Dual::<S, N>::constant(t),
+        &SVector::<Dual<S, N>, N>::from_fn(|k, _| Dual::variable(q[k], k)),
+    );
+    SVector::from(v.eps)
+}
+
+/// `M = d2T/dq'dq'` over any scalar `S` (plain for the mass matrix, a dual number for its
+/// derivatives), from one evaluation of `T` over a [`Jet`].
 fn mass_matrix_in<T, S, L, const N: usize>(
     l: &L,
     t: S,
@@ -172,60 +225,37 @@ where
     S: Scalar<Real = T>,
     L: Lagrangian<T, N>,
 {
-    // Velocities seeded in both the outer and the inner direction:
-    // r.eps[k].eps[i] = d2T/dq'_k dq'_i.
-    let q = q.map(d2_constant);
-    let qd = SVector::<D2<S, N>, N>::from_fn(|k, _| D2::variable(D1::variable(qd[k], k), k));
-    let r = l.kinetic(d2_constant(t), &q, &qd);
-    SMatrix::from_fn(|i, k| r.eps[k].eps[i])
+    kinetic_jet(l, t, q, qd).0
 }
 
-/// `f = dT/dq - dV/dq - (d2T/dq'dq) q' - d2T/dq'dt` over any scalar `S`.
-fn rhs_in<T, S, L, const N: usize>(
+/// `M` and `f = dT/dq - dV/dq - (d2T/dq'dq) q' - d2T/dq'dt` over any scalar `S`, from one
+/// evaluation of `T` over a [`Jet`] and one of `V` over `Dual<S, N>`. Where
+/// [`Lagrangian::CONSTANT_MASS`] holds, `f` skips `T` but for the time term, and `M` is not
+/// computed (zero here: use the factor made once).
+#[inline(always)]
+fn terms_in<T, S, L, const N: usize>(
     l: &L,
     t: S,
     q: &SVector<S, N>,
     qd: &SVector<S, N>,
-) -> SVector<S, N>
+) -> (SMatrix<S, N, N>, SVector<S, N>)
 where
     T: Real,
     S: Scalar<Real = T>,
     L: Lagrangian<T, N>,
 {
-    let v = l.potential(
-        D1::constant(t),
-        &SVector::<D1<S, N>, N>::from_fn(|k, _| D1::variable(q[k], k)),
-    );
-    let inner_qd = SVector::<D2<S, N>, N>::from_fn(|i, _| D2::constant(D1::variable(qd[i], i)));
-    let mut f = if L::CONSTANT_MASS {
-        // dT/dq = 0 and d2T/dq'dq = 0: nothing of T to differentiate.
-        SVector::<S, N>::from_fn(|i, _| -v.eps[i])
-    } else {
-        // Outer direction k on q_k, inner direction i on q'_i: r.eps[k].re = dT/dq_k and
-        // r.eps[k].eps[i] = d2T/dq_k dq'_i.
-        let outer_q = SVector::<D2<S, N>, N>::from_fn(|k, _| D2::variable(D1::constant(q[k]), k));
-        let r = l.kinetic(d2_constant(t), &outer_q, &inner_qd);
-        SVector::<S, N>::from_fn(|i, _| {
-            let mut fi = r.eps[i].re - v.eps[i];
-            for k in 0..N {
-                fi -= r.eps[k].eps[i] * qd[k];
-            }
-            fi
-        })
-    };
-
-    if L::EXPLICIT_TIME {
-        // Outer direction 0 on t: r.eps[0].eps[i] = d2T/dt dq'_i.
-        let rt = l.kinetic(
-            D2::variable(D1::constant(t), 0),
-            &q.map(d2_constant),
-            &inner_qd,
-        );
-        if let Some(dt) = rt.eps.first() {
-            f -= SVector::<S, N>::from(dt.eps);
+    let dv = potential_gradient(l, t, q);
+    if L::CONSTANT_MASS {
+        // dT/dq = 0 and d2T/dq'dq = 0: nothing of T to differentiate but the time term.
+        let mut f = -dv;
+        if L::EXPLICIT_TIME {
+            // T's part is then -d2T/dq'dt alone (dT/dq = 0 and d2T/dq'dq = 0).
+            f += kinetic_jet(l, t, q, qd).1;
         }
+        return (SMatrix::zeros(), f);
     }
-    f
+    let (m, f) = kinetic_jet(l, t, q, qd);
+    (m, f - dv)
 }
 
 /// `v` as one-direction duals, seeded along component `k` when `seed` is true.
@@ -271,9 +301,12 @@ fn residual_jacobian<T: Real, const N: usize, L: Lagrangian<T, N>>(
         for velocity in [false, true] {
             let q = seeded(&s.q, k, !velocity);
             let qd = seeded(&s.qd, k, velocity);
-            let m = mass_matrix_in(l, t, &q, &qd);
-            let f = rhs_in(l, t, &q, &qd);
-            let column = m.map(|x| x.eps[0]) * a - f.map(|x| x.eps[0]);
+            // With a constant mass matrix, dM/dx = 0.
+            let (m, f) = terms_in(l, t, &q, &qd);
+            let mut column = -f.map(|x| x.eps[0]);
+            if !L::CONSTANT_MASS {
+                column += m.map(|x| x.eps[0]) * a;
+            }
             if velocity {
                 j.wrt_qd.set_column(k, &column);
             } else {
@@ -290,7 +323,7 @@ impl<T: Real, const N: usize, L: Lagrangian<T, N>> Mechanism<T, N> for EulerLagr
     }
 
     fn rhs(&self, s: &State<T, N>) -> SVector<T, N> {
-        rhs_in(&self.lagrangian, s.t, &s.q, &s.qd)
+        terms_in(&self.lagrangian, s.t, &s.q, &s.qd).1
     }
 
     /// With the factor made once where the mass matrix is constant.
@@ -298,6 +331,20 @@ impl<T: Real, const N: usize, L: Lagrangian<T, N>> Mechanism<T, N> for EulerLagr
         match &self.mass {
             Some(factor) => factor.as_ref().map(|c| c.solve(b)).map_err(|e| *e),
             None => solve_spd(&self.mass_matrix(s), b),
+        }
+    }
+
+    /// `M` and `f` from one evaluation of `T` (or the factor made once).
+    fn law<F: GeneralizedForce<T, N>>(
+        &self,
+        s: &State<T, N>,
+        extra: &F,
+    ) -> Result<SVector<T, N>, Error> {
+        let (m, f) = terms_in(&self.lagrangian, s.t, &s.q, &s.qd);
+        let b = extra.added_to(s, f + self.lagrangian.non_conservative_force(s));
+        match &self.mass {
+            Some(factor) => factor.as_ref().map(|c| c.solve(&b)).map_err(|e| *e),
+            None => solve_spd(&m, &b),
         }
     }
 

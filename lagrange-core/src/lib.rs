@@ -53,6 +53,7 @@ pub mod fast_trig;
 mod forces;
 mod free_law;
 mod jacobian;
+mod jet;
 mod lagrangian;
 mod lanes;
 mod mechanism;

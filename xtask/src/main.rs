@@ -8,7 +8,8 @@
 //!   standard problems, CSV, Markdown and SVG work-precision plots under
 //!   `target/lagrange-bench/` (not part of `ci`). `--quick` for a smoke run. `--scene`: the
 //!   cost of a scene's frame against the fraction awake and against plain loops, and the
-//!   constant-mass skip (`scene.csv`, `scene.md`).
+//!   constant-mass skip (`scene.csv`, `scene.md`). `--automatic`: ns per automatic
+//!   acceleration against the hand-derived and generated ones (`automatic.csv`, `automatic.md`).
 //! - `cross`: thumbv7em-none-eabihf builds of the library crates, with and without `defmt`,
 //!   and a linked no_std binary with no allocator, with its size.
 //! - `qemu`: the firmware on an emulated Cortex-M4F (QEMU `mps2-an386`), its defmt log compared
@@ -101,11 +102,27 @@ const SCENE_BENCH: [&str; 9] = [
     "--",
 ];
 
-/// `cargo xtask bench [--scene] ...`: the work-precision bench, or with `--scene` the scene
-/// bench, with the other flags passed on.
+/// The automatic-path bench (`--automatic`), run like the work-precision bench.
+const AUTOMATIC_BENCH: [&str; 9] = [
+    "run",
+    "--quiet",
+    "--profile",
+    "xtask",
+    "-p",
+    "lagrange-benches",
+    "--bin",
+    "automatic-cost",
+    "--",
+];
+
+/// `cargo xtask bench [--scene | --automatic] ...`: the work-precision bench, or with
+/// `--scene` the scene bench, with `--automatic` the automatic-path bench, with the other
+/// flags passed on.
 fn bench(args: &[String]) -> Result<(), String> {
     let which = if args.iter().any(|a| a == "--scene") {
         SCENE_BENCH
+    } else if args.iter().any(|a| a == "--automatic") {
+        AUTOMATIC_BENCH
     } else {
         BENCH
     };
