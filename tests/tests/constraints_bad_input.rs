@@ -56,6 +56,14 @@ fn parameters_are_checked<T: Real>() -> Result<(), Error> {
         refuses(CartesianPendulum::new(one, one, bad), "gravity");
         refuses(FourBarLinkage::new([one; 4], [one; 3], bad), "gravity");
     }
+    // Gains whose products the equation forms (2 alpha, beta^2, rate^2) must not overflow.
+    let root = T::MAX.sqrt();
+    refuses(Stabilization::baumgarte(T::MAX, T::zero()), "alpha");
+    refuses(Stabilization::baumgarte(T::zero(), root * T::TWO), "beta");
+    refuses(Stabilization::critical(root * T::TWO), "rate");
+    refuses(Stabilization::for_step(T::from_f64(0.01) / root), "dt");
+    Stabilization::baumgarte(T::MAX / T::from_f64(4.0), root / T::TWO)?;
+    Stabilization::critical(root / T::TWO)?;
     refuses(Projection::new(small, 0), "max_iterations");
     refuses(Projection::new(small, 1001), "max_iterations");
     refuses(Projection::new(small, u32::MAX), "max_iterations");

@@ -155,6 +155,10 @@ const AREAS: [Area; 9] = [
             "four_bar_linkage",
             "--test",
             "rolling_disk",
+            "--test",
+            "constrained_laws",
+            "--test",
+            "constraints_bad_input",
         ],
     },
     Area {
