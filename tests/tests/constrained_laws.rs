@@ -10,7 +10,10 @@ use lagrange_systems::CartesianPendulum;
 /// Rounding of forces and velocities of order 10 (a few hundred ulps at most).
 const ROUNDING: f64 = 1e-12;
 
-fn pendulum() -> Result<(Constrained<f64, 1, CartesianPendulum<f64>>, State<f64, 2>), Error> {
+/// The constrained pendulum.
+type Rod = Constrained<f64, 1, CartesianPendulum<f64>>;
+
+fn pendulum() -> Result<(Rod, State<f64, 2>), Error> {
     let (l, th, thd) = (1.5, 0.7_f64, 1.3);
     let q = [l * th.sin(), -l * th.cos()];
     let qd = [l * thd * th.cos(), l * thd * th.sin()];
