@@ -139,9 +139,9 @@ pub fn measure(opts: &Options) -> Overhead {
 /// Rounds of timing per point.
 fn rounds(opts: &Options) -> usize {
     if opts.quick {
-        3
+        9
     } else {
-        15
+        41
     }
 }
 

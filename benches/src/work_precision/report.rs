@@ -471,6 +471,87 @@ fn overhead_summary(s: &mut String, o: &Overhead) {
     }
 }
 
+/// The ratios of issue 17's goals in one place: the engine's own cost per evaluation against
+/// `ode_solvers`' for each N, and the RK4 step against the hand-written loop for each problem.
+fn goals_summary(s: &mut String, ratios: &[Rk4Ratio], o: &Overhead) {
+    if ratios.is_empty() && o.rows.is_empty() {
+        return;
+    }
+    s.push_str("\n## Summary: the goals of issue 17 (speed)\n\n");
+    if !o.rows.is_empty() {
+        s.push_str(
+            "**Overhead that does not grow with N**: the library's own cost per evaluation \
+             (solve time per evaluation minus one right-hand side) at most `ode_solvers`' for \
+             every N. Per N, over its problems and both tolerances (details in the next \
+             section): the largest difference `lagrange - ode_solvers`, ns per evaluation, and \
+             the median ratio of the solve times per evaluation.\n\n\
+             | N | problems | overhead ns lagrange (range) | overhead ns ode_solvers (range) | largest difference ns | solve per eval ratio (median) | at most ode_solvers' |\n\
+             |---:|---|---:|---:|---:|---:|---|\n",
+        );
+        let mut ns: Vec<usize> = o.rows.iter().map(|r| r.n).collect();
+        ns.sort_unstable();
+        ns.dedup();
+        for n in ns {
+            let rows: Vec<_> = o.rows.iter().filter(|r| r.n == n).collect();
+            let mut problems: Vec<&str> = rows.iter().map(|r| r.problem).collect();
+            problems.dedup();
+            let range = |f: &dyn Fn(&&super::engine_overhead::OverheadRow) -> f64| {
+                let v: Vec<f64> = rows.iter().map(f).collect();
+                let lo = v.iter().copied().fold(f64::INFINITY, f64::min);
+                let hi = v.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+                format!("{lo:.0}..{hi:.0}")
+            };
+            let worst = rows
+                .iter()
+                .map(|r| r.lib_overhead_ns() - r.ode_overhead_ns())
+                .fold(f64::NEG_INFINITY, f64::max);
+            let mut per_eval: Vec<f64> = rows.iter().map(|r| r.per_eval_ratio()).collect();
+            per_eval.sort_by(f64::total_cmp);
+            let met = rows
+                .iter()
+                .all(|r| r.lib_overhead_ns() <= r.ode_overhead_ns().max(0.0));
+            let _ = writeln!(
+                s,
+                "| {n} | {} | {} | {} | {worst:+.1} | {:.2} | {} |",
+                problems.join(", "),
+                range(&|r| r.lib_overhead_ns()),
+                range(&|r| r.ode_overhead_ns()),
+                per_eval[per_eval.len() / 2],
+                if met { "yes" } else { "**no**" }
+            );
+        }
+    }
+    if !ratios.is_empty() {
+        let _ = write!(
+            s,
+            "\n**The RK4 step**: the library's RK4 within {RK4_BUDGET}x of the hand-written loop \
+             (the goal is for f32; f64 shown too). Median of the per-pair ratios; details under \
+             Budgets.\n\n| problem | f32 ratio | f32 within {RK4_BUDGET}x | f64 ratio |\n|---|---:|---|---:|\n"
+        );
+        let mut problems: Vec<&str> = ratios.iter().map(|r| r.problem).collect();
+        problems.dedup();
+        for p in problems {
+            let of = |precision: &str| {
+                ratios
+                    .iter()
+                    .find(|r| r.problem == p && r.precision == precision)
+            };
+            let (f32r, f64r) = (of("f32"), of("f64"));
+            let _ = writeln!(
+                s,
+                "| {p} | {} | {} | {} |",
+                f32r.map_or("-".into(), |r| format!("{:.3}", r.ratio)),
+                f32r.map_or("-", |r| if r.ratio <= RK4_BUDGET {
+                    "yes"
+                } else {
+                    "**no**"
+                }),
+                f64r.map_or("-".into(), |r| format!("{:.3}", r.ratio)),
+            );
+        }
+    }
+}
+
 /// The whole Markdown report.
 fn markdown(
     context: &Context,
@@ -508,7 +589,8 @@ fn markdown(
         context.budget.seconds
     );
 
-    s.push_str("## Problems and references\n\n");
+    goals_summary(&mut s, ratios, overhead);
+    s.push_str("\n## Problems and references\n\n");
     s.push_str("| id | problem | T (s) | mechanism simulated | reference | its error | E(0) |\n|---|---|---:|---|---|---:|---:|\n");
     for r in &sweeps.references {
         let _ = writeln!(
