@@ -254,8 +254,13 @@ pub trait Mechanism<T: Real, const N: usize>: Lagrangian<T, N> {
 }
 
 /// `v` when every component is finite, else [`Error::NonFiniteState`].
+///
+/// Every component is tested, without stopping at the first that fails: the tests then
+/// vectorise, and there is one branch, not one per component (the profile of a DOP853 step of
+/// a 40-coordinate system showed the test as a scalar loop with a branch per component).
+#[inline(always)]
 pub(crate) fn finite<T: Real, const N: usize>(v: SVector<T, N>) -> Result<SVector<T, N>, Error> {
-    if v.iter().all(|x| x.is_finite()) {
+    if v.iter().fold(true, |all, x| all & x.is_finite()) {
         Ok(v)
     } else {
         Err(Error::NonFiniteState)

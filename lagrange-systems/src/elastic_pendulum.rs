@@ -104,6 +104,7 @@ impl<T: Real> Mechanism<T, 2> for ElasticPendulum<T> {
         let r = s.q[0];
         Matrix2::new(self.mass, T::zero(), T::zero(), self.mass * r * r)
     }
+    #[inline]
     fn rhs(&self, s: &State<T, 2>) -> Vector2<T> {
         let (r, rd, thd) = (s.q[0], s.qd[0], s.qd[1]);
         let (sin, cos) = s.q[1].sin_cos();
@@ -113,10 +114,23 @@ impl<T: Real> Mechanism<T, 2> for ElasticPendulum<T> {
             -T::TWO * m * r * rd * thd - m * g * r * sin,
         )
     }
+    #[inline]
     fn solve_mass(&self, s: &State<T, 2>, b: &Vector2<T>) -> Result<Vector2<T>, Error> {
         let r = s.q[0];
         positive_radius(s, SPRING_COLLAPSED)?;
         solve_diagonal2(s, [self.mass, self.mass * r * r], b, SPRING_COLLAPSED)
+    }
+    /// The default law, `M^-1 (f + Q + extra)`, inlined into the integrators' stages: out of
+    /// line, the call and the result passed through memory kept the RK4 step above the
+    /// hand-written loop's (as for [`DoublePendulum`](crate::DoublePendulum)).
+    #[inline(always)]
+    fn law<F: GeneralizedForce<T, 2>>(
+        &self,
+        s: &State<T, 2>,
+        extra: &F,
+    ) -> Result<SVector<T, 2>, Error> {
+        let b = self.rhs(s) + self.non_conservative_force(s);
+        self.solve_mass(s, &extra.added_to(s, b))
     }
     fn law_force<F: GeneralizedForce<T, 2>>(
         &self,

@@ -81,14 +81,28 @@ impl<T: Real> Mechanism<T, 2> for Kepler<T> {
         let r = s.q[0];
         Matrix2::new(T::one(), T::zero(), T::zero(), r * r)
     }
+    #[inline]
     fn rhs(&self, s: &State<T, 2>) -> Vector2<T> {
         let (r, rd, phid) = (s.q[0], s.qd[0], s.qd[1]);
         Vector2::new(r * phid * phid - self.mu / (r * r), -T::TWO * r * rd * phid)
     }
+    #[inline]
     fn solve_mass(&self, s: &State<T, 2>, b: &Vector2<T>) -> Result<Vector2<T>, Error> {
         let r = s.q[0];
         positive_radius(s, AT_CENTRE)?;
         solve_diagonal2(s, [T::one(), r * r], b, AT_CENTRE)
+    }
+    /// The default law, `M^-1 (f + Q + extra)`, inlined into the integrators' stages: out of
+    /// line, the call and the result passed through memory kept the RK4 step above the
+    /// hand-written loop's (as for [`DoublePendulum`](crate::DoublePendulum)).
+    #[inline(always)]
+    fn law<F: GeneralizedForce<T, 2>>(
+        &self,
+        s: &State<T, 2>,
+        extra: &F,
+    ) -> Result<SVector<T, 2>, Error> {
+        let b = self.rhs(s) + self.non_conservative_force(s);
+        self.solve_mass(s, &extra.added_to(s, b))
     }
     fn law_force<F: GeneralizedForce<T, 2>>(
         &self,

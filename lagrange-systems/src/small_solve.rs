@@ -45,6 +45,7 @@ pub(crate) fn solve_sym2_det<T: Real>(
 /// [`Error::NonFiniteState`] when `s` holds NaN or infinity; else [`Error::Singularity`] `what`
 /// when an entry of `d` is not positive (the state is at the singular configuration) or a
 /// quotient is not finite (the state is so close to it, or so fast, that `q''` overflows).
+#[inline]
 pub(crate) fn solve_diagonal2<T: Real>(
     s: &State<T, 2>,
     d: [T; 2],
@@ -63,6 +64,7 @@ pub(crate) fn solve_diagonal2<T: Real>(
 
 /// `Ok` when the radial coordinate `r = s.q[0]` is positive: [`Error::NonFiniteState`] when `s`
 /// holds NaN or infinity, [`Error::Singularity`] `what` at `r <= 0`.
+#[inline]
 pub(crate) fn positive_radius<T: Real>(s: &State<T, 2>, what: &'static str) -> Result<(), Error> {
     s.check_finite()?;
     if s.q[0] > T::zero() {
@@ -73,11 +75,13 @@ pub(crate) fn positive_radius<T: Real>(s: &State<T, 2>, what: &'static str) -> R
 }
 
 /// `x` when every entry is finite, else `error`.
+#[inline]
 pub(crate) fn finite<T: Real, const N: usize>(
     x: SVector<T, N>,
     error: Error,
 ) -> Result<SVector<T, N>, Error> {
-    if x.iter().all(|v| v.is_finite()) {
+    // Every entry tested, without a branch per entry (as `Mechanism::acceleration`'s test).
+    if x.iter().fold(true, |all, v| all & v.is_finite()) {
         Ok(x)
     } else {
         Err(error)

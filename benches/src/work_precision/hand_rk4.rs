@@ -1,6 +1,8 @@
-//! Hand-written RK4 loops for the pendulum and the double pendulum: plain, non-generic `f64` and
-//! `f32` code with the state in local variables, no trait, no `Result`, no checks. They are the
-//! speed limit for RK4 on these two problems: the library's `Rk4` is measured against them.
+//! Hand-written RK4 loops: for the pendulum and the double pendulum, plain, non-generic `f64`
+//! and `f32` code with the state in local variables, no trait, no `Result`, no checks; for every
+//! other problem, one loop over arrays ([`rk4`]) on the problem's equations written by hand
+//! ([`HandRhs`]). They are the speed limit for RK4: the library's `Rk4` is measured against
+//! them.
 //!
 //! Each loop is written once in a macro and stamped out for `f64` and `f32`, so that both
 //! precisions run the same arithmetic. The sines and cosines are the library's own for that
@@ -10,7 +12,8 @@
 //! `DoublePendulum` does: the comparison measures the library's overhead, not two trig
 //! routines.
 
-use lagrange_core::Scalar;
+use super::problem::HandRhs;
+use lagrange_core::{Real, Scalar, State};
 
 /// Stamps out `pendulum_$t`: RK4 on `th'' = -w2 sin th`.
 macro_rules! pendulum_loop {
@@ -88,3 +91,51 @@ pendulum_loop!(pendulum_f64, f64);
 pendulum_loop!(pendulum_f32, f32);
 double_loop!(double_f64, f64);
 double_loop!(double_f32, f32);
+
+/// RK4 over arrays on `rhs`: `steps` steps of `dt` from `start`, with the library's `Rk4`'s
+/// arithmetic in the same order (`q + q' h/2`, ..., `q + (k1 + 2 (k2 + k3) + k4) h/6`), the
+/// state in stack arrays and nothing checked. The time of the end is `t + steps dt`.
+#[allow(clippy::needless_range_loop)] // indices read like the formulas, over four arrays at once
+pub fn rk4<T: Real, R: HandRhs<T, N>, const N: usize>(
+    rhs: &R,
+    start: &State<T, N>,
+    dt: T,
+    steps: u64,
+) -> State<T, N> {
+    let (mut q, mut v): ([T; N], [T; N]) = (start.q.into(), start.qd.into());
+    let half = dt * T::HALF;
+    let sixth = dt / T::from_f64(6.0);
+    let t0 = start.t;
+    let mut t = t0;
+    let zero = [T::zero(); N];
+    let (mut a1, mut a2, mut a3, mut a4) = (zero, zero, zero, zero);
+    let (mut q2, mut v2, mut q3, mut v3, mut q4, mut v4) = (zero, zero, zero, zero, zero, zero);
+    for _ in 0..steps {
+        rhs.accelerations(t, &q, &v, &mut a1);
+        for i in 0..N {
+            q2[i] = q[i] + v[i] * half;
+            v2[i] = v[i] + a1[i] * half;
+        }
+        rhs.accelerations(t + half, &q2, &v2, &mut a2);
+        for i in 0..N {
+            q3[i] = q[i] + v2[i] * half;
+            v3[i] = v[i] + a2[i] * half;
+        }
+        rhs.accelerations(t + half, &q3, &v3, &mut a3);
+        for i in 0..N {
+            q4[i] = q[i] + v3[i] * dt;
+            v4[i] = v[i] + a3[i] * dt;
+        }
+        rhs.accelerations(t + dt, &q4, &v4, &mut a4);
+        for i in 0..N {
+            q[i] += (v[i] + (v2[i] + v3[i]) * T::TWO + v4[i]) * sixth;
+            v[i] += (a1[i] + (a2[i] + a3[i]) * T::TWO + a4[i]) * sixth;
+        }
+        t += dt;
+    }
+    State {
+        t: t0 + dt * T::from_f64(steps as f64),
+        q: q.into(),
+        qd: v.into(),
+    }
+}

@@ -19,6 +19,7 @@
 mod budgets;
 mod chain_cost;
 mod counting;
+mod engine_overhead;
 mod hand_rk4;
 mod method;
 mod ode_peer;
@@ -141,6 +142,7 @@ fn run(args: &[String]) -> Result<(), String> {
     println!("\n== budgets");
     let ratios = budgets::rk4_against_hand(&opts);
     let chain = chain_cost::measure(&opts);
+    let overhead = engine_overhead::measure(&opts);
     println!("\n== stability limits");
     let limits = stability::scan(&opts);
     let elapsed = clock.elapsed().as_secs_f64();
@@ -153,7 +155,7 @@ fn run(args: &[String]) -> Result<(), String> {
         load: (load_before, load_average()),
         budget: opts.budget,
     };
-    let files = report::write(&dir, &context, &sweeps, &ratios, &chain, &limits)?;
+    let files = report::write(&dir, &context, &sweeps, &ratios, &chain, &overhead, &limits)?;
     println!("\nwrote {} files under {}:", files.len(), dir.display());
     for f in files.iter().filter(|f| !f.ends_with(".svg")) {
         println!("  {f}");

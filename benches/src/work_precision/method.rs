@@ -1,6 +1,6 @@
 //! The [`Method`] contract of the bench (a way of solving a problem over `[0, T]` at a step size
 //! or a tolerance) and the methods table: the library's integrators, the hand-written RK4 loop
-//! and `ode_solvers`' Dopri5 and Dop853.
+//! and `ode_solvers`' Dopri5 and Dop853 (on the problem's equations written by hand).
 
 use super::ode_peer::Peer;
 use super::outcome::{Observer, Outcome};
@@ -116,8 +116,8 @@ pub trait Method {
     /// Solves `problem` (whose mechanism in `T` is `mechanism`, possibly wrapped) from `start`
     /// to `t_end` at `param`, calling `observe` with every new state when given.
     ///
-    /// `None` when the method does not apply to the problem (a hand-written loop exists for
-    /// P1 and P2 only); `Some(Err)` when the solve failed (a blow-up past the stability limit,
+    /// `None` when the method does not apply to the problem (a fixed-step method at a
+    /// tolerance); `Some(Err)` when the solve failed (a blow-up past the stability limit,
     /// a step size underflow), with the reason.
     #[allow(clippy::too_many_arguments)]
     fn solve<T, P, M, const N: usize, const N2: usize>(
@@ -498,10 +498,11 @@ impl Method for OdeSolvers {
             Peer::Dop853 => Tableau::DormandPrince853,
         })
     }
+    /// On the problem's equations written by hand ([`Problem::hand`]), not on `mechanism`.
     fn solve<T, P, M, const N: usize, const N2: usize>(
         &self,
-        _problem: &P,
-        mechanism: &M,
+        problem: &P,
+        _mechanism: &M,
         start: &State<T, N>,
         t_end: T,
         param: Param,
@@ -515,9 +516,9 @@ impl Method for OdeSolvers {
         let Param::Tolerance(tol) = param else {
             return None;
         };
-        Some(T::ode_solve::<M, N, N2>(
+        Some(T::ode_solve::<_, N, N2>(
             self.0,
-            mechanism,
+            &problem.hand::<T>(),
             start,
             t_end,
             T::real(tol),

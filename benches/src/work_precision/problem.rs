@@ -15,6 +15,15 @@ pub struct Reference<const N: usize> {
     pub error: f64,
 }
 
+/// A problem's equations of motion written by hand on plain arrays, as a user of another
+/// solver writes them: the accelerations `q''` at `(t, q, q')`, with no `Result`, no trait
+/// of the library and no checks. `ode_solvers` runs on it, so that a comparison with the
+/// library measures the solvers alone, and the generic hand-written RK4 loop steps it.
+pub trait HandRhs<T, const N: usize> {
+    /// Writes `q''` at `(t, q, q')` into `qdd`.
+    fn accelerations(&self, t: T, q: &[T; N], qd: &[T; N], qdd: &mut [T; N]);
+}
+
 /// A standard problem of `N` degrees of freedom (`N2 = 2 N` state components, spelled out
 /// because `ode_solvers` wants a static vector of the whole state and stable Rust cannot write
 /// `2 * N` in a type).
@@ -22,6 +31,9 @@ pub trait Problem<const N: usize, const N2: usize> {
     /// The mechanism simulated, in precision `T` (a [`Lagrangian`](lagrange_core::Lagrangian)
     /// too, as every mechanism is: the variational integrator steps its `L`).
     type Mech<T: BenchReal>: Mechanism<T, N>;
+
+    /// Its equations of motion written by hand ([`HandRhs`]), in precision `T`.
+    type Hand<T: BenchReal>: HandRhs<T, N>;
 
     /// Short key used in file names, the CSV and `--only`: `P1`, `P3-N20`, ...
     fn id(&self) -> &'static str;
@@ -34,6 +46,10 @@ pub trait Problem<const N: usize, const N2: usize> {
     /// # Errors
     /// When a parameter is refused (never, for the fixed parameters used here).
     fn mechanism<T: BenchReal>(&self) -> Result<Self::Mech<T>, Error>;
+    /// The equations of motion written by hand, in precision `T`: what `ode_solvers` runs
+    /// on, and what the generic hand-written RK4 loop steps where the problem has no loop of
+    /// its own.
+    fn hand<T: BenchReal>(&self) -> Self::Hand<T>;
     /// The start state, in `f64`.
     fn start(&self) -> State<f64, N>;
     /// The final time, s.
@@ -58,15 +74,16 @@ pub trait Problem<const N: usize, const N2: usize> {
         None
     }
 
-    /// The hand-written RK4 loop for this problem in precision `T`, where there is one.
+    /// The hand-written RK4 loop for this problem in precision `T`: by default the generic
+    /// loop over arrays ([`hand_rk4::rk4`](super::hand_rk4::rk4)) on [`Problem::hand`]; P1 and
+    /// P2 keep their state in scalar locals instead.
     fn hand_rk4<T: BenchReal>(
         &self,
         start: &State<T, N>,
         dt: T,
         steps: u64,
     ) -> Option<State<T, N>> {
-        let _ = (start, dt, steps);
-        None
+        Some(super::hand_rk4::rk4(&self.hand::<T>(), start, dt, steps))
     }
 }
 

@@ -3,7 +3,8 @@
 use super::hand_rk4;
 use super::ode_peer::{self, OdeReal, Peer};
 use super::outcome::{Observer, Outcome};
-use lagrange_core::{Mechanism, Real, State};
+use super::problem::HandRhs;
+use lagrange_core::{Real, State};
 
 /// `f32` or `f64`: a library scalar that `ode_solvers` also accepts, with the hand-written RK4
 /// loops of its precision.
@@ -17,19 +18,18 @@ pub trait BenchReal: OdeReal {
         <Self as lagrange_core::Scalar>::from_f64(x)
     }
 
-    /// Solves with `ode_solvers` in this precision (its solvers need `f64: From<Self>`, which
-    /// only the concrete types can promise).
-    #[allow(clippy::too_many_arguments)]
-    fn ode_solve<M, const N: usize, const N2: usize>(
+    /// Solves the hand-written equations `rhs` with `ode_solvers` in this precision (its
+    /// solvers need `f64: From<Self>`, which only the concrete types can promise).
+    fn ode_solve<R, const N: usize, const N2: usize>(
         peer: Peer,
-        mechanism: &M,
+        rhs: &R,
         start: &State<Self, N>,
         t_end: Self,
         tol: Self,
         observe: Observer<'_, Self, N>,
     ) -> Result<Outcome<Self, N>, String>
     where
-        M: Mechanism<Self, N>;
+        R: HandRhs<Self, N>;
 
     /// The hand-written RK4 loop for the pendulum `th'' = -(g/l) sin th`, in this precision:
     /// `steps` steps of `dt` from `(th, th')`.
@@ -42,15 +42,15 @@ pub trait BenchReal: OdeReal {
 
 impl BenchReal for f64 {
     const LABEL: &'static str = "f64";
-    fn ode_solve<M: Mechanism<f64, N>, const N: usize, const N2: usize>(
+    fn ode_solve<R: HandRhs<f64, N>, const N: usize, const N2: usize>(
         peer: Peer,
-        mechanism: &M,
+        rhs: &R,
         start: &State<f64, N>,
         t_end: f64,
         tol: f64,
         observe: Observer<'_, f64, N>,
     ) -> Result<Outcome<f64, N>, String> {
-        ode_peer::solve::<f64, M, N, N2>(peer, mechanism, start, t_end, tol, observe)
+        ode_peer::solve::<f64, R, N, N2>(peer, rhs, start, t_end, tol, observe)
     }
     fn hand_rk4_pendulum(g_over_l: f64, y: [f64; 2], dt: f64, steps: u64) -> [f64; 2] {
         hand_rk4::pendulum_f64(g_over_l, y, dt, steps)
@@ -62,15 +62,15 @@ impl BenchReal for f64 {
 
 impl BenchReal for f32 {
     const LABEL: &'static str = "f32";
-    fn ode_solve<M: Mechanism<f32, N>, const N: usize, const N2: usize>(
+    fn ode_solve<R: HandRhs<f32, N>, const N: usize, const N2: usize>(
         peer: Peer,
-        mechanism: &M,
+        rhs: &R,
         start: &State<f32, N>,
         t_end: f32,
         tol: f32,
         observe: Observer<'_, f32, N>,
     ) -> Result<Outcome<f32, N>, String> {
-        ode_peer::solve::<f32, M, N, N2>(peer, mechanism, start, t_end, tol, observe)
+        ode_peer::solve::<f32, R, N, N2>(peer, rhs, start, t_end, tol, observe)
     }
     #[allow(clippy::cast_possible_truncation)]
     fn hand_rk4_pendulum(g_over_l: f64, y: [f32; 2], dt: f32, steps: u64) -> [f32; 2] {

@@ -3,6 +3,7 @@
 
 use super::budgets::{Rk4Ratio, RK4_BUDGET};
 use super::chain_cost::ChainCost;
+use super::engine_overhead::Overhead;
 use super::method::{Origin, Tableau};
 use super::stability::{Limit, STABLE_ENERGY_ERROR};
 use super::sweep::{Row, Sweeps};
@@ -38,6 +39,7 @@ pub fn write(
     sweeps: &Sweeps,
     ratios: &[Rk4Ratio],
     chain: &ChainCost,
+    overhead: &Overhead,
     limits: &[Limit],
 ) -> Result<Vec<String>, String> {
     let mut files = Vec::new();
@@ -55,7 +57,7 @@ pub fn write(
     }
     put(
         "report.md".into(),
-        markdown(context, sweeps, ratios, chain, limits, &names),
+        markdown(context, sweeps, ratios, chain, overhead, limits, &names),
     )?;
     Ok(files)
 }
@@ -371,12 +373,192 @@ fn peer_table(s: &mut String, rows: &[Row], peer: Origin, label: &str) {
     );
 }
 
+/// The engine's own cost per evaluation against `ode_solvers`', and the N-body through the
+/// automatic path (issue 17).
+fn overhead_summary(s: &mut String, o: &Overhead) {
+    if o.rows.is_empty() && o.automatic.is_empty() {
+        return;
+    }
+    s.push_str(
+        "\n## Summary (f64): the engine's own cost per evaluation against `ode_solvers`\n\n",
+    );
+    let mut rows: Vec<_> = o.rows.iter().collect();
+    rows.sort_by_key(|r| r.n);
+    let rounds = rows.first().map_or(0, |r| r.rounds);
+    let _ = write!(
+        s,
+        "Goal (issue 17): beyond the right-hand side, the library's cost per evaluation is at \
+         most `ode_solvers`' for every N from 1 to 40. Both solve the problem from its start to \
+         its end with the same tableau at rtol = atol = tol, each on a right-hand side written \
+         by hand (the library on the problem's mechanism, `ode_solvers` on the same equations \
+         written on plain arrays); `overhead = (solve - evals x rhs) / evals`, with `rhs` timed \
+         over the states the library's solve evaluates at (each library its own call). The \
+         four timings are taken in turn, round after round; medians of {rounds} rounds. `ratio`: \
+         the library's solve time per evaluation over `ode_solvers`'. A negative overhead means \
+         the right-hand side ran faster inside the solve than in the loop that timed it: the \
+         overhead there is below the timing's resolution.\n\n\
+         | problem | N | tableau | tol | evals lagrange / ode_solvers | rhs ns lagrange / ode_solvers | solve ns per eval lagrange / ode_solvers | ratio | overhead ns per eval lagrange | overhead ns per eval ode_solvers | lagrange's overhead at most ode_solvers' |\n\
+         |---|---:|---|---:|---:|---:|---:|---:|---:|---:|---|\n",
+    );
+    for r in &rows {
+        let (lo, oo) = (r.lib_overhead_ns(), r.ode_overhead_ns());
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} | {:.0e} | {} / {} | {:.1} / {:.1} | {:.1} / {:.1} | {:.2} | {:.1} | {:.1} | {} |",
+            r.problem,
+            r.n,
+            match r.tableau {
+                Tableau::DormandPrince54 => "DP 5(4)",
+                Tableau::DormandPrince853 => "DP 8(5,3)",
+            },
+            r.tol,
+            r.lib_evals,
+            r.ode_evals,
+            r.lib_rhs_ns,
+            r.ode_rhs_ns,
+            r.lib_solve * 1e9 / r.lib_evals as f64,
+            r.ode_solve * 1e9 / r.ode_evals as f64,
+            r.per_eval_ratio(),
+            lo,
+            oo,
+            if lo <= oo.max(0.0) { "yes" } else { "**no**" }
+        );
+    }
+    if !o.automatic.is_empty() {
+        s.push_str(
+            "\n### The N-body through the automatic path\n\n\
+             The same mechanism three ways: its law written by hand (a `Mechanism`), and its \
+             `Lagrangian` through `EulerLagrange`, declaring `CONSTANT_MASS` (the mass matrix \
+             factored once, `T` never differentiated) or not. One acceleration timed over the \
+             states of the hand law's DOP853 solve at 1e-6; whole DOP853 solves.\n\n\
+             | problem | equations | ns per acceleration | x law by hand | DOP853 solves (tol: evals, time) | x law by hand |\n\
+             |---|---|---:|---:|---|---|\n",
+        );
+        for r in &o.automatic {
+            let hand = o
+                .automatic
+                .iter()
+                .find(|h| h.problem == r.problem)
+                .unwrap_or(r);
+            let solves: Vec<String> = r
+                .solves
+                .iter()
+                .map(|(tol, evals, t)| format!("{tol:.0e}: {evals}, {}", time(*t)))
+                .collect();
+            let ratios: Vec<String> = r
+                .solves
+                .iter()
+                .filter_map(|(tol, _, t)| {
+                    let h = hand.solves.iter().find(|x| x.0 == *tol)?;
+                    Some(format!("{tol:.0e}: {:.1}x", t / h.2))
+                })
+                .collect();
+            let _ = writeln!(
+                s,
+                "| {} | {} | {:.0} | {:.1}x | {} | {} |",
+                r.problem,
+                r.variant,
+                r.ns_per_eval,
+                r.ns_per_eval / hand.ns_per_eval,
+                if solves.is_empty() {
+                    "not timed (seconds per solve)".into()
+                } else {
+                    solves.join("; ")
+                },
+                ratios.join("; ")
+            );
+        }
+    }
+}
+
+/// The ratios of issue 17's goals in one place: the engine's own cost per evaluation against
+/// `ode_solvers`' for each N, and the RK4 step against the hand-written loop for each problem.
+fn goals_summary(s: &mut String, ratios: &[Rk4Ratio], o: &Overhead) {
+    if ratios.is_empty() && o.rows.is_empty() {
+        return;
+    }
+    s.push_str("\n## Summary: the goals of issue 17 (speed)\n\n");
+    if !o.rows.is_empty() {
+        s.push_str(
+            "**Overhead that does not grow with N**: the library's own cost per evaluation \
+             (solve time per evaluation minus one right-hand side) at most `ode_solvers`' for \
+             every N. Per N, over its problems and both tolerances (details in the next \
+             section): the largest difference `lagrange - ode_solvers`, ns per evaluation, and \
+             the median ratio of the solve times per evaluation.\n\n\
+             | N | problems | overhead ns lagrange (range) | overhead ns ode_solvers (range) | largest difference ns | solve per eval ratio (median) | at most ode_solvers' |\n\
+             |---:|---|---:|---:|---:|---:|---|\n",
+        );
+        let mut ns: Vec<usize> = o.rows.iter().map(|r| r.n).collect();
+        ns.sort_unstable();
+        ns.dedup();
+        for n in ns {
+            let rows: Vec<_> = o.rows.iter().filter(|r| r.n == n).collect();
+            let mut problems: Vec<&str> = rows.iter().map(|r| r.problem).collect();
+            problems.dedup();
+            let range = |f: &dyn Fn(&&super::engine_overhead::OverheadRow) -> f64| {
+                let v: Vec<f64> = rows.iter().map(f).collect();
+                let lo = v.iter().copied().fold(f64::INFINITY, f64::min);
+                let hi = v.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+                format!("{lo:.0}..{hi:.0}")
+            };
+            let worst = rows
+                .iter()
+                .map(|r| r.lib_overhead_ns() - r.ode_overhead_ns())
+                .fold(f64::NEG_INFINITY, f64::max);
+            let mut per_eval: Vec<f64> = rows.iter().map(|r| r.per_eval_ratio()).collect();
+            per_eval.sort_by(f64::total_cmp);
+            let met = rows
+                .iter()
+                .all(|r| r.lib_overhead_ns() <= r.ode_overhead_ns().max(0.0));
+            let _ = writeln!(
+                s,
+                "| {n} | {} | {} | {} | {worst:+.1} | {:.2} | {} |",
+                problems.join(", "),
+                range(&|r| r.lib_overhead_ns()),
+                range(&|r| r.ode_overhead_ns()),
+                per_eval[per_eval.len() / 2],
+                if met { "yes" } else { "**no**" }
+            );
+        }
+    }
+    if !ratios.is_empty() {
+        let _ = write!(
+            s,
+            "\n**The RK4 step**: the library's RK4 within {RK4_BUDGET}x of the hand-written loop \
+             (the goal is for f32; f64 shown too). Median of the per-pair ratios; details under \
+             Budgets.\n\n| problem | f32 ratio | f32 within {RK4_BUDGET}x | f64 ratio |\n|---|---:|---|---:|\n"
+        );
+        let mut problems: Vec<&str> = ratios.iter().map(|r| r.problem).collect();
+        problems.dedup();
+        for p in problems {
+            let of = |precision: &str| {
+                ratios
+                    .iter()
+                    .find(|r| r.problem == p && r.precision == precision)
+            };
+            let (f32r, f64r) = (of("f32"), of("f64"));
+            let _ = writeln!(
+                s,
+                "| {p} | {} | {} | {} |",
+                f32r.map_or("-".into(), |r| format!("{:.3}", r.ratio)),
+                f32r.map_or("-", |r| if r.ratio <= RK4_BUDGET {
+                    "yes"
+                } else {
+                    "**no**"
+                }),
+                f64r.map_or("-".into(), |r| format!("{:.3}", r.ratio)),
+            );
+        }
+    }
+}
+
 /// The whole Markdown report.
 fn markdown(
     context: &Context,
     sweeps: &Sweeps,
     ratios: &[Rk4Ratio],
     chain: &ChainCost,
+    overhead: &Overhead,
     limits: &[Limit],
     plots: &[String],
 ) -> String {
@@ -407,7 +589,8 @@ fn markdown(
         context.budget.seconds
     );
 
-    s.push_str("## Problems and references\n\n");
+    goals_summary(&mut s, ratios, overhead);
+    s.push_str("\n## Problems and references\n\n");
     s.push_str("| id | problem | T (s) | mechanism simulated | reference | its error | E(0) |\n|---|---|---:|---|---|---:|---:|\n");
     for r in &sweeps.references {
         let _ = writeln!(
@@ -439,6 +622,7 @@ fn markdown(
          coarsest point of the sweep is already below the level; `— (e)`: the sweep never gets \
          there, `e` its best error (rounding floor, stability, or the time cap per point).\n",
     );
+    overhead_summary(&mut s, overhead);
 
     s.push_str("\n## Budgets\n\n### The library's RK4 against a hand-written RK4 loop\n\n");
     s.push_str(

@@ -1,9 +1,9 @@
 //! P1, the origin's pendulum: L = 1 m, g = 9.81 m/s^2, 30 degrees at rest, 10 s; exact
 //! reference from the Jacobi elliptic solution.
 
-use crate::problem::{Problem, Reference};
+use crate::problem::{HandRhs, Problem, Reference};
 use crate::real::BenchReal;
-use lagrange_core::{Error, State};
+use lagrange_core::{Error, Real, Scalar, State};
 use lagrange_systems::exact::pendulum_from_rest;
 use lagrange_systems::SimplePendulum;
 
@@ -21,8 +21,22 @@ const PUBLISHED: [f64; 2] = [
 /// P1.
 pub struct OriginPendulum;
 
+/// P1's equation by hand: `th'' = -(g / l) sin th`.
+pub struct PendulumRhs<T> {
+    /// `g / l`, 1/s^2.
+    w2: T,
+}
+
+impl<T: Real> HandRhs<T, 1> for PendulumRhs<T> {
+    #[inline]
+    fn accelerations(&self, _t: T, q: &[T; 1], _qd: &[T; 1], qdd: &mut [T; 1]) {
+        qdd[0] = -self.w2 * Scalar::sin(q[0]);
+    }
+}
+
 impl Problem<1, 2> for OriginPendulum {
     type Mech<T: BenchReal> = SimplePendulum<T>;
+    type Hand<T: BenchReal> = PendulumRhs<T>;
 
     fn id(&self) -> &'static str {
         "P1"
@@ -35,6 +49,9 @@ impl Problem<1, 2> for OriginPendulum {
     }
     fn mechanism<T: BenchReal>(&self) -> Result<SimplePendulum<T>, Error> {
         SimplePendulum::new(T::one(), T::one(), T::real(G), T::zero())
+    }
+    fn hand<T: BenchReal>(&self) -> PendulumRhs<T> {
+        PendulumRhs { w2: T::real(G) }
     }
     fn start(&self) -> State<f64, 1> {
         State::at_rest([TH0])

@@ -1,9 +1,9 @@
 //! P2, the chaotic double pendulum: m = l = 1, both angles pi/2 at rest, 10 s; reference from
 //! the published 1e-27 solve.
 
-use crate::problem::{Problem, Reference};
+use crate::problem::{HandRhs, Problem, Reference};
 use crate::real::BenchReal;
-use lagrange_core::{Error, State};
+use lagrange_core::{Error, Real, Scalar, State};
 use lagrange_systems::DoublePendulum;
 
 /// Gravity, m/s^2.
@@ -21,8 +21,30 @@ const PUBLISHED: [f64; 4] = [
 /// P2.
 pub struct ChaoticDouble;
 
+/// P2's equations by hand, for unit masses and rods, as the hand-written RK4 loop writes them:
+/// `M = [[2, c], [c, 1]]`, `f = [-s w2^2 - 2 g sin th1, s w1^2 - g sin th2]`, `q'' = M^-1 f` with
+/// `s, c` the sine and cosine of `th1 - th2`.
+pub struct DoubleRhs<T> {
+    /// Gravity, m/s^2.
+    g: T,
+}
+
+impl<T: Real> HandRhs<T, 2> for DoubleRhs<T> {
+    #[inline]
+    fn accelerations(&self, _t: T, q: &[T; 2], qd: &[T; 2], qdd: &mut [T; 2]) {
+        let [a, b] = *q;
+        let [wa, wb] = *qd;
+        let (s, c) = Scalar::sin_cos(a - b);
+        let f1 = -s * wb * wb - T::TWO * self.g * Scalar::sin(a);
+        let f2 = s * wa * wa - self.g * Scalar::sin(b);
+        let det = T::TWO - c * c;
+        *qdd = [(f1 - c * f2) / det, (T::TWO * f2 - c * f1) / det];
+    }
+}
+
 impl Problem<2, 4> for ChaoticDouble {
     type Mech<T: BenchReal> = DoublePendulum<T>;
+    type Hand<T: BenchReal> = DoubleRhs<T>;
 
     fn id(&self) -> &'static str {
         "P2"
@@ -36,6 +58,9 @@ impl Problem<2, 4> for ChaoticDouble {
     fn mechanism<T: BenchReal>(&self) -> Result<DoublePendulum<T>, Error> {
         let one = T::one();
         DoublePendulum::new(one, one, one, one, T::real(G))
+    }
+    fn hand<T: BenchReal>(&self) -> DoubleRhs<T> {
+        DoubleRhs { g: T::real(G) }
     }
     fn start(&self) -> State<f64, 2> {
         State::at_rest([std::f64::consts::FRAC_PI_2; 2])

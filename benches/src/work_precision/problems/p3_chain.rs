@@ -1,10 +1,13 @@
 //! P3, the n-link chain: N unit point masses on N massless unit links, all links at 45 degrees
-//! at rest, T = 5 s, for N = 5 and N = 20; references from the published 1e-28 solves.
+//! at rest, T = 5 s, for N = 5 and N = 20 (references from the published 1e-28 solves) and for
+//! N = 10 and N = 40 (references from the tightest run of the library's DOP853, error
+//! estimated); its equations written by hand for the peers ([`ChainRhs`]).
 
-use crate::problem::{Problem, Reference};
+use crate::problem::{state_error, HandRhs, Problem, Reference};
 use crate::real::BenchReal;
 use lagrange_core::nalgebra::SVector;
-use lagrange_core::{Error, Real, State};
+use lagrange_core::{Error, Real, Scalar, State};
+use lagrange_integrators::{AdaptiveSettings, DormandPrince853};
 use lagrange_systems::NLinkPendulum;
 
 /// Gravity, m/s^2.
@@ -81,29 +84,143 @@ pub fn chain<T: Real, const N: usize>() -> Result<ChainMechanism<T, N>, Error> {
     NLinkPendulum::new([T::one(); N], [T::one(); N], T::from_f64(G))
 }
 
-/// P3 with `N` links (`N2 = 2 N`) and its published final state.
+/// Where a chain's reference comes from.
+pub enum ChainReference<const N2: usize> {
+    /// A published high-precision final state, angles then rates.
+    Published([f64; N2]),
+    /// The tightest run of the library's DOP853 (rtol = atol = [`TIGHT`]), its error taken as
+    /// its distance to the run at ten times that tolerance.
+    Tightest,
+}
+
+/// The tolerance of a computed chain reference (about 45 machine epsilons).
+pub const TIGHT: f64 = 1e-14;
+
+/// P3 with `N` links (`N2 = 2 N`) and its reference.
 pub struct Chain<const N: usize, const N2: usize> {
     id: &'static str,
     title: &'static str,
-    published: [f64; N2],
+    reference: ChainReference<N2>,
 }
 
 /// P3 with N = 5.
 pub const CHAIN_5: Chain<5, 10> = Chain {
     id: "P3-N5",
     title: "n-link chain, N = 5: unit masses and links, all at 45 deg at rest, T = 5 s",
-    published: N5,
+    reference: ChainReference::Published(N5),
+};
+
+/// P3 with N = 10.
+pub const CHAIN_10: Chain<10, 20> = Chain {
+    id: "P3-N10",
+    title: "n-link chain, N = 10: unit masses and links, all at 45 deg at rest, T = 5 s",
+    reference: ChainReference::Tightest,
 };
 
 /// P3 with N = 20.
 pub const CHAIN_20: Chain<20, 40> = Chain {
     id: "P3-N20",
     title: "n-link chain, N = 20: unit masses and links, all at 45 deg at rest, T = 5 s",
-    published: N20,
+    reference: ChainReference::Published(N20),
 };
+
+/// P3 with N = 40.
+pub const CHAIN_40: Chain<40, 80> = Chain {
+    id: "P3-N40",
+    title: "n-link chain, N = 40: unit masses and links, all at 45 deg at rest, T = 5 s",
+    reference: ChainReference::Tightest,
+};
+
+/// The chain's equations by hand, as a user of another solver writes them: the same O(N)
+/// recursion for the rod tensions as `NLinkPendulum`'s (Newton's law for each mass, a
+/// tridiagonal system for the tensions solved by Thomas's algorithm), on plain arrays,
+/// without its checks.
+pub struct ChainRhs<T, const N: usize> {
+    /// `1 / m_j`.
+    inv_m: [T; N],
+    /// `l_j`.
+    l: [T; N],
+    /// `1 / l_j`.
+    inv_l: [T; N],
+    /// Gravity, m/s^2.
+    g: T,
+}
+
+impl<T: Real, const N: usize> ChainRhs<T, N> {
+    /// The chain of `N` unit masses on unit links in gravity `g`.
+    pub fn unit(g: T) -> Self {
+        Self {
+            inv_m: [T::one(); N],
+            l: [T::one(); N],
+            inv_l: [T::one(); N],
+            g,
+        }
+    }
+}
+
+impl<T: Real, const N: usize> HandRhs<T, N> for ChainRhs<T, N> {
+    /// Gravity `(0, -g)` on every mass: the differences of the external forces per unit mass
+    /// vanish past the first rod, whose row carries `g cos th_1`.
+    #[allow(clippy::needless_range_loop)] // the recursion reads like its formulas
+    fn accelerations(&self, _t: T, q: &[T; N], qd: &[T; N], qdd: &mut [T; N]) {
+        let (inv_m, l) = (&self.inv_m, &self.l);
+        let mut sin = [T::zero(); N];
+        let mut cos = [T::zero(); N];
+        for j in 0..N {
+            (sin[j], cos[j]) = Scalar::sin_cos(q[j]);
+        }
+        // K tau = r, K tridiagonal: diagonal d, super-diagonal off; sn[j] = sin(th_j+1 - th_j).
+        let mut d = [T::zero(); N];
+        let mut off = [T::zero(); N];
+        let mut sn = [T::zero(); N];
+        let mut r = [T::zero(); N];
+        for j in 0..N {
+            d[j] = inv_m[j];
+            r[j] = l[j] * qd[j] * qd[j];
+            if j == 0 {
+                r[j] += self.g * cos[j];
+            } else {
+                d[j] += inv_m[j - 1];
+            }
+            if j + 1 < N {
+                off[j] = -(cos[j] * cos[j + 1] + sin[j] * sin[j + 1]) * inv_m[j];
+                sn[j] = sin[j + 1] * cos[j] - cos[j + 1] * sin[j];
+            }
+        }
+        let mut inv_d = [T::zero(); N];
+        for j in 0..N {
+            if j > 0 {
+                let factor = off[j - 1] * inv_d[j - 1];
+                d[j] -= factor * off[j - 1];
+                r[j] -= factor * r[j - 1];
+            }
+            inv_d[j] = d[j].recip();
+        }
+        let mut tau = [T::zero(); N];
+        let mut above = T::zero();
+        for j in (0..N).rev() {
+            tau[j] = (r[j] - above) * inv_d[j];
+            if j > 0 {
+                above = off[j - 1] * tau[j];
+            }
+        }
+        // th_j'' = (a_j - a_j-1) . n_j / l_j; gravity's own part cancels but on the first rod.
+        for j in 0..N {
+            let mut rel = if j == 0 { -self.g * sin[j] } else { T::zero() };
+            if j + 1 < N {
+                rel += tau[j + 1] * sn[j] * inv_m[j];
+            }
+            if j > 0 {
+                rel -= tau[j - 1] * sn[j - 1] * inv_m[j - 1];
+            }
+            qdd[j] = rel * self.inv_l[j];
+        }
+    }
+}
 
 impl<const N: usize, const N2: usize> Problem<N, N2> for Chain<N, N2> {
     type Mech<T: BenchReal> = ChainMechanism<T, N>;
+    type Hand<T: BenchReal> = ChainRhs<T, N>;
 
     fn id(&self) -> &'static str {
         self.id
@@ -117,6 +234,9 @@ impl<const N: usize, const N2: usize> Problem<N, N2> for Chain<N, N2> {
     fn mechanism<T: BenchReal>(&self) -> Result<ChainMechanism<T, N>, Error> {
         chain()
     }
+    fn hand<T: BenchReal>(&self) -> ChainRhs<T, N> {
+        ChainRhs::unit(T::real(G))
+    }
     fn start(&self) -> State<f64, N> {
         State::at_rest([std::f64::consts::FRAC_PI_4; N])
     }
@@ -127,7 +247,10 @@ impl<const N: usize, const N2: usize> Problem<N, N2> for Chain<N, N2> {
         Some(State::at_rest([0.0; N]))
     }
     fn reference(&self) -> Result<Reference<N>, String> {
-        let p = &self.published;
+        let p = match &self.reference {
+            ChainReference::Published(p) => p,
+            ChainReference::Tightest => return self.tightest(),
+        };
         Ok(Reference {
             state: State {
                 t: self.t_end(),
@@ -144,6 +267,49 @@ impl<const N: usize, const N2: usize> Problem<N, N2> for Chain<N, N2> {
     fn fastest_frequency(&self) -> f64 {
         fastest_small_oscillation::<N>()
     }
+}
+
+impl<const N: usize, const N2: usize> Chain<N, N2> {
+    /// The tightest run of the library's DOP853 (rtol = atol = [`TIGHT`]) and its distance to
+    /// the run at ten times that tolerance as its error.
+    fn tightest(&self) -> Result<Reference<N>, String> {
+        let m = chain::<f64, N>().map_err(|e| e.to_string())?;
+        tight_reference(&m, &self.start(), self.t_end())
+    }
+}
+
+/// The state at `t_end` from `start` by the library's DOP853 at rtol = atol = [`TIGHT`], with
+/// its distance to the run at ten times that tolerance as its error.
+///
+/// # Errors
+/// Either run failing.
+pub fn tight_reference<M: lagrange_core::Mechanism<f64, N>, const N: usize>(
+    m: &M,
+    start: &State<f64, N>,
+    t_end: f64,
+) -> Result<Reference<N>, String> {
+    let run = |tol: f64| {
+        AdaptiveSettings::new(tol, tol)
+            .and_then(|s| s.with_max_steps(100_000_000))
+            .map_err(|e| e.to_string())
+            .and_then(|s| {
+                DormandPrince853::<f64, N>::new(s)
+                    .integrate_to(m, start, t_end)
+                    .map_err(|e| e.to_string())
+            })
+    };
+    let fine = run(TIGHT)?;
+    let coarse = run(10.0 * TIGHT)?;
+    let error = state_error(&fine, &coarse);
+    Ok(Reference {
+        state: fine,
+        source: format!(
+            "tightest run of the library's DOP853, rtol = atol = {TIGHT:.0e}; error: its \
+             distance to the run at {:.0e}",
+            10.0 * TIGHT
+        ),
+        error,
+    })
 }
 
 /// The fastest small-oscillation frequency of the hanging unit chain of `N` links: the largest

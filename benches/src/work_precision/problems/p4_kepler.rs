@@ -1,9 +1,9 @@
 //! P4, a Kepler orbit: mu = 1, e = 0.5, a = 1 from periapsis over 100 periods (T = 200 pi);
 //! exact reference from Kepler's equation.
 
-use crate::problem::{Problem, Reference};
+use crate::problem::{HandRhs, Problem, Reference};
 use crate::real::BenchReal;
-use lagrange_core::{Error, State};
+use lagrange_core::{Error, Real, State};
 use lagrange_systems::exact::kepler_orbit;
 use lagrange_systems::Kepler;
 use std::f64::consts::PI;
@@ -24,8 +24,25 @@ const PUBLISHED_PHI: f64 = 628.318_530_717_958_647_69;
 /// P4.
 pub struct KeplerOrbit;
 
+/// P4's equations by hand, in polar coordinates: `r'' = r phi'^2 - mu / r^2`,
+/// `phi'' = -2 r' phi' / r`.
+pub struct KeplerRhs<T> {
+    /// Gravitational parameter.
+    mu: T,
+}
+
+impl<T: Real> HandRhs<T, 2> for KeplerRhs<T> {
+    #[inline]
+    fn accelerations(&self, _t: T, q: &[T; 2], qd: &[T; 2], qdd: &mut [T; 2]) {
+        let r = q[0];
+        let [rd, phid] = *qd;
+        *qdd = [r * phid * phid - self.mu / (r * r), -T::TWO * rd * phid / r];
+    }
+}
+
 impl Problem<2, 4> for KeplerOrbit {
     type Mech<T: BenchReal> = Kepler<T>;
+    type Hand<T: BenchReal> = KeplerRhs<T>;
 
     fn id(&self) -> &'static str {
         "P4"
@@ -38,6 +55,9 @@ impl Problem<2, 4> for KeplerOrbit {
     }
     fn mechanism<T: BenchReal>(&self) -> Result<Kepler<T>, Error> {
         Kepler::new(T::real(MU))
+    }
+    fn hand<T: BenchReal>(&self) -> KeplerRhs<T> {
+        KeplerRhs { mu: T::real(MU) }
     }
     fn start(&self) -> State<f64, 2> {
         State::new(0.0, [A * (1.0 - E), 0.0], [0.0, PERIAPSIS_RATE])

@@ -2,9 +2,9 @@
 //! static stretch, 0.3 rad from the vertical, at rest, T = 2 s; reference from the tightest run
 //! of the library's A-stable Gauss-Legendre 2, with its estimated error.
 
-use crate::problem::{state_error, Problem, Reference};
+use crate::problem::{state_error, HandRhs, Problem, Reference};
 use crate::real::BenchReal;
-use lagrange_core::{Error, State};
+use lagrange_core::{Error, Real, Scalar, State};
 use lagrange_integrators::{GaussLegendre2, Integrator, Rk4};
 use lagrange_systems::ElasticPendulum;
 
@@ -22,8 +22,33 @@ const REFERENCE_STEPS: u64 = 1 << 19;
 /// P5.
 pub struct StiffElastic;
 
+/// P5's equations by hand: `r'' = r th'^2 + g cos th - (k / m) (r - l0)`,
+/// `th'' = -(2 r' th' + g sin th) / r`.
+pub struct ElasticRhs<T> {
+    /// `k / m`, 1/s^2.
+    k_over_m: T,
+    /// Rest length, m.
+    l0: T,
+    /// Gravity, m/s^2.
+    g: T,
+}
+
+impl<T: Real> HandRhs<T, 2> for ElasticRhs<T> {
+    #[inline]
+    fn accelerations(&self, _t: T, q: &[T; 2], qd: &[T; 2], qdd: &mut [T; 2]) {
+        let [r, th] = *q;
+        let [rd, thd] = *qd;
+        let (sin, cos) = Scalar::sin_cos(th);
+        *qdd = [
+            r * thd * thd + self.g * cos - self.k_over_m * (r - self.l0),
+            -(T::TWO * rd * thd + self.g * sin) / r,
+        ];
+    }
+}
+
 impl Problem<2, 4> for StiffElastic {
     type Mech<T: BenchReal> = ElasticPendulum<T>;
+    type Hand<T: BenchReal> = ElasticRhs<T>;
 
     fn id(&self) -> &'static str {
         "P5"
@@ -37,6 +62,13 @@ impl Problem<2, 4> for StiffElastic {
     }
     fn mechanism<T: BenchReal>(&self) -> Result<ElasticPendulum<T>, Error> {
         ElasticPendulum::new(T::real(M), T::real(K), T::real(L0), T::real(G))
+    }
+    fn hand<T: BenchReal>(&self) -> ElasticRhs<T> {
+        ElasticRhs {
+            k_over_m: T::real(K / M),
+            l0: T::real(L0),
+            g: T::real(G),
+        }
     }
     fn start(&self) -> State<f64, 2> {
         State::at_rest([L0 + M * G / K + 1e-3, 0.3])
