@@ -29,6 +29,7 @@ mod drivers;
 mod exact;
 mod fixed_step;
 mod harness;
+mod scenes;
 mod systems;
 mod values;
 
@@ -84,6 +85,7 @@ fn main() -> ExitCode {
         fixed_step::family(),
         adaptive::family(),
         drivers::family(),
+        scenes::family(),
     ];
     let reports = harness::run(families, &cfg);
     println!();
