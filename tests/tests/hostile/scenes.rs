@@ -820,6 +820,170 @@ bank_case!(particles_euler, FallingParticle, 1, euler, never, true);
 bank_case!(driven_stormer, Driven, 1, stormer1, never, false);
 bank_case!(driven_rk4, Driven, 1, rk4, sleeps, true);
 
+/// Adds up to `K` drawn instances to `bank` (refusals by name only).
+fn fill<T, const N: usize, M, I, Z>(
+    ctx: &mut Ctx,
+    bank: &mut Bank<T, N, K, M, I, Z>,
+) -> Result<(), Verdict>
+where
+    T: Real,
+    M: Piece<T, N>,
+    I: Integrator<T, N, M> + Clone,
+    Z: Sleep<T>,
+{
+    for _ in 0..ctx.pick(K + 1) {
+        let (m, names) = M::draw(ctx);
+        match m {
+            Ok(m) => {
+                let s = state::<T, N>(ctx, "s");
+                say!(ctx, "let _ = bank.add(m, s);");
+                let _ = bank.add(m, s);
+            }
+            Err(e) => {
+                if let v @ Verdict::WrongName(_) = refused(e, names) {
+                    return Err(v);
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Frames of a scene of several banks: every frame's verdict, every state held finite, and
+/// a frame of `dt` after a huge one takes one step.
+fn frames_of<T: Real, B: lagrange_integrators::scene::Banks<T> + Debug>(
+    ctx: &mut Ctx,
+    scene: &mut Scene<T, B>,
+    finite: impl Fn(&B) -> bool,
+) -> Verdict {
+    let dt = scene.dt();
+    let mut after_huge = false;
+    for call in 0..=ctx.pick(12) {
+        let before = observe(scene);
+        let op = ctx.pick(4);
+        let f = match op {
+            0 => huge(ctx, dt),
+            1 if after_huge => dt,
+            _ => frame_time(ctx, dt),
+        };
+        say!(ctx, "scene.advance({})?;", lit(f));
+        let r = scene.advance(f);
+        let v = verdict(
+            &r.map(|fr| fr.dropped).map(crate::checks::num),
+            &["frame_time"],
+        );
+        if v.class().is_finding() {
+            return v;
+        }
+        match r {
+            Err(e @ Error::InvalidParameter { .. }) => {
+                if observe(scene) != before {
+                    return Verdict::Changed(format!("call {call}: advance failed with {e:?}"));
+                }
+            }
+            Err(_) => after_huge = false,
+            Ok(frame) => {
+                if after_huge && f == dt && frame.steps != 1 {
+                    return Verdict::Inconsistent(format!(
+                        "call {call}: a frame of dt after a huge one took {frame:?}"
+                    ));
+                }
+                after_huge = op == 0 || (after_huge && f == dt);
+            }
+        }
+        if !finite(scene.banks()) {
+            return Verdict::Silent(format!("call {call}: {:?}", scene.banks()));
+        }
+    }
+    Verdict::Ok
+}
+
+/// True when every state `bank` holds is finite.
+fn all_finite<T, const N: usize, M, I, Z>(bank: &Bank<T, N, K, M, I, Z>) -> bool
+where
+    T: Real,
+    M: Mechanism<T, N>,
+    I: Integrator<T, N, M> + Clone,
+    Z: Sleep<T>,
+{
+    bank.iter().all(|(_, s)| s.is_finite())
+}
+
+/// Scenes of several banks: a tuple of banks of different types and integrators (lanes and
+/// not, sleeping and not), an array of banks, and banks borrowed (`&mut`).
+fn many_banks<T: Real>(ctx: &mut Ctx) -> Verdict {
+    let dt = ctx.value::<T>(Kind::Step);
+    let cap = u32::try_from(ctx.count()).unwrap_or(u32::MAX).min(16);
+    let rule = match rule::<T>(ctx) {
+        Ok(r) => r,
+        Err(v) => return v,
+    };
+    let made = (|| {
+        let mut a: Bank<T, 1, K, SimplePendulum<T>, Rk4> =
+            Bank::new(Rk4, NeverSleeps).map_err(Verdict::Error)?;
+        let mut b: Bank<T, 2, K, CartPole<T>, SemiImplicitEuler, Sleeps<T>> =
+            Bank::new(SemiImplicitEuler, rule).map_err(Verdict::Error)?;
+        let mut c: Bank<T, 1, K, Driven<T>, StormerVerlet<T, 1>, Sleeps<T>> =
+            Bank::new(StormerVerlet::default(), rule).map_err(Verdict::Error)?;
+        fill(ctx, &mut a)?;
+        fill(ctx, &mut b)?;
+        fill(ctx, &mut c)?;
+        Ok::<_, Verdict>((a, b, c))
+    })();
+    let (a, b, c) = match made {
+        Ok(banks) => banks,
+        Err(v) => return v,
+    };
+    match ctx.pick(3) {
+        0 => {
+            say!(
+                ctx,
+                "let mut scene = Scene::new((a, b, c), {}, {cap})?;",
+                lit(dt)
+            );
+            let mut scene = match Scene::new((a, b, c), dt, cap) {
+                Ok(s) => s,
+                Err(e) => return refused(e, &["dt", "max_steps_per_frame"]),
+            };
+            frames_of(ctx, &mut scene, |(a, b, c)| {
+                all_finite(a) && all_finite(b) && all_finite(c)
+            })
+        }
+        1 => {
+            let mut d: Bank<T, 1, K, SimplePendulum<T>, Rk4> = match Bank::new(Rk4, NeverSleeps) {
+                Ok(d) => d,
+                Err(e) => return Verdict::Error(e),
+            };
+            if let Err(v) = fill(ctx, &mut d) {
+                return v;
+            }
+            say!(
+                ctx,
+                "let mut scene = Scene::new([a, d], {}, {cap})?;",
+                lit(dt)
+            );
+            let mut scene = match Scene::new([a, d], dt, cap) {
+                Ok(s) => s,
+                Err(e) => return refused(e, &["dt", "max_steps_per_frame"]),
+            };
+            frames_of(ctx, &mut scene, |banks| banks.iter().all(all_finite))
+        }
+        _ => {
+            let (mut a, mut b) = (a, b);
+            say!(
+                ctx,
+                "let mut scene = Scene::new((&mut a, &mut b), {}, {cap})?;",
+                lit(dt)
+            );
+            let mut scene = match Scene::new((&mut a, &mut b), dt, cap) {
+                Ok(s) => s,
+                Err(e) => return refused(e, &["dt", "max_steps_per_frame"]),
+            };
+            frames_of(ctx, &mut scene, |(a, b)| all_finite(a) && all_finite(b))
+        }
+    }
+}
+
 /// Two values agree bit for bit, or are both NaN.
 fn same<T: Real>(a: T, b: T) -> bool {
     let (a, b) = (a.to_f64(), b.to_f64());
@@ -969,6 +1133,12 @@ pub fn family() -> Family {
         0.7,
         "Scene<Bank<Forced<SimplePendulum, Input>, Rk4, Sleeps>>",
         driven_rk4
+    );
+    entries!(
+        v,
+        0.7,
+        "Scene of banks: (Bank, Bank, Bank), [Bank; 2], (&mut Bank, &mut Bank)",
+        many_banks
     );
     entries!(v, 0.5, "Lanes, sin_cos_lanes (no error channel)", lanes);
     Family {
