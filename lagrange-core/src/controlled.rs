@@ -38,8 +38,9 @@ pub trait Controlled<T: Real> {
     /// Sets the input, used from the next evaluation on.
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] for a value the mechanism refuses (not finite); the input
-    /// is then unchanged.
+    /// [`Error::InvalidParameter`] `input` for a value the mechanism refuses (not finite):
+    /// the error names this method's own parameter, whatever the mechanism calls its input
+    /// elsewhere (`force`, `torque`); the input is then unchanged.
     fn set_input(&mut self, input: Self::Input) -> Result<(), Error>;
 }
 

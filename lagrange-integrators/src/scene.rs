@@ -87,10 +87,15 @@ impl<T: Real, B: Banks<T>> Scene<T, B> {
     /// Adds `frame_time` (zero or positive, finite) and takes the fixed steps it pays for, up
     /// to the cap ([`FrameClock::advance`]).
     ///
+    /// Whatever the frame time (`T::MAX`, a pause in a debugger), the time beyond the cap is
+    /// dropped whole: a frame of exactly `dt` after it takes one step.
+    ///
     /// # Errors
     /// [`Error::InvalidParameter`] `frame_time` when negative or not finite (nothing
-    /// changes). An instance whose step fails does not stop the others: it is counted in
-    /// [`SceneFrame::failed`].
+    /// changes); [`Error::NonFiniteState`] when the scene's time after a step would overflow
+    /// (a `dt` near `T::MAX`): the steps before it are taken, and the time of the step
+    /// refused stays accumulated, as in [`FrameClock::advance`]. An instance whose step fails
+    /// does not stop the others: it is counted in [`SceneFrame::failed`].
     pub fn advance(&mut self, frame_time: T) -> Result<SceneFrame<T>, Error> {
         let banks = &mut self.banks;
         let dt = self.clock.dt();

@@ -249,8 +249,10 @@ impl<T: Real> Controlled<T> for Acrobot<T> {
     fn input(&self) -> T {
         self.torque()
     }
+    /// # Errors
+    /// [`Error::InvalidParameter`] `input` when not finite (the torque is left unchanged).
     fn set_input(&mut self, input: T) -> Result<(), Error> {
-        self.set_torque(input)
+        self.set_torque(validate::finite("input", input)?)
     }
 }
 

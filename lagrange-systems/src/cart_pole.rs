@@ -157,8 +157,10 @@ impl<T: Real> Controlled<T> for CartPole<T> {
     fn input(&self) -> T {
         self.force()
     }
+    /// # Errors
+    /// [`Error::InvalidParameter`] `input` when not finite (the force is left unchanged).
     fn set_input(&mut self, input: T) -> Result<(), Error> {
-        self.set_force(input)
+        self.set_force(validate::finite("input", input)?)
     }
 }
 

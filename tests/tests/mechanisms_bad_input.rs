@@ -2,7 +2,7 @@
 //! non-finite states with specific errors, never a panic or a NaN.
 
 use lagrange_core::nalgebra::SVector;
-use lagrange_core::{Error, Mechanism, Real, State};
+use lagrange_core::{Controlled, Error, Mechanism, Real, State};
 use lagrange_integrators::{Integrator, Rk4};
 use lagrange_systems::exact::{damped_oscillator, eccentric_anomaly, kepler_orbit};
 use lagrange_systems::{
@@ -125,7 +125,8 @@ fn chain_refuses_a_mass_it_cannot_invert() {
     );
 }
 
-/// Inputs refuse non-finite values by name and keep their last good value.
+/// Inputs refuse non-finite values by name and keep their last good value; through
+/// `Controlled::set_input` the name is `input`, that method's own parameter (issue 15).
 fn inputs_refuse_non_finite<T: Real>() -> Result<(), Error> {
     let g = T::from_f64(9.81);
     let mut cp = CartPole::new(T::one(), T::one(), T::one(), g)?;
@@ -135,6 +136,8 @@ fn inputs_refuse_non_finite<T: Real>() -> Result<(), Error> {
     for bad in [T::from_f64(f64::NAN), T::INFINITY, -T::INFINITY] {
         refuses(cp.set_force(bad), "force");
         refuses(acrobot.set_torque(bad), "torque");
+        refuses(Controlled::set_input(&mut cp, bad), "input");
+        refuses(Controlled::set_input(&mut acrobot, bad), "input");
     }
     assert_eq!(cp.force(), T::from_f64(3.0));
     assert_eq!(acrobot.torque(), -T::from_f64(2.0));
@@ -311,3 +314,28 @@ fn exact_solutions_refuse_bad_arguments() {
     refuses(kepler_orbit(1.0, 1.0, 0.5, f64::INFINITY), "t");
     refuses(eccentric_anomaly(f64::NAN, 0.5), "mean_anomaly");
 }
+
+/// Issue 15: the generated mechanisms (lagrange-generated, `cargo xtask derive`) follow the
+/// finiteness rule: a mass so small that the inverse mass overflows, a finite but extreme
+/// state, and a non-finite right-hand side give `NonFiniteState`, never `Ok` with an infinity
+/// or a NaN, from `solve_mass` and the law.
+fn generated_mechanisms_are_finite_or_refuse<T: Real>() -> Result<(), Error> {
+    use lagrange_core::NoForce;
+    use lagrange_generated::{DoublePendulum, Pendulum};
+    let at = State::new(T::zero(), [T::one()], [T::one()]);
+    let tiny = Pendulum::new(T::MIN_POSITIVE * T::EPSILON, T::one(), T::one(), T::one())?;
+    assert_eq!(tiny.law(&at, &NoForce), Err(Error::NonFiniteState));
+    let p = Pendulum::new(T::one(), T::one(), T::one(), T::from_f64(1e6))?;
+    let fast = State::new(T::zero(), [T::one()], [T::MAX]);
+    assert_eq!(p.law(&fast, &NoForce), Err(Error::NonFiniteState));
+    let nan = SVector::from([T::from_f64(f64::NAN)]);
+    assert_eq!(p.solve_mass(&at, &nan), Err(Error::NonFiniteState));
+    assert!(p.law(&at, &NoForce)?[0].is_finite());
+    let d = DoublePendulum::new(T::one(), T::one(), T::one(), T::one(), T::one())?;
+    let huge = SVector::from([T::one(), T::MAX]);
+    let s2 = State::at_rest([T::one(), T::zero()]);
+    assert_eq!(d.solve_mass(&s2, &huge), Err(Error::NonFiniteState));
+    Ok(())
+}
+
+for_f32_and_f64!(generated_mechanisms_are_finite_or_refuse);

@@ -124,7 +124,8 @@ fn scene_picture<T: Real>(scene: &Scene<T, (Props<T>, Carts<T>)>) -> String {
 /// drawn state, status and mechanism, the banks' sizes and times, the scene's time and
 /// alpha), and nothing panics. Non-finite states on add and write (`NonFiniteState`); a full
 /// bank (`BankFull`); non-finite impulses (`impulse`), and a finite one whose velocities
-/// overflow (`NonFiniteState`); a non-finite input (`force`) or refused modification (the
+/// overflow (`NonFiniteState`); a non-finite input (`input`, the name of `set_input`'s own
+/// parameter) or refused modification (the
 /// modification's error, even after it changed its copy); negative and non-finite frame
 /// times (`frame_time`); `alpha` outside `[0, 1]` (`alpha`). Then handles that name nothing
 /// (`NoSuchInstance`) for every method: one removed (also once its index is given to a new
@@ -192,7 +193,7 @@ fn bad_input_changes_nothing<T: Real>() -> Result<(), Error> {
             "impulse",
         );
         for id in [hanging, driven] {
-            refuses(carts.set_input(id, bad), "force");
+            refuses(carts.set_input(id, bad), "input");
             refuses(carts.modify(id, |c| c.set_force(bad)), "force");
         }
         unchanged(&scene, "a non-finite impulse or input");
@@ -426,7 +427,27 @@ fn failures_sleeping<T: Real>() -> Result<(), Error> {
     )?)
 }
 
+/// Issue 15 (the scenes' hostile-input campaign): a finite state whose energy is not (a speed
+/// of `sqrt(T::MAX)` squared) gets `NonFiniteState` from `energies`, never `Ok` with an
+/// infinity, and the bank is unchanged; a state of finite energy gets it.
+fn energies_are_finite_or_refused<T: Real>() -> Result<(), Error> {
+    let mut bank: Bank<T, 1, 2, SimplePendulum<T>, Rk4> = Bank::new(Rk4, NeverSleeps)?;
+    let m = SimplePendulum::new(T::one(), T::one(), T::from_f64(G), T::zero())?;
+    let fast = bank.add(
+        m,
+        State::new(T::zero(), [T::one()], [T::MAX.sqrt() * T::TWO]),
+    )?;
+    let slow = bank.add(m, State::at_rest([T::one()]))?;
+    let before = picture(&bank);
+    assert_eq!(bank.energies(fast), Err(Error::NonFiniteState));
+    assert_eq!(picture(&bank), before);
+    let e = bank.energies(slow)?;
+    assert!(e.kinetic == T::zero() && e.potential.is_finite() && e.total().is_finite());
+    Ok(())
+}
+
 for_f32_and_f64!(
+    energies_are_finite_or_refused,
     constructors_refuse_bad_parameters,
     bad_input_changes_nothing,
     a_handle_names_nothing_in_another_bank,

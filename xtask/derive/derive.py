@@ -1258,8 +1258,8 @@ class Generator:
         )
         o.append("")
         if d.fixed_mass:
-            apply = "Ok(self.inverse? * b)" if n <= 2 else "Ok(self.factor?.solve(b))"
-            o.append("    /// With the constant `M`'s inverse (or factor) formed once.")
+            apply = "finite(self.inverse? * b)" if n <= 2 else "finite(self.factor?.solve(b))"
+            o.append("    /// With the constant `M`'s inverse (or factor) formed once; finite or an error.")
             o.append(f"    fn solve_mass(&self, _s: &State<T, {n}>, b: &SVector<T, {n}>) -> Result<SVector<T, {n}>, Error> {{")
             o.append(f"        {apply}")
             o.append("    }")
@@ -1369,6 +1369,23 @@ class Generator:
     def solver(self):
         n = self.s.n
         o = self.out
+        # The finiteness rule of every function that returns a `Result` (issue 15): the solves,
+        # and so the law, return `Ok` only with finite values. Parameters that are each valid
+        # may still form products that overflow or underflow (a mass of 1e-308: an infinite
+        # inverse), and a finite state may be extreme.
+        o.extend([
+            "/// `x` when every component is finite, else [`Error::NonFiniteState`]: the solves, and so",
+            "/// the law, return `Ok` only with finite values, whatever the parameters' products and the",
+            "/// state.",
+            "fn finite<T: Real, const N: usize>(x: SVector<T, N>) -> Result<SVector<T, N>, Error> {",
+            "    if x.iter().all(|v| v.is_finite()) {",
+            "        Ok(x)",
+            "    } else {",
+            "        Err(Error::NonFiniteState)",
+            "    }",
+            "}",
+            "",
+        ])
         if self.d.fixed_mass and n >= 3:
             return  # the Cholesky factor of lagrange_core does it
         if self.d.fixed_mass:
@@ -1395,7 +1412,7 @@ class Generator:
                 "    if d <= T::zero() {",
                 "        return Err(Error::SingularMassMatrix { pivot: 0 });",
                 "    }",
-                "    Ok(b / d)",
+                "    finite(b / d)",
                 "}",
             ])
         elif n == 2:
@@ -1415,7 +1432,7 @@ class Generator:
                 "        return Err(Error::SingularMassMatrix { pivot: 1 });",
                 "    }",
                 "    let inv = T::one() / det;",
-                "    Ok(SVector::from([(d * b[0] - c * b[1]) * inv, (a * b[1] - c * b[0]) * inv]))",
+                "    finite(SVector::from([(d * b[0] - c * b[1]) * inv, (a * b[1] - c * b[0]) * inv]))",
                 "}",
             ])
         else:
@@ -1423,7 +1440,7 @@ class Generator:
             o.extend([
                 f"/// Solves `m x = b` by the fixed-size Cholesky solve.",
                 f"fn solve<T: Real>(m: &SMatrix<T, {n}, {n}>, b: &SVector<T, {n}>) -> Result<SVector<T, {n}>, Error> {{",
-                "    solve_spd(m, b)",
+                "    finite(solve_spd(m, b)?)",
                 "}",
             ])
 

@@ -138,9 +138,9 @@ impl<T: Real> Mechanism<T, 2> for CartesianPendulum<T> {
         SVector::from([T::zero(), -self.k0])
     }
 
-    /// With the constant `M`'s inverse (or factor) formed once.
+    /// With the constant `M`'s inverse (or factor) formed once; finite or an error.
     fn solve_mass(&self, _s: &State<T, 2>, b: &SVector<T, 2>) -> Result<SVector<T, 2>, Error> {
-        Ok(self.inverse? * b)
+        finite(self.inverse? * b)
     }
 
     /// `M^-1 (f + Q + extra)`, `M^-1` formed once.
@@ -197,6 +197,17 @@ impl<T: Real> HolonomicConstraints<T, 2, 1> for CartesianPendulum<T> {
     }
 }
 
+/// `x` when every component is finite, else [`Error::NonFiniteState`]: the solves, and so
+/// the law, return `Ok` only with finite values, whatever the parameters' products and the
+/// state.
+fn finite<T: Real, const N: usize>(x: SVector<T, N>) -> Result<SVector<T, N>, Error> {
+    if x.iter().all(|v| v.is_finite()) {
+        Ok(x)
+    } else {
+        Err(Error::NonFiniteState)
+    }
+}
+
 /// `m^-1`, column by column, or why there is none (as [`solve`] would refuse `m`).
 fn inverse<T: Real>(m: &SMatrix<T, 2, 2>) -> Result<SMatrix<T, 2, 2>, Error> {
     let c0 = solve(m, &SVector::from([T::one(), T::zero()]))?;
@@ -219,7 +230,7 @@ fn solve<T: Real>(m: &SMatrix<T, 2, 2>, b: &SVector<T, 2>) -> Result<SVector<T, 
         return Err(Error::SingularMassMatrix { pivot: 1 });
     }
     let inv = T::one() / det;
-    Ok(SVector::from([
+    finite(SVector::from([
         (d * b[0] - c * b[1]) * inv,
         (a * b[1] - c * b[0]) * inv,
     ]))

@@ -218,6 +218,17 @@ impl<T: Real> Lagrangian<T, 2> for DoublePendulum<T> {
     }
 }
 
+/// `x` when every component is finite, else [`Error::NonFiniteState`]: the solves, and so
+/// the law, return `Ok` only with finite values, whatever the parameters' products and the
+/// state.
+fn finite<T: Real, const N: usize>(x: SVector<T, N>) -> Result<SVector<T, N>, Error> {
+    if x.iter().all(|v| v.is_finite()) {
+        Ok(x)
+    } else {
+        Err(Error::NonFiniteState)
+    }
+}
+
 /// Solves the symmetric 2x2 system `m x = b` by its closed-form inverse, refusing a mass
 /// matrix that is singular or not positive definite as the Cholesky solve would.
 fn solve<T: Real>(m: &SMatrix<T, 2, 2>, b: &SVector<T, 2>) -> Result<SVector<T, 2>, Error> {
@@ -233,7 +244,7 @@ fn solve<T: Real>(m: &SMatrix<T, 2, 2>, b: &SVector<T, 2>) -> Result<SVector<T, 
         return Err(Error::SingularMassMatrix { pivot: 1 });
     }
     let inv = T::one() / det;
-    Ok(SVector::from([
+    finite(SVector::from([
         (d * b[0] - c * b[1]) * inv,
         (a * b[1] - c * b[0]) * inv,
     ]))

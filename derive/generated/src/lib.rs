@@ -15,6 +15,11 @@
 //! | [`KapitzaPendulum`] | `kapitza_pendulum.py`: a pivot driven up and down, time explicit in `T` | `[th]` |
 //! | [`CartesianPendulum`] | `cartesian_pendulum.py`: one holonomic row | `[x, y]` |
 //!
+//! Like every function of the library that returns a `Result`, their solves and laws return
+//! `Ok` only with finite values: parameters that are each valid but whose products overflow
+//! or underflow (a mass of `1e-308`, whose inverse is infinite), or an extreme state, give
+//! [`Error::NonFiniteState`](lagrange_core::Error::NonFiniteState).
+//!
 //! Do not edit the files: `cargo xtask derive --check` (part of `cargo xtask ci`) regenerates
 //! each and fails when one differs. Each file holds a test against the automatic path of its
 //! own `T` and `V`; `tests/hand_derived.rs` checks them against the hand-derived mechanisms of

@@ -137,9 +137,9 @@ impl<T: Real> Mechanism<T, 1> for Pendulum<T> {
         SVector::from([-self.k1 * sin_th])
     }
 
-    /// With the constant `M`'s inverse (or factor) formed once.
+    /// With the constant `M`'s inverse (or factor) formed once; finite or an error.
     fn solve_mass(&self, _s: &State<T, 1>, b: &SVector<T, 1>) -> Result<SVector<T, 1>, Error> {
-        Ok(self.inverse? * b)
+        finite(self.inverse? * b)
     }
 
     /// `M^-1 (f + Q + extra)`, `M^-1` formed once.
@@ -172,6 +172,17 @@ impl<T: Real> Lagrangian<T, 1> for Pendulum<T> {
     }
 }
 
+/// `x` when every component is finite, else [`Error::NonFiniteState`]: the solves, and so
+/// the law, return `Ok` only with finite values, whatever the parameters' products and the
+/// state.
+fn finite<T: Real, const N: usize>(x: SVector<T, N>) -> Result<SVector<T, N>, Error> {
+    if x.iter().all(|v| v.is_finite()) {
+        Ok(x)
+    } else {
+        Err(Error::NonFiniteState)
+    }
+}
+
 /// `m^-1`, column by column, or why there is none (as [`solve`] would refuse `m`).
 fn inverse<T: Real>(m: &SMatrix<T, 1, 1>) -> Result<SMatrix<T, 1, 1>, Error> {
     let c0 = solve(m, &SVector::from([T::one()]))?;
@@ -188,7 +199,7 @@ fn solve<T: Real>(m: &SMatrix<T, 1, 1>, b: &SVector<T, 1>) -> Result<SVector<T, 
     if d <= T::zero() {
         return Err(Error::SingularMassMatrix { pivot: 0 });
     }
-    Ok(b / d)
+    finite(b / d)
 }
 
 /// The generated equations against the automatic path of the same `T` and `V`.

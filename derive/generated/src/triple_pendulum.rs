@@ -318,9 +318,20 @@ impl<T: Real> Lagrangian<T, 3> for TriplePendulum<T> {
     }
 }
 
+/// `x` when every component is finite, else [`Error::NonFiniteState`]: the solves, and so
+/// the law, return `Ok` only with finite values, whatever the parameters' products and the
+/// state.
+fn finite<T: Real, const N: usize>(x: SVector<T, N>) -> Result<SVector<T, N>, Error> {
+    if x.iter().all(|v| v.is_finite()) {
+        Ok(x)
+    } else {
+        Err(Error::NonFiniteState)
+    }
+}
+
 /// Solves `m x = b` by the fixed-size Cholesky solve.
 fn solve<T: Real>(m: &SMatrix<T, 3, 3>, b: &SVector<T, 3>) -> Result<SVector<T, 3>, Error> {
-    solve_spd(m, b)
+    finite(solve_spd(m, b)?)
 }
 
 /// The generated equations against the automatic path of the same `T` and `V`.

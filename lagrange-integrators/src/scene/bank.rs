@@ -455,16 +455,23 @@ where
     }
 
     /// Kinetic and potential energy of the instance's state (computed now, never inside a
-    /// step).
+    /// step). Finite or an error: a state may be finite and its energy not (a speed of
+    /// `1e200` m/s squared).
     ///
     /// # Errors
-    /// [`Error::NoSuchInstance`].
+    /// [`Error::NoSuchInstance`]; [`Error::NonFiniteState`] when either energy, or their sum
+    /// ([`Energies::total`]), is not finite.
     pub fn energies(&self, id: Id) -> Result<Energies<T>, Error> {
         let slot = self.slot(id)?;
-        Ok(Energies {
+        let energies = Energies {
             kinetic: slot.mechanism.kinetic_energy(&slot.current),
             potential: slot.mechanism.potential_energy(&slot.current),
-        })
+        };
+        if energies.total().is_finite() {
+            Ok(energies)
+        } else {
+            Err(Error::NonFiniteState)
+        }
     }
 
     /// Writes the instance's state (finite; its time becomes the bank's) and wakes it, with

@@ -1,5 +1,6 @@
 //! The hostile-input campaign: every public entry point of lagrange-core,
-//! lagrange-integrators and lagrange-systems, `f32` and `f64`, called with drawn nasty values
+//! lagrange-integrators (scenes and lanes included), lagrange-systems and the generated
+//! mechanisms of lagrange-generated, `f32` and `f64`, called with drawn nasty values
 //! (NaN, infinities, the largest and smallest values, subnormals, signed zeros, tiny and huge
 //! steps, tolerances at their edges) and classified: ok, a specific error, panic, hang, silent
 //! non-finite (`Ok` holding NaN or an infinity), wrong parameter named, state changed on error,
@@ -29,6 +30,7 @@ mod drivers;
 mod exact;
 mod fixed_step;
 mod harness;
+mod scenes;
 mod systems;
 mod values;
 
@@ -84,6 +86,7 @@ fn main() -> ExitCode {
         fixed_step::family(),
         adaptive::family(),
         drivers::family(),
+        scenes::family(),
     ];
     let reports = harness::run(families, &cfg);
     println!();

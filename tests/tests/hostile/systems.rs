@@ -402,6 +402,68 @@ impl<T: Real> Bits for T {
     }
 }
 
+/// A generated mechanism of crate lagrange-generated (`cargo xtask derive`): its validated
+/// constructor with drawn parameters, then one of its methods.
+macro_rules! generated {
+    ($name:ident, $ty:ident, $n:literal, [$($i:literal),*], [$($param:literal),*]) => {
+        fn $name<T: Real>(ctx: &mut Ctx) -> Verdict {
+            let p = ctx.values::<T, $n>(Kind::Param);
+            say!(
+                ctx,
+                "let m = lagrange_generated::{}::<{}>::new{}?;",
+                stringify!($ty),
+                ty::<T>(),
+                lits(&p).replace('[', "(").replace(']', ")")
+            );
+            let m = call!(lagrange_generated::$ty::new($(p[$i]),*), &[$($param),*]);
+            exercise(ctx, &m)
+        }
+    };
+}
+
+generated!(
+    gen_pendulum,
+    Pendulum,
+    4,
+    [0, 1, 2, 3],
+    ["m", "l", "g", "b"]
+);
+generated!(
+    gen_double,
+    DoublePendulum,
+    5,
+    [0, 1, 2, 3, 4],
+    ["m1", "m2", "l1", "l2", "g"]
+);
+generated!(
+    gen_spring_cart,
+    SpringCartPendulum,
+    6,
+    [0, 1, 2, 3, 4, 5],
+    ["m_cart", "m", "k", "c", "l", "g"]
+);
+generated!(
+    gen_triple,
+    TriplePendulum,
+    7,
+    [0, 1, 2, 3, 4, 5, 6],
+    ["m1", "m2", "m3", "l1", "l2", "l3", "g"]
+);
+generated!(
+    gen_kapitza,
+    KapitzaPendulum,
+    5,
+    [0, 1, 2, 3, 4],
+    ["m", "l", "g", "a", "w"]
+);
+generated!(
+    gen_cartesian,
+    CartesianPendulum,
+    3,
+    [0, 1, 2],
+    ["m", "l", "g"]
+);
+
 /// The family.
 pub fn family() -> Family {
     let mut v: Vec<Entry> = Vec::new();
@@ -421,6 +483,12 @@ pub fn family() -> Family {
     entries!(v, 1.0, "CartesianPendulum (parts)", cartesian_parts);
     entries!(v, 1.0, "FourBarLinkage (parts)", four_bar_parts);
     entries!(v, 1.0, "RollingDisk (parts)", rolling_disk_parts);
+    entries!(v, 0.5, "generated Pendulum", gen_pendulum);
+    entries!(v, 0.5, "generated DoublePendulum", gen_double);
+    entries!(v, 0.5, "generated SpringCartPendulum", gen_spring_cart);
+    entries!(v, 0.5, "generated TriplePendulum", gen_triple);
+    entries!(v, 0.5, "generated KapitzaPendulum", gen_kapitza);
+    entries!(v, 0.5, "generated CartesianPendulum", gen_cartesian);
     Family {
         name: "systems",
         entries: v,
