@@ -159,6 +159,8 @@ const AREAS: [Area; 9] = [
             "constrained_laws",
             "--test",
             "constraints_bad_input",
+            "--test",
+            "constraints_three_rows",
         ],
     },
     Area {
