@@ -88,6 +88,64 @@ fn sin_cos<T: Real, const N: usize>(q: &SVector<T, N>) -> ([T; N], [T; N]) {
     (sin, cos)
 }
 
+/// Thomas's algorithm on the tension system `K tau = r` (`K` tridiagonal, symmetric: diagonal
+/// `d`, overwritten by the pivots; super-diagonal `off`, `off[j] = K_j,j+1`): eliminates below
+/// the diagonal keeping the inverse pivots, then back-substitutes.
+///
+/// The pivots are tested once, after the elimination, without a branch per pivot: a bad pivot
+/// spoils only those after it, so the first one that fails is found by a scan that runs only
+/// when one did.
+///
+/// # Errors
+/// At the first pivot that fails: [`Error::NonFiniteState`] when it is not finite,
+/// [`Error::SingularMassMatrix`] when it is not positive.
+#[inline(always)]
+fn thomas<T: Real, const N: usize>(
+    d: &mut [T; N],
+    off: &[T; N],
+    mut r: [T; N],
+) -> Result<[T; N], Error> {
+    let mut inv_d = [T::zero(); N];
+    let mut ok = true;
+    for j in 0..N {
+        if j > 0 {
+            let factor = off[j - 1] * inv_d[j - 1];
+            d[j] -= factor * off[j - 1];
+            r[j] -= factor * r[j - 1];
+        }
+        // `>` is false for NaN; `is_finite` catches infinity. `&`: no branch.
+        ok &= d[j].is_finite() & (d[j] > T::zero());
+        inv_d[j] = d[j].recip();
+    }
+    if !ok {
+        return Err(bad_pivot(d));
+    }
+    let mut tau = [T::zero(); N];
+    let mut above = T::zero();
+    for j in (0..N).rev() {
+        tau[j] = (r[j] - above) * inv_d[j];
+        if j > 0 {
+            above = off[j - 1] * tau[j];
+        }
+    }
+    Ok(tau)
+}
+
+/// The error for the first pivot in `d` that is not finite and positive (off the hot path).
+#[cold]
+#[inline(never)]
+fn bad_pivot<T: Real, const N: usize>(d: &[T; N]) -> Error {
+    for (j, dj) in d.iter().enumerate() {
+        if !dj.is_finite() {
+            return Error::NonFiniteState;
+        }
+        if *dj <= T::zero() {
+            return Error::SingularMassMatrix { pivot: j };
+        }
+    }
+    Error::NonFiniteState
+}
+
 impl<T: Real, const N: usize> NLinkPendulum<T, N> {
     /// A chain of `masses` (kg, each > 0) on rods of `lengths` (m, each > 0), mass `j` at the
     /// end of rod `j` counted from the pivot, in `gravity` (m/s^2, >= 0).
@@ -196,6 +254,52 @@ impl<T: Real, const N: usize> NLinkPendulum<T, N> {
         })
     }
 
+    /// [`Self::tension_solve`] under gravity alone, `(px_j, py_j) = (0, -g)` on every mass,
+    /// written out: the differences of the external forces per unit mass vanish past the first
+    /// rod, so gravity enters the first row of the tension system (`g cos th_1`) and the first
+    /// angle's acceleration (`-g sin th_1 / l_1`) only.
+    #[inline(always)]
+    fn falling(
+        &self,
+        (sin, cos): ([T; N], [T; N]),
+        qd: &SVector<T, N>,
+    ) -> Result<SVector<T, N>, Error> {
+        let (l, inv_m) = (&self.lengths, &self.inv_masses);
+        let mut d = [T::zero(); N];
+        let mut off = [T::zero(); N];
+        let mut sn = [T::zero(); N];
+        let mut r = [T::zero(); N];
+        for j in 0..N {
+            d[j] = inv_m[j];
+            r[j] = l[j] * qd[j] * qd[j];
+            if j == 0 {
+                r[j] += self.gravity * cos[j];
+            } else {
+                d[j] += inv_m[j - 1];
+            }
+            if j + 1 < N {
+                off[j] = -(cos[j] * cos[j + 1] + sin[j] * sin[j + 1]) * inv_m[j];
+                sn[j] = sin[j + 1] * cos[j] - cos[j + 1] * sin[j];
+            }
+        }
+        let tau = thomas(&mut d, &off, r)?;
+        let qdd = SVector::<T, N>::from_fn(|j, _| {
+            let mut rel = if j == 0 {
+                -self.gravity * sin[j]
+            } else {
+                T::zero()
+            };
+            if j + 1 < N {
+                rel += tau[j + 1] * sn[j] * inv_m[j];
+            }
+            if j > 0 {
+                rel -= tau[j - 1] * sn[j - 1] * inv_m[j - 1];
+            }
+            rel * self.inv_lengths[j]
+        });
+        finite(qdd, Error::NonFiniteState)
+    }
+
     /// The tension recursion described on the type: `q''` of the chain at angles with sines
     /// `sin` and cosines `cos`, rates `qd`, under external forces per unit mass `(px_j, py_j)`
     /// on each mass (gravity is `(0, -g)` on every one).
@@ -227,30 +331,7 @@ impl<T: Real, const N: usize> NLinkPendulum<T, N> {
                 sn[j] = sin[j + 1] * cos[j] - cos[j + 1] * sin[j];
             }
         }
-        // Thomas: eliminate below the diagonal, keeping the inverse pivots, then back-substitute.
-        let mut inv_d = [T::zero(); N];
-        for j in 0..N {
-            if j > 0 {
-                let factor = off[j - 1] * inv_d[j - 1];
-                d[j] -= factor * off[j - 1];
-                r[j] -= factor * r[j - 1];
-            }
-            if !d[j].is_finite() {
-                return Err(Error::NonFiniteState);
-            }
-            if d[j] <= T::zero() {
-                return Err(Error::SingularMassMatrix { pivot: j });
-            }
-            inv_d[j] = d[j].recip();
-        }
-        let mut tau = [T::zero(); N];
-        let mut above = T::zero();
-        for j in (0..N).rev() {
-            tau[j] = (r[j] - above) * inv_d[j];
-            if j > 0 {
-                above = off[j - 1] * tau[j];
-            }
-        }
+        let tau = thomas(&mut d, &off, r)?;
         // th_j'' = (a_j - a_{j-1}) . n_j / l_j with m_j a_j = -tau_j e_j + tau_{j+1} e_{j+1} + F_j.
         let qdd = SVector::<T, N>::from_fn(|j, _| {
             let mut rel = px[j] * cos[j] + py[j] * sin[j];
@@ -327,14 +408,15 @@ impl<T: Real, const N: usize> Mechanism<T, N> for NLinkPendulum<T, N> {
         self.tension_solve((sin, cos), &SVector::zeros(), (px, py))
     }
 
-    /// The closed form.
+    /// The closed form: the tension recursion under gravity alone ([`Self::falling`]), plus
+    /// `M^-1` of the extra force when there is one.
+    #[inline]
     fn law<F: GeneralizedForce<T, N>>(
         &self,
         s: &State<T, N>,
         extra: &F,
     ) -> Result<SVector<T, N>, Error> {
-        let down = [-self.gravity; N];
-        let free = self.tension_solve(sin_cos(&s.q), &s.qd, ([T::zero(); N], down))?;
+        let free = self.falling(sin_cos(&s.q), &s.qd)?;
         if F::IS_ZERO {
             Ok(free)
         } else {
