@@ -49,7 +49,7 @@ fn main() -> ExitCode {
     let task = std::env::args().nth(1).unwrap_or_default();
     let result = match task.as_str() {
         "demo" => demo::run(),
-        "test" => cmd::run_all(&TEST).and(cmd::run_all(&LONG_TEST)),
+        "test" => cmd::run_all(&TEST).and(long_test()),
         "cross" => cross::run(),
         "bench" => bench(&std::env::args().skip(2).collect::<Vec<_>>()),
         "qemu" => qemu::run(),
@@ -151,16 +151,53 @@ const DOC_TEST: [&[&str]; 1] = [&["test", "--workspace", "--doc", "--quiet"]];
 
 /// Long runs (10^6 steps and more) are `#[ignore]`d in the quick debug test run and run here,
 /// optimised. They all live in the `tests` crate, so the bench crate's heavy dependencies are
-/// not built in release for them.
-const LONG_TEST: [&[&str]; 1] = [&[
-    "test",
-    "-p",
-    "lagrange-tests",
-    "--release",
-    "--quiet",
-    "--",
-    "--ignored",
-]];
+/// not built in release for them; and only the test targets that hold an `#[ignore]`d test
+/// are built in release (found by reading `tests/tests/`), not all seventy.
+fn long_test() -> Result<(), String> {
+    let mut args: Vec<String> = ["test", "-p", "lagrange-tests", "--release", "--quiet"]
+        .map(String::from)
+        .to_vec();
+    for target in targets_with_ignored(&cmd::project_root().join("tests/tests"))? {
+        args.push("--test".into());
+        args.push(target);
+    }
+    args.extend(["--", "--ignored"].map(String::from));
+    cmd::run(cmd::cargo().args(&args))
+}
+
+/// The test targets of `dir` (a file `NAME.rs`, or a directory `NAME/` with its `main.rs` and
+/// modules) with a line that starts with `#[ignore` (an attribute, not a comment), sorted.
+fn targets_with_ignored(dir: &std::path::Path) -> Result<Vec<String>, String> {
+    let read = |p: &std::path::Path| std::fs::read_to_string(p).unwrap_or_default();
+    let mut targets = Vec::new();
+    let entries = std::fs::read_dir(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    for entry in entries.flatten() {
+        let path = entry.path();
+        let (name, sources) = if path.is_dir() {
+            let files = std::fs::read_dir(&path)
+                .map_err(|e| format!("{}: {e}", path.display()))?
+                .flatten()
+                .map(|f| f.path())
+                .filter(|f| f.extension().is_some_and(|x| x == "rs"))
+                .collect::<Vec<_>>();
+            (entry.file_name(), files)
+        } else if path.extension().is_some_and(|x| x == "rs") {
+            (path.file_stem().unwrap_or_default().to_owned(), vec![path])
+        } else {
+            continue;
+        };
+        let ignores = |f: &std::path::PathBuf| {
+            read(f)
+                .lines()
+                .any(|l| l.trim_start().starts_with("#[ignore"))
+        };
+        if sources.iter().any(ignores) {
+            targets.push(name.to_string_lossy().into_owned());
+        }
+    }
+    targets.sort();
+    Ok(targets)
+}
 
 /// The publishable library crates.
 const LIBRARIES: [&str; 6] = [
@@ -196,7 +233,7 @@ fn ci() -> Result<(), String> {
         publishable(),
         cmd::run_all(&TEST),
         cmd::run_all(&DOC_TEST),
-        cmd::run_all(&LONG_TEST),
+        long_test(),
         derive::check(),
         cross::run(),
         qemu::run(),
@@ -210,5 +247,26 @@ fn ci() -> Result<(), String> {
         Ok(())
     } else {
         Err(failures.join("\n"))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    /// The long runs are found where they are: the stress suite (a directory target) and the
+    /// files with an `#[ignore]`d test, not the campaign, whose `ignore` is only a word.
+    #[test]
+    fn long_runs_are_found() -> Result<(), String> {
+        let targets = super::targets_with_ignored(&crate::cmd::project_root().join("tests/tests"))?;
+        for expected in ["stress", "long_run_energy", "fast_trig"] {
+            assert!(
+                targets.iter().any(|t| t == expected),
+                "{expected} in {targets:?}"
+            );
+        }
+        assert!(
+            !targets.iter().any(|t| t == "hostile" || t == "lanes"),
+            "{targets:?}"
+        );
+        Ok(())
     }
 }
