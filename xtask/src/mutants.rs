@@ -79,6 +79,10 @@ const AREAS: [Area; 9] = [
             "origin_pendulum",
             "--test",
             "forces_and_energy",
+            "--test",
+            "step_time",
+            "--test",
+            "lanes",
         ],
     },
     Area {
@@ -103,6 +107,8 @@ const AREAS: [Area; 9] = [
             "implicit",
             "--test",
             "stiff",
+            "--test",
+            "step_time",
         ],
     },
     Area {
