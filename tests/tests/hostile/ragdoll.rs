@@ -21,7 +21,7 @@ use lagrange_systems::{
 };
 
 /// The fields of a [`RagdollBody`], by the path a caller writes.
-const FIELDS: [&str; 16] = [
+pub const FIELDS: [&str; 16] = [
     "torso.mass",
     "torso.length",
     "head.mass",
@@ -64,7 +64,7 @@ fn field<T>(b: &mut RagdollBody<T>, i: usize) -> &mut T {
 
 /// A body: the adult's, some fields drawn (a masses' or lengths' scale drawn for every
 /// segment at once now and then); the fields drawn are the names an error may give.
-fn body<T: Real>(ctx: &mut Ctx) -> (RagdollBody<T>, Vec<&'static str>) {
+pub fn body<T: Real>(ctx: &mut Ctx) -> (RagdollBody<T>, Vec<&'static str>) {
     let mut b = RagdollBody::<T>::adult();
     let mut drawn = Vec::new();
     say!(ctx, "let mut b = RagdollBody::<{}>::adult();", ty::<T>());
@@ -174,7 +174,7 @@ fn contacts<T: Real>(ctx: &mut Ctx, m: &Ragdoll<T>) -> Result<RagdollContacts<T>
     );
     for (j, bounds) in limits.iter_mut().enumerate() {
         for (k, x) in bounds.iter_mut().enumerate() {
-            if ctx.pick(8) == 0 {
+            if ctx.pick(24) == 0 {
                 *x = ctx.value::<T>(Kind::Signed);
                 say!(ctx, "limits[{j}][{k}] = {};", lit(*x));
                 drawn.push(format!("limits[{j}]"));
@@ -225,19 +225,16 @@ where
     ContactStepper<T, N, RAGDOLL_CONTACTS, I, RagdollContacts<T>>: Integrator<T, N, Ragdoll<T>>,
 {
     let c = tryv!(contacts::<T>(ctx, m));
-    let [e, rest, tol] = [
-        ctx.value::<T>(Kind::Tolerance),
-        ctx.value::<T>(Kind::Step),
-        ctx.value::<T>(Kind::Tolerance),
-    ];
-    say!(
-        ctx,
-        "let model = ContactModel::<{}>::new({}, {}, {})?;",
-        ty::<T>(),
-        lit(e),
-        lit(rest),
-        lit(tol)
-    );
+    // Half the time the test's own model (so that the steps get past the setup).
+    let [e, rest, tol] = if ctx.pick(2) == 0 {
+        [0.3, 0.3, 1e-6].map(T::from_f64)
+    } else {
+        [
+            ctx.value::<T>(Kind::Tolerance),
+            ctx.value::<T>(Kind::Step),
+            ctx.value::<T>(Kind::Tolerance),
+        ]
+    };
     let mut model = tryv!(setup(
         ContactModel::new(e, rest, tol),
         &["restitution", "rest_speed", "time_tolerance"]
@@ -247,8 +244,14 @@ where
         say!(ctx, "let model = model.with_friction({})?;", lit(mu));
         model = tryv!(setup(model.with_friction(mu), &["friction"]));
     }
-    let ptol = ctx.value::<T>(Kind::Tolerance);
-    let iters = u32::try_from(ctx.count()).unwrap_or(u32::MAX).min(64);
+    let (ptol, iters) = if ctx.pick(2) == 0 {
+        (T::from_f64(1e-6), 8)
+    } else {
+        (
+            ctx.value::<T>(Kind::Tolerance),
+            u32::try_from(ctx.count()).unwrap_or(u32::MAX).min(16),
+        )
+    };
     say!(
         ctx,
         "let proj = Projection::<{}>::new({}, {iters})?;",
@@ -266,7 +269,7 @@ where
     let mut st = ContactStepper::<T, N, RAGDOLL_CONTACTS, _, _>::new(method, c, model, p);
     let start = doll_state::<T>(ctx, "s0");
     let mut last: Option<State<T, N>> = None;
-    for call in 0..=ctx.pick(4) {
+    for call in 0..=ctx.pick(3) {
         let from = match (ctx.pick(3), last) {
             (0, Some(l)) => {
                 say!(ctx, "let s = last;");
@@ -285,7 +288,7 @@ where
             let r = st.step(m, &from, dt);
             (verdict(&r, &["dt", "state"]), r.ok())
         } else {
-            let n = ctx.count().min(20);
+            let n = ctx.count().min(4);
             say!(ctx, "let last = st.integrate(&m, &s, {}, {n})?;", lit(dt));
             let r = st.integrate(m, &from, dt, n).map_err(|f| f.error);
             (verdict(&r, &["dt", "state", "steps"]), r.ok())
