@@ -27,6 +27,34 @@ const LEFT_LEG: usize = 6;
 /// Right thigh; its shin is `RIGHT_LEG + 1`.
 const RIGHT_LEG: usize = 8;
 
+/// The field of a [`RagdollBody`] that gives each link's mass, by its path (an error names it).
+const MASS_NAMES: [&str; RAGDOLL_LINKS] = [
+    "torso.mass",
+    "head.mass",
+    "upper_arm.mass",
+    "forearm.mass",
+    "upper_arm.mass",
+    "forearm.mass",
+    "thigh.mass",
+    "shin.mass",
+    "thigh.mass",
+    "shin.mass",
+];
+
+/// The field that gives each link's length, likewise.
+const LENGTH_NAMES: [&str; RAGDOLL_LINKS] = [
+    "torso.length",
+    "head.length",
+    "upper_arm.length",
+    "forearm.length",
+    "upper_arm.length",
+    "forearm.length",
+    "thigh.length",
+    "shin.length",
+    "thigh.length",
+    "shin.length",
+];
+
 /// The parent of each link (the torso's entry is unused).
 pub(crate) const PARENT: [usize; RAGDOLL_LINKS] = [0, 0, 0, 2, 0, 4, 0, 6, 0, 8];
 
@@ -289,9 +317,14 @@ impl<T: Real> Ragdoll<T> {
     /// A ragdoll of `body`.
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] naming `mass` or `length` (every segment's: positive and
-    /// finite), `shoulder_width`, `hip_width`, `gravity` or `joint_damping` (zero or
-    /// positive, finite).
+    /// [`Error::InvalidParameter`] naming the field of `body` by its path: `torso.mass`,
+    /// `head.length`, ... (every segment's mass and length: positive and finite),
+    /// `shoulder_width`, `hip_width`, `gravity` or `joint_damping` (zero or positive, finite);
+    /// or the field most responsible when a quantity the motion forms from them leaves the
+    /// range of `T`: a segment's moment of inertia `mass length^2 / 12` (overflow or
+    /// underflow: the recursion divides by it), the total mass, the whole body's moment of
+    /// inertia about the torso (total mass times its reach squared, the reach being the sum of
+    /// the lengths and widths) or its weight times its reach.
     pub fn new(body: RagdollBody<T>) -> Result<Self, Error> {
         let segments = [
             body.torso,
@@ -305,25 +338,68 @@ impl<T: Real> Ragdoll<T> {
             body.thigh,
             body.shin,
         ];
-        for s in segments {
-            validate::positive("mass", s.mass)?;
-            validate::positive("length", s.length)?;
+        for k in 0..RAGDOLL_LINKS {
+            validate::positive(MASS_NAMES[k], segments[k].mass)?;
+            validate::positive(LENGTH_NAMES[k], segments[k].length)?;
         }
         let half_shoulders = validate::non_negative("shoulder_width", body.shoulder_width)?;
         let half_hips = validate::non_negative("hip_width", body.hip_width)?;
-        validate::non_negative("gravity", body.gravity)?;
+        let gravity = validate::non_negative("gravity", body.gravity)?;
         validate::non_negative("joint_damping", body.joint_damping)?;
+        let twelfth = T::from_f64(1.0 / 12.0);
+        let mut inertia = [T::zero(); RAGDOLL_LINKS];
+        for (k, (i, s)) in inertia.iter_mut().zip(&segments).enumerate() {
+            let factors = [(MASS_NAMES[k], s.mass, 1), (LENGTH_NAMES[k], s.length, 2)];
+            *i = validate::divisor(s.mass * s.length * s.length * twelfth, &factors)?;
+        }
+        // The whole body: its mass, its reach (every length and width laid end to end), the
+        // heaviest segment and the longest field, which an overflow of a whole-body quantity
+        // is blamed on.
+        let heaviest = (0..RAGDOLL_LINKS)
+            .max_by(|&a, &b| {
+                segments[a]
+                    .mass
+                    .partial_cmp(&segments[b].mass)
+                    .unwrap_or(Ordering::Equal)
+            })
+            .unwrap_or(TORSO);
+        let heaviest = (MASS_NAMES[heaviest], segments[heaviest].mass, 1);
+        let mut longest = (LENGTH_NAMES[TORSO], body.torso.length);
+        let widths = [
+            ("shoulder_width", body.shoulder_width),
+            ("hip_width", body.hip_width),
+        ];
+        for (name, x) in (0..RAGDOLL_LINKS)
+            .map(|k| (LENGTH_NAMES[k], segments[k].length))
+            .chain(widths)
+        {
+            if x > longest.1 {
+                longest = (name, x);
+            }
+        }
+        let mass_terms: [(&'static str, T, i32); RAGDOLL_LINKS] =
+            core::array::from_fn(|k| (MASS_NAMES[k], segments[k].mass, 1));
+        let total = validate::derived(
+            segments.iter().fold(T::zero(), |a, s| a + s.mass),
+            &mass_terms,
+        )?;
+        let reach = validate::derived(
+            segments.iter().fold(T::zero(), |a, s| a + s.length)
+                + body.shoulder_width
+                + body.hip_width,
+            &[(longest.0, longest.1, 1)],
+        )?;
+        validate::derived(
+            total * reach * reach,
+            &[heaviest, (longest.0, longest.1, 2)],
+        )?;
+        validate::derived(
+            total * gravity * reach,
+            &[heaviest, ("gravity", gravity, 1), (longest.0, longest.1, 1)],
+        )?;
         let (half_shoulders, half_hips) = (half_shoulders * T::HALF, half_hips * T::HALF);
         let mass = segments.map(|s| s.mass);
         let length = segments.map(|s| s.length);
-        let twelfth = T::from_f64(1.0 / 12.0);
-        let inertia = segments.map(|s| s.mass * s.length * s.length * twelfth);
-        if !inertia.iter().all(|i| i.is_finite() && *i > T::zero()) {
-            return Err(Error::InvalidParameter {
-                name: "mass",
-                reason: "each segment's mass length^2 / 12 must be positive and finite",
-            });
-        }
         let half = body.torso.length * T::HALF;
         let at = |link: usize, along: T, across: T| Mark {
             link,

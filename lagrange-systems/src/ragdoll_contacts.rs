@@ -3,7 +3,7 @@
 
 use lagrange_core::constraints::contact::Contacts;
 use lagrange_core::nalgebra::{SMatrix, SVector};
-use lagrange_core::{validate, Constraints, Error, Real};
+use lagrange_core::{entry_names, validate, Constraints, Error, Real};
 
 use crate::ragdoll::{Mark, PARENT, RAGDOLL_COORDINATES as N, RAGDOLL_LINKS};
 use crate::Ragdoll;
@@ -55,20 +55,22 @@ impl<T: Real> RagdollContacts<T> {
     /// `limits` (rad, `[lower, upper]` per joint, in the order of [`ADULT_JOINT_LIMITS`]).
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] `floor` when not finite, `limits` when a bound is not
-    /// finite or a lower bound is not below its upper one.
+    /// [`Error::InvalidParameter`] `floor` when not finite; `limits[j]`, naming the joint,
+    /// when one of its bounds is not finite or its lower bound is not below its upper one.
     pub fn new(
         ragdoll: &Ragdoll<T>,
         floor: T,
         limits: [[T; 2]; RAGDOLL_LINKS - 1],
     ) -> Result<Self, Error> {
+        const LIMITS: [&str; 32] = entry_names!("limits");
         let floor = validate::finite("floor", floor)?;
-        for [lower, upper] in limits {
-            validate::finite("limits", lower)?;
-            validate::finite("limits", upper)?;
+        for (j, [lower, upper]) in limits.into_iter().enumerate() {
+            let name = validate::entry(&LIMITS, j, "limits");
+            validate::finite(name, lower)?;
+            validate::finite(name, upper)?;
             if lower.partial_cmp(&upper) != Some(core::cmp::Ordering::Less) {
                 return Err(Error::InvalidParameter {
-                    name: "limits",
+                    name,
                     reason: "each lower bound must be below its upper bound",
                 });
             }

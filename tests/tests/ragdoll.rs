@@ -9,7 +9,8 @@ use lagrange_core::{Constraints, Error, Lagrangian, Mechanism, Projection, Real,
 use lagrange_integrators::scene::{Bank, Scene, Sleeps, Status};
 use lagrange_integrators::{ContactModel, ContactStepper, Rk4};
 use lagrange_systems::{
-    Ragdoll, RagdollBody, RagdollContacts, Segment, RAGDOLL_CONTACTS, RAGDOLL_COORDINATES as N,
+    Ragdoll, RagdollBody, RagdollContacts, Segment, ADULT_JOINT_LIMITS, RAGDOLL_CONTACTS,
+    RAGDOLL_COORDINATES as N,
 };
 use lagrange_tests::{agrees_with_automatic, for_f32_and_f64, pick, Agreement, Rng, Scales};
 
@@ -271,3 +272,63 @@ fn comes_to_rest_and_sleeps<T: Real>() -> Result<(), Error> {
 }
 
 long_f32_and_f64!(comes_to_rest_and_sleeps);
+
+/// The error names what was wrong.
+fn refuses_naming<V: core::fmt::Debug>(r: Result<V, Error>, name: &str) {
+    assert!(
+        matches!(r, Err(Error::InvalidParameter { name: n, .. }) if n == name),
+        "expected InvalidParameter naming {name}, got {r:?}"
+    );
+}
+
+/// Hostile bodies (issue 15, found by the campaign's `ragdoll` family): an error names the
+/// body's field by its path (it named `mass` or `length`, not which segment's); a segment's
+/// mass of `MAX` was accepted with an infinite total mass (every law call then failed); a
+/// segment whose `mass length^2 / 12` underflows, a reach or a weight that overflows are
+/// refused naming the field most responsible; a joint limit is named by its joint.
+fn hostile_bodies_are_refused_by_field<T: Real>() -> Result<(), Error> {
+    let adult = RagdollBody::<T>::adult();
+    let mut b = adult;
+    b.forearm.length = T::zero();
+    refuses_naming(Ragdoll::new(b), "forearm.length");
+    let mut b = adult;
+    b.thigh.mass = -T::one();
+    refuses_naming(Ragdoll::new(b), "thigh.mass");
+    let mut b = adult;
+    b.head.mass = T::from_f64(f64::NAN);
+    refuses_naming(Ragdoll::new(b), "head.mass");
+    let mut b = adult;
+    b.thigh.mass = T::MAX;
+    refuses_naming(Ragdoll::new(b), "thigh.mass");
+    let mut b = adult;
+    b.upper_arm.mass = T::MAX / T::from_f64(4.0);
+    b.torso.mass = T::MAX / T::from_f64(4.0);
+    assert!(Ragdoll::new(b).is_err());
+    let mut b = adult;
+    b.shin.mass = T::MIN_POSITIVE;
+    refuses_naming(Ragdoll::new(b), "shin.mass");
+    let mut b = adult;
+    b.shoulder_width = T::MAX;
+    refuses_naming(Ragdoll::new(b), "shoulder_width");
+    let mut b = adult;
+    b.gravity = T::MAX;
+    refuses_naming(Ragdoll::new(b), "gravity");
+    let mut b = adult;
+    b.joint_damping = -T::one();
+    refuses_naming(Ragdoll::new(b), "joint_damping");
+    let doll = Ragdoll::new(adult)?;
+    assert!(doll.total_mass().is_finite());
+    let mut limits = ADULT_JOINT_LIMITS.map(|l| l.map(T::from_f64));
+    limits[4] = [T::one(), T::zero()];
+    refuses_naming(RagdollContacts::new(&doll, T::zero(), limits), "limits[4]");
+    limits[4] = [T::zero(), T::from_f64(f64::INFINITY)];
+    refuses_naming(RagdollContacts::new(&doll, T::zero(), limits), "limits[4]");
+    limits[4] = [T::zero(), T::one()];
+    refuses_naming(
+        RagdollContacts::new(&doll, T::from_f64(f64::NAN), limits),
+        "floor",
+    );
+    Ok(())
+}
+
+for_f32_and_f64!(hostile_bodies_are_refused_by_field);

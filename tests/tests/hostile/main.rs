@@ -30,6 +30,7 @@ mod drivers;
 mod exact;
 mod fixed_step;
 mod harness;
+mod ragdoll;
 mod scenes;
 mod systems;
 mod values;
@@ -87,6 +88,7 @@ fn main() -> ExitCode {
         adaptive::family(),
         drivers::family(),
         scenes::family(),
+        ragdoll::family(),
     ];
     let reports = harness::run(families, &cfg);
     println!();

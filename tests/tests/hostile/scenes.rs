@@ -18,13 +18,16 @@ use crate::checks::{refused, state, vector, verdict};
 use crate::harness::{lit, lits, ty, Ctx, Entry, Family, Verdict};
 use crate::values::Kind;
 use crate::{entries, say};
+use lagrange_core::Projection;
 use lagrange_core::{Error, Forced, Input, Lanes, Mechanism, Real, Scalar, State};
 use lagrange_integrators::scene::{Bank, Id, NeverSleeps, Scene, Sleep, Sleeps, Status};
+use lagrange_integrators::{ContactModel, ContactStepper};
 use lagrange_integrators::{
     FrameClock, Integrator, NewtonSettings, Rk4, SemiImplicitEuler, StormerVerlet,
 };
 use lagrange_systems::{
-    Acrobot, CartPole, DoublePendulum, FallingParticle, SimplePendulum, SpringMassDamper,
+    Acrobot, CartPole, DoublePendulum, FallingParticle, Ragdoll, RagdollBody, RagdollContacts,
+    SimplePendulum, SpringMassDamper, RAGDOLL_CONTACTS, RAGDOLL_COORDINATES,
 };
 use std::fmt::Debug;
 
@@ -820,6 +823,49 @@ bank_case!(particles_euler, FallingParticle, 1, euler, never, true);
 bank_case!(driven_stormer, Driven, 1, stormer1, never, false);
 bank_case!(driven_rk4, Driven, 1, rk4, sleeps, true);
 
+/// A ragdoll of a drawn body (fields left at the adult's or drawn, as in the `ragdoll`
+/// family); an error may name any of the body's fields.
+impl<T: Real> Piece<T, RAGDOLL_COORDINATES> for Ragdoll<T> {
+    fn draw(ctx: &mut Ctx) -> (Result<Self, Error>, &'static [&'static str]) {
+        let (b, _) = crate::ragdoll::body::<T>(ctx);
+        say!(ctx, "let m = Ragdoll::new(b)?;");
+        (Ragdoll::new(b), &crate::ragdoll::FIELDS)
+    }
+}
+
+/// A contact stepper over `Rk4` for the adult's floor at zero and joint limits, with the
+/// ragdoll test's model and projection.
+type DollStepper<T> =
+    ContactStepper<T, RAGDOLL_COORDINATES, RAGDOLL_CONTACTS, Rk4, RagdollContacts<T>>;
+
+fn doll_stepper<T: Real>(ctx: &mut Ctx) -> (DollStepper<T>, String) {
+    let adult = RagdollBody::<T>::adult();
+    let made = Ragdoll::new(adult).and_then(|doll| {
+        Ok(ContactStepper::new(
+            Rk4,
+            RagdollContacts::adult(&doll, T::zero())?,
+            ContactModel::new(T::from_f64(0.3), T::from_f64(0.3), T::from_f64(1e-6))?
+                .with_friction(T::from_f64(0.8))?,
+            Projection::new(T::from_f64(1e-6), 8)?,
+        ))
+    });
+    let Ok(stepper) = made else {
+        unreachable!("the adult's stepper is valid");
+    };
+    say!(ctx, "let stepper = ContactStepper::new(Rk4, RagdollContacts::adult(&Ragdoll::new(RagdollBody::adult())?, 0.0)?, ContactModel::new(0.3, 0.3, 1e-6)?.with_friction(0.8)?, Projection::new(1e-6, 8)?);");
+    (stepper, "stepper".into())
+}
+
+fn ragdolls_contacts<T: Real>(ctx: &mut Ctx) -> Verdict {
+    let kit: Kit<T, RAGDOLL_COORDINATES, Ragdoll<T>, _, Sleeps<T>> = Kit {
+        integrator: doll_stepper::<T>,
+        sleep: rule::<T>,
+        asleep: Some(|b, m, q| b.add_asleep(m, q)),
+        stateless: false,
+    };
+    session(ctx, &kit)
+}
+
 /// Adds up to `K` drawn instances to `bank` (refusals by name only).
 fn fill<T, const N: usize, M, I, Z>(
     ctx: &mut Ctx,
@@ -1139,6 +1185,12 @@ pub fn family() -> Family {
         0.7,
         "Scene of banks: (Bank, Bank, Bank), [Bank; 2], (&mut Bank, &mut Bank)",
         many_banks
+    );
+    entries!(
+        v,
+        0.5,
+        "Scene<Bank<Ragdoll, ContactStepper<Rk4, RagdollContacts>, Sleeps>>",
+        ragdolls_contacts
     );
     entries!(v, 0.5, "Lanes, sin_cos_lanes (no error channel)", lanes);
     Family {
