@@ -175,44 +175,43 @@ impl<T: Real, const N: usize> NLinkPendulum<T, N> {
         // mu_j and its blame: the masses from j on.
         let mut mu = masses;
         let mut below = T::zero();
-        for (j, m) in mu.iter_mut().enumerate().rev() {
+        for (j, (m, &length)) in mu.iter_mut().zip(&lengths).enumerate().rev() {
             below += *m;
             *m = below;
             // A sum overflows through its largest term.
-            let largest = (j..N).fold(j, |a, i| if masses[i] > masses[a] { i } else { a });
-            let heaviest = (mass_name(largest), masses[largest], 1);
+            let (largest, largest_mass) = largest_from(&masses, j);
+            let heaviest = (mass_name(largest), largest_mass, 1);
             validate::derived(below, &[heaviest])?;
-            let l = (length_name(j), lengths[j], 2);
-            validate::derived(below * lengths[j] * lengths[j], &[heaviest, l])?;
-            let l1 = (length_name(j), lengths[j], 1);
-            validate::derived(gravity * below * lengths[j], &[g, heaviest, l1])?;
+            let l = (length_name(j), length, 2);
+            validate::derived(below * length * length, &[heaviest, l])?;
+            let l1 = (length_name(j), length, 1);
+            validate::derived(gravity * below * length, &[g, heaviest, l1])?;
         }
         let mut total_length = T::zero();
-        let mut longest = 0;
+        let (mut longest, mut longest_length) = (0, T::zero());
+        let mut previous: Option<(usize, T)> = None;
         for (j, (m, l)) in masses.iter().zip(&lengths).enumerate() {
             validate::divisor(*m, &[(mass_name(j), *m, 1)])?;
             validate::divisor(*l, &[(length_name(j), *l, 1)])?;
             validate::derived(*m * gravity, &[(mass_name(j), *m, 1), g])?;
-            if j > 0 {
-                let pair = [
-                    (mass_name(j), *m, -1),
-                    (mass_name(j - 1), masses[j - 1], -1),
-                ];
-                validate::derived(m.recip() + masses[j - 1].recip(), &pair)?;
+            if let Some((i, before)) = previous {
+                let pair = [(mass_name(j), *m, -1), (mass_name(i), before, -1)];
+                validate::derived(m.recip() + before.recip(), &pair)?;
             }
-            if *l > lengths[longest] {
-                longest = j;
+            previous = Some((j, *m));
+            if *l > longest_length {
+                (longest, longest_length) = (j, *l);
             }
             total_length += *l;
-            validate::derived(total_length, &[(length_name(longest), lengths[longest], 1)])?;
+            validate::derived(total_length, &[(length_name(longest), longest_length, 1)])?;
         }
-        let heaviest = (0..N).fold(0, |a, i| if masses[i] > masses[a] { i } else { a });
+        let (heaviest, heaviest_mass) = largest_from(&masses, 0);
         validate::derived(
             gravity * below * total_length,
             &[
                 g,
-                (mass_name(heaviest), masses[heaviest], 1),
-                (length_name(longest), lengths[longest], 1),
+                (mass_name(heaviest), heaviest_mass, 1),
+                (length_name(longest), longest_length, 1),
             ],
         )?;
         let inv_masses = masses.map(T::recip);
@@ -457,4 +456,23 @@ impl<T: Real, const N: usize> Lagrangian<T, N> for NLinkPendulum<T, N> {
         }
         v
     }
+}
+
+/// The largest of `values[from..]` (positive) and its index, the first of equals: by
+/// iteration, so that a constructor holds no bounds check (the panic-free firmware image).
+fn largest_from<T: Real>(values: &[T], from: usize) -> (usize, T) {
+    values
+        .iter()
+        .enumerate()
+        .skip(from)
+        .fold(
+            (from, T::zero()),
+            |(a, va), (i, &v)| {
+                if v > va {
+                    (i, v)
+                } else {
+                    (a, va)
+                }
+            },
+        )
 }

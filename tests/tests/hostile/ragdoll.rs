@@ -357,13 +357,18 @@ pub fn family() -> Family {
     entries!(v, 0.6, "Ragdoll::new", constructor);
     entries!(v, 1.0, "Ragdoll methods", ragdoll);
     entries!(v, 0.6, "RagdollContacts rows", ragdoll_contacts);
-    entries!(v, 0.5, "ContactStepper<Rk4, RagdollContacts>", stepper_rk4);
-    entries!(
-        v,
-        0.5,
-        "ContactStepper<StormerVerlet, RagdollContacts>",
-        stepper_verlet
-    );
+    // The contact runs only optimised (`cargo xtask fuzz`): unoptimised, one ragdoll step that
+    // spends its events before it fails takes up to 43 s, near the 60 s deadline of the short
+    // run in `cargo test`, and the run as a whole a minute and a half more.
+    if !cfg!(debug_assertions) {
+        entries!(v, 0.5, "ContactStepper<Rk4, RagdollContacts>", stepper_rk4);
+        entries!(
+            v,
+            0.5,
+            "ContactStepper<StormerVerlet, RagdollContacts>",
+            stepper_verlet
+        );
+    }
     Family {
         name: "ragdoll",
         entries: v,

@@ -1186,12 +1186,15 @@ pub fn family() -> Family {
         "Scene of banks: (Bank, Bank, Bank), [Bank; 2], (&mut Bank, &mut Bank)",
         many_banks
     );
-    entries!(
-        v,
-        0.5,
-        "Scene<Bank<Ragdoll, ContactStepper<Rk4, RagdollContacts>, Sleeps>>",
-        ragdolls_contacts
-    );
+    // Optimised only, as the ragdoll family's contact runs (see there).
+    if !cfg!(debug_assertions) {
+        entries!(
+            v,
+            0.5,
+            "Scene<Bank<Ragdoll, ContactStepper<Rk4, RagdollContacts>, Sleeps>>",
+            ragdolls_contacts
+        );
+    }
     entries!(v, 0.5, "Lanes, sin_cos_lanes (no error channel)", lanes);
     Family {
         name: "scenes",
