@@ -51,8 +51,6 @@ pub struct ElasticPendulum<T: Real> {
     stiffness: T,
     rest_length: T,
     gravity: T,
-    /// `k / m`, 1/s^2: the law's spring term per unit mass, kept so that the law multiplies.
-    k_over_m: T,
 }
 
 impl<T: Real> ElasticPendulum<T> {
@@ -61,7 +59,7 @@ impl<T: Real> ElasticPendulum<T> {
     ///
     /// # Errors
     /// [`Error::InvalidParameter`] naming the first parameter out of range or not finite, or
-    /// the one most responsible when `1 / m`, `k / m` or the weight `m g` overflows.
+    /// the one most responsible when `1 / m` or the weight `m g` overflows.
     pub fn new(mass: T, stiffness: T, rest_length: T, gravity: T) -> Result<Self, Error> {
         let mass = validate::positive("mass", mass)?;
         let stiffness = validate::positive("stiffness", stiffness)?;
@@ -72,16 +70,11 @@ impl<T: Real> ElasticPendulum<T> {
             mass * gravity,
             &[("mass", mass, 1), ("gravity", gravity, 1)],
         )?;
-        let k_over_m = validate::derived(
-            stiffness / mass,
-            &[("stiffness", stiffness, 1), ("mass", mass, -1)],
-        )?;
         Ok(Self {
             mass,
             stiffness,
             rest_length,
             gravity,
-            k_over_m,
         })
     }
     /// Mass, kg.
@@ -106,20 +99,6 @@ impl<T: Real> ElasticPendulum<T> {
     }
 }
 
-/// Why the law refuses `s` (off the hot path): [`Error::NonFiniteState`] when `s` holds NaN or
-/// infinity, else [`Error::Singularity`] (`r <= 0`, `m r^2` underflowing, or `q''`
-/// overflowing), as [`Mechanism::solve_mass`] reports them.
-#[cold]
-#[inline(never)]
-fn refusal<T: Real>(s: &State<T, 2>) -> Error {
-    match positive_radius(s, SPRING_COLLAPSED) {
-        Err(e) => e,
-        Ok(()) => Error::Singularity {
-            what: SPRING_COLLAPSED,
-        },
-    }
-}
-
 impl<T: Real> Mechanism<T, 2> for ElasticPendulum<T> {
     fn mass_matrix(&self, s: &State<T, 2>) -> Matrix2<T> {
         let r = s.q[0];
@@ -141,13 +120,8 @@ impl<T: Real> Mechanism<T, 2> for ElasticPendulum<T> {
         positive_radius(s, SPRING_COLLAPSED)?;
         solve_diagonal2(s, [self.mass, self.mass * r * r], b, SPRING_COLLAPSED)
     }
-    /// Without an extra force, the closed form
-    /// `r'' = r th'^2 + g cos th - (k / m) (r - l0)`, `th'' = -(2 r' th' + g sin th) / r`
-    /// (`M^-1 f` with the masses cancelled), tested once: `r > 0`, `m r^2 > 0` and both
-    /// accelerations finite (a state with NaN or infinity makes an acceleration so), and only
-    /// when that fails are the causes told apart, as the mass solve tells them. With an extra
-    /// force, the default law, `M^-1 (f + Q + extra)`. Inlined into the integrators' stages:
-    /// out of line, the call and the result passed through memory kept the RK4 step above the
+    /// The default law, `M^-1 (f + Q + extra)`, inlined into the integrators' stages: out of
+    /// line, the call and the result passed through memory kept the RK4 step above the
     /// hand-written loop's (as for [`DoublePendulum`](crate::DoublePendulum)).
     #[inline(always)]
     fn law<F: GeneralizedForce<T, 2>>(
@@ -155,25 +129,8 @@ impl<T: Real> Mechanism<T, 2> for ElasticPendulum<T> {
         s: &State<T, 2>,
         extra: &F,
     ) -> Result<SVector<T, 2>, Error> {
-        if !F::IS_ZERO {
-            let b = self.rhs(s) + self.non_conservative_force(s);
-            return self.solve_mass(s, &extra.added_to(s, b));
-        }
-        let (r, rd, thd) = (s.q[0], s.qd[0], s.qd[1]);
-        let (sin, cos) = s.q[1].sin_cos();
-        let g = self.gravity;
-        let a = Vector2::new(
-            r * thd * thd + g * cos - self.k_over_m * (r - self.rest_length),
-            -(T::TWO * rd * thd + g * sin) / r,
-        );
-        // `&`, not `&&`: one branch for the four conditions.
-        let ok =
-            (r > T::zero()) & (self.mass * r * r > T::zero()) & a[0].is_finite() & a[1].is_finite();
-        if ok {
-            Ok(a)
-        } else {
-            Err(refusal(s))
-        }
+        let b = self.rhs(s) + self.non_conservative_force(s);
+        self.solve_mass(s, &extra.added_to(s, b))
     }
     fn law_force<F: GeneralizedForce<T, 2>>(
         &self,

@@ -407,7 +407,7 @@ impl<T: Real, const N: usize> Mechanism<T, N> for NLinkPendulum<T, N> {
         self.tension_solve((sin, cos), &SVector::zeros(), (px, py))
     }
 
-    /// The closed form: the tension recursion under gravity alone ([`Self::falling`]), plus
+    /// The closed form: the tension recursion under gravity alone (`falling`), plus
     /// `M^-1` of the extra force when there is one.
     #[inline]
     fn law<F: GeneralizedForce<T, N>>(
