@@ -12,7 +12,7 @@
 //! `DoublePendulum` does: the comparison measures the library's overhead, not two trig
 //! routines.
 
-use super::problem::HandRhs;
+use super::hand_rhs::HandRhs;
 use lagrange_core::{Real, Scalar, State};
 
 /// Stamps out `pendulum_$t`: RK4 on `th'' = -w2 sin th`.

@@ -20,6 +20,7 @@ mod budgets;
 mod chain_cost;
 mod counting;
 mod engine_overhead;
+mod hand_rhs;
 mod hand_rk4;
 mod method;
 mod ode_peer;

@@ -4,8 +4,8 @@
 //! library measures the solvers alone. The bench's method for them is
 //! [`OdeSolvers`](super::method::OdeSolvers).
 
+use super::hand_rhs::HandRhs;
 use super::outcome::{Observer, Outcome};
-use super::problem::HandRhs;
 use lagrange_core::nalgebra as na;
 use lagrange_core::{Error, Real, Scalar, State};
 use ode_solvers::dop_shared::FloatNumber;

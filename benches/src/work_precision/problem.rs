@@ -1,6 +1,7 @@
 //! The [`Problem`] contract of the bench: a mechanism, a start, a span, a reference final state
 //! and the energy convention of `shared/BENCH_PROBLEMS.md`.
 
+pub use super::hand_rhs::HandRhs;
 use super::real::BenchReal;
 use lagrange_core::{Error, Mechanism, State};
 
@@ -13,15 +14,6 @@ pub struct Reference<const N: usize> {
     pub source: String,
     /// Its own error (max norm over coordinates and rates), as published or as estimated.
     pub error: f64,
-}
-
-/// A problem's equations of motion written by hand on plain arrays, as a user of another
-/// solver writes them: the accelerations `q''` at `(t, q, q')`, with no `Result`, no trait
-/// of the library and no checks. `ode_solvers` runs on it, so that a comparison with the
-/// library measures the solvers alone, and the generic hand-written RK4 loop steps it.
-pub trait HandRhs<T, const N: usize> {
-    /// Writes `q''` at `(t, q, q')` into `qdd`.
-    fn accelerations(&self, t: T, q: &[T; N], qd: &[T; N], qdd: &mut [T; N]);
 }
 
 /// A standard problem of `N` degrees of freedom (`N2 = 2 N` state components, spelled out

@@ -1,9 +1,9 @@
 //! [`BenchReal`]: the two precisions the bench runs in, with what every runner needs of them.
 
+use super::hand_rhs::HandRhs;
 use super::hand_rk4;
 use super::ode_peer::{self, OdeReal, Peer};
 use super::outcome::{Observer, Outcome};
-use super::problem::HandRhs;
 use lagrange_core::{Real, State};
 
 /// `f32` or `f64`: a library scalar that `ode_solvers` also accepts, with the hand-written RK4
