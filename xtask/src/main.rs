@@ -28,6 +28,8 @@
 //! - `web`: the interactive page, the library compiled to WebAssembly, written to
 //!   `target/lagrange-web/` and served on 127.0.0.1 (`--no-serve`: build only; `--test`: drive
 //!   it in headless Chromium and compare its scenario's bits with the host's and QEMU's).
+//! - `publish`: the library crates' docs (rustdoc warnings denied) and packages, each verified
+//!   against the others' packaged files.
 //! - `ci`: format check, clippy with `-D warnings`, the library crates' docs (warnings denied)
 //!   and packages, test, `derive --check`, cross, qemu, web --test.
 
@@ -38,6 +40,7 @@ mod demo;
 mod derive;
 mod fuzz;
 mod mutants;
+mod publish;
 mod qemu;
 mod trig_fit;
 mod venv;
@@ -57,6 +60,7 @@ fn main() -> ExitCode {
         "derive" => derive::run(&std::env::args().skip(2).collect::<Vec<_>>()),
         "fuzz" => fuzz::run(&std::env::args().skip(2).collect::<Vec<_>>()),
         "web" => web::run(&std::env::args().skip(2).collect::<Vec<_>>()),
+        "publish" => publish::run(),
         "ci" => ci(),
         "trig-fit" => trig_fit::run(),
         _ => {
@@ -199,38 +203,11 @@ fn targets_with_ignored(dir: &std::path::Path) -> Result<Vec<String>, String> {
     Ok(targets)
 }
 
-/// The publishable library crates.
-const LIBRARIES: [&str; 6] = [
-    "-p",
-    "lagrange-core",
-    "-p",
-    "lagrange-integrators",
-    "-p",
-    "lagrange-systems",
-];
-
-/// The library crates' documentation, every feature on, with rustdoc's warnings denied; and
-/// their packages, each built from its packaged files against the others'.
-fn publishable() -> Result<(), String> {
-    let doc = cmd::run(
-        cmd::cargo()
-            .env("RUSTDOCFLAGS", "-D warnings")
-            .args(["doc", "--quiet", "--no-deps", "--all-features"])
-            .args(LIBRARIES),
-    );
-    let package = cmd::run(
-        cmd::cargo()
-            .args(["package", "--quiet", "--allow-dirty"])
-            .args(LIBRARIES),
-    );
-    doc.and(package)
-}
-
 /// Everything CI checks; every step runs and every failure is reported at the end.
 fn ci() -> Result<(), String> {
     let failures: Vec<String> = [
         cmd::run_all(&CHECKS),
-        publishable(),
+        publish::run(),
         cmd::run_all(&TEST),
         cmd::run_all(&DOC_TEST),
         long_test(),
