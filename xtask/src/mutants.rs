@@ -83,6 +83,8 @@ const AREAS: [Area; 9] = [
             "step_time",
             "--test",
             "lanes",
+            "--test",
+            "work_counts",
         ],
     },
     Area {
@@ -109,6 +111,8 @@ const AREAS: [Area; 9] = [
             "stiff",
             "--test",
             "step_time",
+            "--test",
+            "work_counts",
         ],
     },
     Area {
@@ -121,7 +125,16 @@ const AREAS: [Area; 9] = [
             "lagrange-integrators/src/adaptive/controller.rs",
         ],
         only: None,
-        tests: &["--test", "adaptive", "--test", "driven", "--test", "kepler"],
+        tests: &[
+            "--test",
+            "adaptive",
+            "--test",
+            "driven",
+            "--test",
+            "kepler",
+            "--test",
+            "work_counts",
+        ],
     },
     Area {
         name: "impacts",

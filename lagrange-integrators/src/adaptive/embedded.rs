@@ -336,6 +336,8 @@ where
         s: &State<T, N>,
     ) -> Result<SVector<T, N>, Error> {
         self.stats.evaluations += 1;
+        // Counted apart from the statistics, which a fresh start zeroes midway through a call.
+        self.work.evaluations = self.work.evaluations.saturating_add(1);
         m.acceleration(s)
     }
 
@@ -580,11 +582,8 @@ where
     pub(super) fn call<V, E>(&mut self, f: impl FnOnce(&mut Self) -> Result<V, E>) -> Result<V, E> {
         self.work = Work::default();
         self.guarded = true;
-        let evaluations = self.stats.evaluations;
         let result = f(self);
         self.guarded = false;
-        let done = self.stats.evaluations.saturating_sub(evaluations);
-        self.work.evaluations = u32::try_from(done).unwrap_or(u32::MAX);
         if let Some((run, stages)) = self.backup.take() {
             if result.is_err() {
                 self.state = run.state;
