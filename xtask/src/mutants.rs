@@ -54,6 +54,10 @@ struct Area {
     only: Option<&'static str>,
     /// Arguments of `cargo test -p lagrange-tests` for each mutant: the test binaries to run.
     tests: &'static [&'static str],
+    /// Also run the mutated package's own unit tests (`--lib`): for private kernels tested
+    /// where they live (the step-size controller's `log2` and `exp2`). Costs a second build
+    /// of the mutated crate per mutant.
+    unit_tests: bool,
 }
 
 /// The areas, in the order they run.
@@ -86,6 +90,7 @@ const AREAS: [Area; 9] = [
             "--test",
             "work_counts",
         ],
+        unit_tests: false,
     },
     Area {
         name: "implicit",
@@ -114,6 +119,7 @@ const AREAS: [Area; 9] = [
             "--test",
             "work_counts",
         ],
+        unit_tests: false,
     },
     Area {
         name: "adaptive",
@@ -135,6 +141,7 @@ const AREAS: [Area; 9] = [
             "--test",
             "work_counts",
         ],
+        unit_tests: true,
     },
     Area {
         name: "impacts",
@@ -153,6 +160,7 @@ const AREAS: [Area; 9] = [
             "--test",
             "friction",
         ],
+        unit_tests: false,
     },
     Area {
         name: "constraints",
@@ -181,6 +189,7 @@ const AREAS: [Area; 9] = [
             "--test",
             "constraints_three_rows",
         ],
+        unit_tests: false,
     },
     Area {
         name: "fast-trig",
@@ -195,6 +204,7 @@ const AREAS: [Area; 9] = [
             "--test",
             "lanes",
         ],
+        unit_tests: false,
     },
     Area {
         name: "systems-one",
@@ -207,6 +217,7 @@ const AREAS: [Area; 9] = [
         ],
         only: Some(ACCELERATIONS),
         tests: SYSTEM_TESTS,
+        unit_tests: false,
     },
     Area {
         name: "systems-two",
@@ -223,6 +234,7 @@ const AREAS: [Area; 9] = [
         ],
         only: Some(ACCELERATIONS),
         tests: SYSTEM_TESTS,
+        unit_tests: false,
     },
     Area {
         name: "systems-chains",
@@ -248,6 +260,7 @@ const AREAS: [Area; 9] = [
             "--test",
             "cartesian_pendulum",
         ],
+        unit_tests: false,
     },
 ];
 
@@ -379,14 +392,17 @@ pub fn run(args: &[String]) -> Result<(), String> {
             // cargo-mutants' own baseline runs the area's tests in the mutated package, where
             // they are not: this is the baseline instead, and must pass for the run to mean
             // anything (a mutant that fails tests that already fail is not killed by them).
-            cmd::run(
-                cmd::cargo()
-                    .env("CARGO_PROFILE_DEV_DEBUG", "0")
-                    .env("CARGO_PROFILE_DEV_OPT_LEVEL", "1")
-                    .args(["test", "--quiet", "-p", "lagrange-tests"])
-                    .args(area.tests),
-            )
-            .map_err(|e| format!("area {}: the unmutated tests fail: {e}", area.name))?;
+            let mut baseline = cmd::cargo();
+            baseline
+                .env("CARGO_PROFILE_DEV_DEBUG", "0")
+                .env("CARGO_PROFILE_DEV_OPT_LEVEL", "1")
+                .args(["test", "--quiet", "-p", "lagrange-tests"])
+                .args(area.tests);
+            if area.unit_tests {
+                baseline.args(["-p", area.package, "--lib"]);
+            }
+            cmd::run(&mut baseline)
+                .map_err(|e| format!("area {}: the unmutated tests fail: {e}", area.name))?;
             // A surviving mutant is a finding, not a failure of the command: the report says.
             let status = cmd::run(&mut mutants_command(area, &out, &o, false));
             println!(
@@ -420,6 +436,9 @@ fn mutants_command(area: &Area, out: &Path, o: &Options, list: bool) -> Command 
         return c;
     }
     c.args(["--test-package", "lagrange-tests", "--jobs", &o.jobs]);
+    if area.unit_tests {
+        c.args(["--test-package", area.package, "--cargo-arg=--lib"]);
+    }
     c.args([
         "--timeout",
         TEST_TIMEOUT_S,
