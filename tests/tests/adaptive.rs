@@ -543,3 +543,52 @@ fn pick_rtols<T: Real>(f32: &'static [f64], f64: &'static [f64]) -> &'static [f6
 }
 
 for_f32_and_f64!(dopri5_held_to_its_tolerance, dop853_held_to_its_tolerance);
+
+/// A step from a state set from outside starts afresh: with the first step size fixed by the
+/// settings, an integrator that has run elsewhere (its controller holding the history of
+/// that run) gives, bit for bit, what a new one gives. Both pairs, f32 and f64.
+fn fresh_start_forgets<T: Real, const S: usize, const R: usize, P: EmbeddedPair<S, R>>(
+) -> Result<(), Error> {
+    let m = SimplePendulum::new(T::one(), T::one(), T::from_f64(G), T::from_f64(0.2))?;
+    let settings = AdaptiveSettings::new(T::from_f64(1e-5), T::from_f64(1e-7))?
+        .with_initial_step(T::from_f64(0.3))?;
+    let dt = T::from_f64(0.3);
+    let mut used = EmbeddedRungeKutta::<T, 1, S, R, P>::new(settings);
+    let mut s = State::new(T::zero(), [T::from_f64(2.5)], [T::from_f64(1.0)]);
+    for _ in 0..10 {
+        s = lagrange_integrators::Integrator::step(&mut used, &m, &s, dt)?;
+    }
+    let mut new = EmbeddedRungeKutta::<T, 1, S, R, P>::new(settings);
+    let outside = State::new(T::from_f64(4.0), [T::from_f64(-0.4)], [T::from_f64(0.3)]);
+    let (mut a, mut b) = (outside, outside);
+    for k in 0..10 {
+        a = lagrange_integrators::Integrator::step(&mut used, &m, &a, dt)?;
+        b = lagrange_integrators::Integrator::step(&mut new, &m, &b, dt)?;
+        assert_eq!(a, b, "step {k} after the fresh start");
+        assert_eq!(used.step_size(), new.step_size(), "step {k}: step size");
+    }
+    Ok(())
+}
+
+fn fresh_starts_forget<T: Real>() -> Result<(), Error> {
+    fresh_start_forgets::<T, 7, 1, lagrange_integrators::Dopri5Pair>()?;
+    fresh_start_forgets::<T, 16, 4, lagrange_integrators::Dop853Pair>()
+}
+
+/// A last step shortened to land on `t_end` leaves the proposal it was shortened from: from a
+/// first step of 0.1 fixed by the settings, landing at 1e-3 takes one step of 1e-3 (its error
+/// far inside the tolerance) and the next call tries 0.1 again, not ten times 1e-3.
+fn landing_keeps_the_step<T: Real>() -> Result<(), Error> {
+    let m = SimplePendulum::new(T::one(), T::one(), T::from_f64(G), T::zero())?;
+    let h0 = T::from_f64(0.1);
+    let settings =
+        AdaptiveSettings::new(T::from_f64(1e-4), T::from_f64(1e-6))?.with_initial_step(h0)?;
+    let mut dp = DormandPrince54::new(settings);
+    let end = dp.integrate_to(&m, &State::at_rest([T::from_f64(0.5)]), T::from_f64(1e-3))?;
+    assert_eq!(end.t, T::from_f64(1e-3));
+    assert_eq!(dp.statistics().accepted, 1);
+    assert_eq!(dp.step_size(), h0, "the step after the landing");
+    Ok(())
+}
+
+for_f32_and_f64!(fresh_starts_forget, landing_keeps_the_step);
