@@ -286,8 +286,10 @@ const SYSTEM_TESTS: &[&str] = &[
 ];
 
 /// The outcome classes of `cargo-mutants`, by the file it lists them in.
-const OUTCOMES: [(&str, Outcome); 4] = [
+const OUTCOMES: [(&str, Outcome); 5] = [
     ("caught.txt", Outcome::Killed),
+    // With `--iterate`: the mutants an earlier run caught, not run again.
+    ("previously_caught.txt", Outcome::Killed),
     ("missed.txt", Outcome::Survived),
     ("timeout.txt", Outcome::TimedOut),
     ("unviable.txt", Outcome::Unviable),
