@@ -597,3 +597,90 @@ fn landing_keeps_the_step<T: Real>() -> Result<(), Error> {
 }
 
 for_f32_and_f64!(fresh_starts_forget, landing_keeps_the_step);
+
+/// Hairer's first step (`hinit` of DOPRI5 and DOP853; Hairer, Norsett and Wanner, Solving
+/// ODEs I, II.4), computed here from its published recipe for `y = (q, q')`: norms
+/// `||x|| = sqrt(mean (x_i / (atol + rtol |y0_i|))^2)`, `d0 = ||y0||`, `d1 = ||f(y0)||`,
+/// `h0 = 0.01 d0 / d1` (1e-6 when either is below 1e-5), `d2 = ||f(y0 + h0 f(y0)) - f(y0)|| /
+/// h0`, `h1 = (0.01 / max(d1, d2))^(1/p)` (`max(1e-6, 1e-3 h0)` when that max is below 1e-15),
+/// `h = min(100 h0, h1)`.
+fn hairer_first_step(
+    m: &SimplePendulum<f64>,
+    y0: &State<f64, 1>,
+    rtol: f64,
+    atol: f64,
+    p: u32,
+) -> Result<f64, Error> {
+    let f = |s: &State<f64, 1>| -> Result<[f64; 2], Error> { Ok([s.qd[0], m.acceleration(s)?[0]]) };
+    let scale = [atol + rtol * y0.q[0].abs(), atol + rtol * y0.qd[0].abs()];
+    let norm =
+        |x: [f64; 2]| ((x[0] / scale[0]).powi(2) + (x[1] / scale[1]).powi(2)).sqrt() / 2f64.sqrt();
+    let f0 = f(y0)?;
+    let (d0, d1) = (norm([y0.q[0], y0.qd[0]]), norm(f0));
+    let h0 = if d0 < 1e-5 || d1 < 1e-5 {
+        1e-6
+    } else {
+        0.01 * d0 / d1
+    };
+    let euler = State::new(y0.t + h0, [y0.q[0] + h0 * f0[0]], [y0.qd[0] + h0 * f0[1]]);
+    let f1 = f(&euler)?;
+    let d2 = norm([f1[0] - f0[0], f1[1] - f0[1]]) / h0;
+    let big = d1.max(d2);
+    let h1 = if big <= 1e-15 {
+        (1e-3 * h0).max(1e-6)
+    } else {
+        (0.01 / big).powf(1.0 / f64::from(p))
+    };
+    Ok((100.0 * h0).min(h1))
+}
+
+/// The first step each pair tries is Hairer's (above), from a swinging state, from rest
+/// away from the bottom, and from rest at the bottom (`d0 = 0`: the fallback `h0`); read as
+/// the step size after landing 1e-9 s later, which keeps the step it was shortened from.
+/// A fresh start from a state set from outside tries the step the last run proposed, not a
+/// new estimate. Agreement to 1e-12 relative (the same formula in another order of
+/// operations).
+#[test]
+fn first_step_is_hairers() -> Result<(), Error> {
+    let damped = SimplePendulum::new(1.0, 1.0, G, 0.3)?;
+    // Short and undamped, through the bottom: f changes faster than its size (d2 > d1).
+    let short = SimplePendulum::new(1.0, 0.01, G, 0.0)?;
+    let (rtol, atol) = (1e-6, 1e-8);
+    let settings = AdaptiveSettings::new(rtol, atol)?;
+    for (m, y0) in [
+        (&damped, State::new(0.5, [1.2], [-0.7])),
+        (&damped, State::new(0.0, [0.3], [0.0])),
+        (&damped, State::new(0.0, [0.0], [0.0])),
+        (&short, State::new(0.0, [0.0], [0.5])),
+    ] {
+        let land = y0.t + 1e-9;
+        let mut dp5 = DormandPrince54::new(settings);
+        dp5.integrate_to(m, &y0, land)?;
+        let want = hairer_first_step(m, &y0, rtol, atol, 5)?;
+        assert!(
+            (dp5.step_size() - want).abs() <= 1e-12 * want,
+            "DP5 at {y0:?}: {} against {want}",
+            dp5.step_size()
+        );
+        let mut dop853 = DormandPrince853::new(settings);
+        dop853.integrate_to(m, &y0, land)?;
+        let want = hairer_first_step(m, &y0, rtol, atol, 8)?;
+        assert!(
+            (dop853.step_size() - want).abs() <= 1e-12 * want,
+            "DOP853 at {y0:?}: {} against {want}",
+            dop853.step_size()
+        );
+        // A fresh start keeps the last proposal as the step to try.
+        let kept = dop853
+            .integrate_to(m, &y0, y0.t + 2.0)
+            .map(|_| dop853.step_size())?;
+        let outside = State::new(7.0, [-0.4], [2.0]);
+        dop853.integrate_to(m, &outside, outside.t + 1e-9)?;
+        assert_eq!(
+            dop853.step_size(),
+            kept,
+            "the step tried after a fresh start"
+        );
+    }
+    Ok(())
+}

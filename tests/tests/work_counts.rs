@@ -285,4 +285,41 @@ fn stormer_verlet_reuses<T: Real>() -> Result<(), Error> {
     Ok(())
 }
 
-for_f32_and_f64!(every_method, variational, stormer_verlet_reuses);
+/// An adaptive pair's statistics since its run started count the evaluations it made, and
+/// its accepted and rejected steps add up to the work of each call: over runs that reject
+/// (a tight tolerance from a first step fixed far too long) and a fresh start in between.
+fn adaptive_statistics<T: Real>() -> Result<(), Error> {
+    let m = Counting::new(SimplePendulum::new(
+        T::one(),
+        T::one(),
+        T::from_f64(9.81),
+        T::from_f64(0.3),
+    )?);
+    let settings = AdaptiveSettings::new(T::from_f64(1e-5), T::from_f64(1e-5))?
+        .with_initial_step(T::from_f64(0.5))?;
+    let mut dp = DormandPrince54::new(settings);
+    for start in [
+        State::new(T::zero(), [T::from_f64(2.0)], [T::zero()]),
+        State::new(T::from_f64(3.0), [T::from_f64(-1.0)], [T::from_f64(1.5)]),
+    ] {
+        m.take();
+        dp.integrate_to(&m, &start, start.t + T::from_f64(2.0))?;
+        let (laws, _, _) = m.take();
+        let (stats, work) = (dp.statistics(), dp.last_step());
+        assert_eq!(stats.evaluations, u64::from(laws), "{stats:?}");
+        assert_eq!(
+            (stats.accepted, stats.rejected),
+            (u64::from(work.steps), u64::from(work.rejected)),
+            "{stats:?} against {work:?}"
+        );
+        assert!(stats.rejected > 0, "no rejection to count: {stats:?}");
+    }
+    Ok(())
+}
+
+for_f32_and_f64!(
+    every_method,
+    variational,
+    stormer_verlet_reuses,
+    adaptive_statistics
+);
