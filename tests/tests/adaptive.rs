@@ -793,3 +793,24 @@ fn work_at_equal_tolerances() -> Result<(), Error> {
     }
     Ok(())
 }
+
+/// The last step to `t_end` stretches by up to 1% rather than leave a sliver: from a first
+/// step of 0.995 s fixed by the settings (loose enough to be accepted), landing at 1 s takes
+/// one step; from 0.985 s (1.5% short), two.
+#[test]
+fn last_step_stretches_by_one_percent() -> Result<(), Error> {
+    let p = SimplePendulum::new(1.0, 1.0, G, 0.0)?;
+    for (h0, steps) in [(0.995, 1), (0.985, 2)] {
+        let settings = AdaptiveSettings::new(0.5, 0.5)?.with_initial_step(h0)?;
+        let mut dp5 = DormandPrince54::new(settings);
+        let end = dp5.integrate_to(&p, &State::at_rest([0.1]), 1.0)?;
+        assert_eq!(end.t, 1.0);
+        let stats = dp5.statistics();
+        assert_eq!(
+            (stats.accepted, stats.rejected),
+            (steps, 0),
+            "first step {h0}"
+        );
+    }
+    Ok(())
+}

@@ -141,6 +141,8 @@ const AREAS: [Area; 9] = [
             "kepler",
             "--test",
             "work_counts",
+            "--test",
+            "issue15",
         ],
         unit_tests: true,
     },
