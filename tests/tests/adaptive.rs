@@ -814,3 +814,97 @@ fn last_step_stretches_by_one_percent() -> Result<(), Error> {
     }
     Ok(())
 }
+
+/// The smallest step of the settings: a run that would need a shorter step than `h_min`
+/// fails with `StepSizeUnderflow` (a tolerance of 1e-9 with steps of at least 0.05 s), and a
+/// step of exactly `h_min` is allowed (a first step fixed at `h_min`, loose tolerance).
+#[test]
+fn smallest_step_is_kept() -> Result<(), Error> {
+    let p = SimplePendulum::new(1.0, 1.0, G, 0.0)?;
+    let start = State::at_rest([1.0]);
+    let tight = AdaptiveSettings::new(1e-9, 1e-11)?.with_step_bounds(0.05, 1.0)?;
+    // Step by step towards a far end, so that no step is a shortened last one.
+    let mut dp5 = DormandPrince54::new(tight);
+    let mut s = start;
+    let failed = (0..100).find_map(|_| match dp5.next_step(&p, &s, 100.0) {
+        Ok(next) => {
+            s = next;
+            None
+        }
+        Err(e) => Some(e),
+    });
+    assert_eq!(failed, Some(Error::StepSizeUnderflow), "at {s:?}");
+    let loose = AdaptiveSettings::new(0.5, 0.5)?
+        .with_step_bounds(0.01, 1.0)?
+        .with_initial_step(0.01)?;
+    let mut dp5 = DormandPrince54::new(loose);
+    dp5.integrate_to(&p, &start, 0.5)?;
+    assert_eq!(dp5.statistics().rejected, 0);
+    Ok(())
+}
+
+/// A call that fails leaves the integrator as it was before the call: the run goes on from
+/// its last good state bit for bit as if the call had not been made (a mechanism that fails
+/// after a number of evaluations, in the middle of a call).
+#[test]
+fn failed_call_changes_nothing() -> Result<(), Error> {
+    use core::cell::Cell;
+    struct Failing {
+        inner: SimplePendulum<f64>,
+        left: Cell<u32>,
+    }
+    impl Lagrangian<f64, 1> for Failing {
+        fn kinetic<S: Scalar<Real = f64>>(&self, t: S, q: &SVector<S, 1>, qd: &SVector<S, 1>) -> S {
+            self.inner.kinetic(t, q, qd)
+        }
+        fn potential<S: Scalar<Real = f64>>(&self, t: S, q: &SVector<S, 1>) -> S {
+            self.inner.potential(t, q)
+        }
+    }
+    impl Mechanism<f64, 1> for Failing {
+        fn mass_matrix(&self, s: &State<f64, 1>) -> lagrange_core::nalgebra::SMatrix<f64, 1, 1> {
+            self.inner.mass_matrix(s)
+        }
+        fn rhs(&self, s: &State<f64, 1>) -> SVector<f64, 1> {
+            self.inner.rhs(s)
+        }
+        fn law<F: lagrange_core::GeneralizedForce<f64, 1>>(
+            &self,
+            s: &State<f64, 1>,
+            extra: &F,
+        ) -> Result<SVector<f64, 1>, Error> {
+            match self.left.get() {
+                0 => Err(Error::NonFiniteState),
+                n => {
+                    self.left.set(n - 1);
+                    self.inner.law(s, extra)
+                }
+            }
+        }
+    }
+    let inner = SimplePendulum::new(1.0, 1.0, G, 0.1)?;
+    let failing = Failing {
+        inner,
+        left: Cell::new(u32::MAX),
+    };
+    let settings = AdaptiveSettings::new(1e-7, 1e-9)?;
+    let start = State::new(0.0, [1.3], [0.2]);
+    let mut a = DormandPrince853::new(settings);
+    let mut b = DormandPrince853::new(settings);
+    let sa = a.integrate_to(&failing, &start, 1.0)?;
+    let sb = b.integrate_to(&inner, &start, 1.0)?;
+    assert_eq!(sa, sb);
+    // Fails some stages into a call that would take several steps.
+    failing.left.set(40);
+    assert!(a.integrate_to(&failing, &sa, 3.0).is_err());
+    failing.left.set(u32::MAX);
+    for t in [1.7, 2.9, 4.0] {
+        let (ea, eb) = (
+            a.integrate_to(&failing, &sa, t)?,
+            b.integrate_to(&inner, &sb, t)?,
+        );
+        assert_eq!(ea, eb, "at {t} after the failed call");
+        assert_eq!(a.step_size(), b.step_size());
+    }
+    Ok(())
+}

@@ -124,7 +124,13 @@ fn counts<T: Real, I: Integrator<T, 1, Counting<SimplePendulum<T>>>>(
             s = outside;
         }
         m.take();
+        let t = s.t;
         s = method.step(&m, &s, dt)?;
+        assert!(
+            s.t == t + dt,
+            "{name}, step {k}: lands at {:?}",
+            s.t.to_f64()
+        );
         let (laws, jacobians, _) = m.take();
         let work = method.last_step();
         assert_eq!(
