@@ -413,3 +413,43 @@ fn equilibrium_is_a_fixed_point() -> Result<(), Error> {
     }
     Ok(())
 }
+
+/// Newton converges as fast as an exact matrix lets it: the implicit Runge-Kutta methods on
+/// the double pendulum (two coordinates, so that every block of the Newton matrix and every
+/// pivot of its LU factors is used), 50 steps of 0.02 s from a swinging state, at most the
+/// measured iterations per step (f64: implicit midpoint 7, Gauss-Legendre 2 6, Radau IIA 2 6,
+/// backward Euler 8). A matrix factored wrong still converges, slowly: more iterations.
+#[test]
+fn newton_iterations_are_few() -> Result<(), Error> {
+    fn most<I: Integrator<f64, 2, DoublePendulum<f64>>>(mut method: I) -> Result<u32, Error> {
+        let dp = DoublePendulum::new(1.0, 1.3, 0.9, 1.1, 9.81)?;
+        let mut s = State::new(0.0, [2.1, -1.4], [0.5, 1.9]);
+        let mut most = 0;
+        for _ in 0..50 {
+            s = method.step(&dp, &s, 0.02)?;
+            most = most.max(method.last_step().iterations);
+        }
+        Ok(most)
+    }
+    for (name, iterations, bound) in [
+        ("implicit midpoint", most(ImplicitMidpoint::default())?, 7),
+        ("Gauss-Legendre 2", most(GaussLegendre2::default())?, 6),
+        ("Radau IIA 2", most(RadauIIA2::default())?, 6),
+        ("backward Euler", most(BackwardEuler::default())?, 8),
+    ] {
+        println!("{name}: at most {iterations} Newton iterations per step");
+        assert!(
+            iterations <= bound,
+            "{name}: {iterations} iterations, measured {bound}"
+        );
+    }
+    Ok(())
+}
+
+/// The Newton settings read back what they were given.
+#[test]
+fn newton_settings_read_back() -> Result<(), Error> {
+    let s = NewtonSettings::new(1e-9, 7)?;
+    assert_eq!((s.tolerance(), s.max_iterations()), (1e-9, 7));
+    Ok(())
+}
