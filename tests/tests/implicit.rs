@@ -7,8 +7,8 @@ use lagrange_core::{
     State, ViscousDamping,
 };
 use lagrange_integrators::{
-    BackwardEuler, GaussLegendre2, ImplicitMidpoint, Integrator, NewtonSettings, RadauIIA2, Rk4,
-    StormerVerlet, VariationalMidpoint, Yoshida4,
+    BackwardEuler, GaussLegendre2, ImplicitMidpoint, Integrator, Method, NewtonSettings, RadauIIA2,
+    Rk4, StormerVerlet, VariationalMidpoint, Yoshida4,
 };
 use lagrange_systems::exact::pendulum_from_rest;
 use lagrange_systems::{DoublePendulum, Kepler, NLinkPendulum, SimplePendulum};
@@ -414,33 +414,79 @@ fn equilibrium_is_a_fixed_point() -> Result<(), Error> {
     Ok(())
 }
 
-/// Newton converges as fast as an exact matrix lets it: the implicit Runge-Kutta methods on
-/// the double pendulum (two coordinates, so that every block of the Newton matrix and every
-/// pivot of its LU factors is used), 50 steps of 0.02 s from a swinging state, at most the
-/// measured iterations per step (f64: implicit midpoint 7, Gauss-Legendre 2 6, Radau IIA 2 6,
-/// backward Euler 8). A matrix factored wrong still converges, slowly: more iterations.
+/// Newton converges as fast as its matrix lets it: the implicit Runge-Kutta methods on the
+/// double pendulum (two coordinates, so that every block of the Newton matrix and every pivot
+/// of its LU factors is used), 50 steps from a swinging state, at most the measured
+/// iterations in all (f64, measured 238 to 310); steps of 0.02 s, and of 0.1 s where Newton
+/// refreshes its matrix when it slows down; and Stormer-Verlet's kick on a heavily damped
+/// pendulum, where the fixed-point start hands over to Newton (223). A matrix factored wrong, refreshed late or
+/// handed over late still converges, slowly: more iterations.
 #[test]
 fn newton_iterations_are_few() -> Result<(), Error> {
-    fn most<I: Integrator<f64, 2, DoublePendulum<f64>>>(mut method: I) -> Result<u32, Error> {
+    fn total<I: Integrator<f64, 2, DoublePendulum<f64>>>(
+        mut method: I,
+        dt: f64,
+    ) -> Result<u32, Error> {
         let dp = DoublePendulum::new(1.0, 1.3, 0.9, 1.1, 9.81)?;
-        let mut s = State::new(0.0, [2.1, -1.4], [0.5, 1.9]);
-        let mut most = 0;
+        let mut s = State::new(0.0, [0.6, -0.4], [0.3, 0.5]);
+        let mut total = 0;
         for _ in 0..50 {
-            s = method.step(&dp, &s, 0.02)?;
-            most = most.max(method.last_step().iterations);
+            s = method.step(&dp, &s, dt)?;
+            total += method.last_step().iterations;
         }
-        Ok(most)
+        Ok(total)
     }
-    for (name, iterations, bound) in [
-        ("implicit midpoint", most(ImplicitMidpoint::default())?, 7),
-        ("Gauss-Legendre 2", most(GaussLegendre2::default())?, 6),
-        ("Radau IIA 2", most(RadauIIA2::default())?, 6),
-        ("backward Euler", most(BackwardEuler::default())?, 8),
+    let damped = SimplePendulum::new(1.0, 1.0, 9.81, 40.0)?;
+    let mut sv = StormerVerlet::default();
+    let mut s = State::new(0.0, [0.9], [-0.4]);
+    let mut kicks = 0;
+    for _ in 0..50 {
+        s = sv.step(&damped, &s, 0.05)?;
+        kicks += sv.last_step().iterations;
+    }
+    for (name, iterations, measured) in [
+        (
+            "implicit midpoint, 0.02 s",
+            total(ImplicitMidpoint::default(), 0.02)?,
+            287,
+        ),
+        (
+            "Gauss-Legendre 2, 0.02 s",
+            total(GaussLegendre2::default(), 0.02)?,
+            274,
+        ),
+        (
+            "Radau IIA 2, 0.02 s",
+            total(RadauIIA2::default(), 0.02)?,
+            238,
+        ),
+        (
+            "backward Euler, 0.02 s",
+            total(BackwardEuler::default(), 0.02)?,
+            245,
+        ),
+        (
+            "implicit midpoint, 0.1 s",
+            total(ImplicitMidpoint::default(), 0.1)?,
+            301,
+        ),
+        (
+            "Gauss-Legendre 2, 0.1 s",
+            total(GaussLegendre2::default(), 0.1)?,
+            295,
+        ),
+        ("Radau IIA 2, 0.1 s", total(RadauIIA2::default(), 0.1)?, 310),
+        (
+            "backward Euler, 0.1 s",
+            total(BackwardEuler::default(), 0.1)?,
+            278,
+        ),
+        ("Stormer-Verlet, damped", kicks, 223),
     ] {
-        println!("{name}: at most {iterations} Newton iterations per step");
+        println!("{name}: {iterations} Newton iterations in 50 steps");
         assert!(
-            iterations <= bound,
-            "{name}: {iterations} iterations, measured {bound}"
+            iterations <= measured,
+            "{name}: {iterations} iterations, measured {measured}"
         );
     }
     Ok(())
