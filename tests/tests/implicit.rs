@@ -7,8 +7,8 @@ use lagrange_core::{
     State, ViscousDamping,
 };
 use lagrange_integrators::{
-    BackwardEuler, GaussLegendre2, ImplicitMidpoint, Integrator, Method, NewtonSettings, RadauIIA2,
-    Rk4, StormerVerlet, VariationalMidpoint, Yoshida4,
+    BackwardEuler, GaussLegendre2, ImplicitMidpoint, Integrator, Method, NewtonSettings,
+    PhaseState, RadauIIA2, Rk4, StormerVerlet, VariationalMidpoint, Yoshida4,
 };
 use lagrange_systems::exact::pendulum_from_rest;
 use lagrange_systems::{DoublePendulum, Kepler, NLinkPendulum, SimplePendulum};
@@ -497,5 +497,40 @@ fn newton_iterations_are_few() -> Result<(), Error> {
 fn newton_settings_read_back() -> Result<(), Error> {
     let s = NewtonSettings::new(1e-9, 7)?;
     assert_eq!((s.tolerance(), s.max_iterations()), (1e-9, 7));
+    Ok(())
+}
+
+/// A phase state is finite when its time, coordinates and momenta all are; the variational
+/// step refuses one that is not, whichever part holds the NaN or infinity.
+#[test]
+fn phase_states_that_are_not_finite_are_refused() -> Result<(), Error> {
+    let p = SimplePendulum::new(1.0, 1.0, 9.81, 0.0)?;
+    let good = PhaseState {
+        t: 0.0,
+        q: SVector::<f64, 1>::new(0.3),
+        p: SVector::<f64, 1>::new(-0.2),
+    };
+    assert!(good.is_finite());
+    let mut method = VariationalMidpoint::default();
+    method.step_phase(&p, &good, 0.01)?;
+    for bad in [f64::NAN, f64::INFINITY] {
+        for broken in [
+            PhaseState { t: bad, ..good },
+            PhaseState {
+                q: SVector::<f64, 1>::new(bad),
+                ..good
+            },
+            PhaseState {
+                p: SVector::<f64, 1>::new(bad),
+                ..good
+            },
+        ] {
+            assert!(!broken.is_finite(), "{broken:?}");
+            assert_eq!(
+                method.step_phase(&p, &broken, 0.01),
+                Err(Error::NonFiniteState)
+            );
+        }
+    }
     Ok(())
 }
