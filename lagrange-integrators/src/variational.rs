@@ -516,13 +516,12 @@ impl<T: Real, const N: usize, M: Mechanism<T, N>> Integrator<T, N, M>
         if steps == 0 {
             return Ok(*state);
         }
-        let mut z = match self.last.take() {
-            Some((out, z)) if continues(&out, state) => PhaseState { t: state.t, ..z },
-            _ => self.phase_state(m, state),
-        };
-        let mut guess = match self.motion {
-            Some(_) => self.guess(&state.q, dt),
-            None => state.q + state.qd * dt,
+        // The last step's momenta and motion only where this run continues from its end.
+        let (mut z, mut guess) = match self.last.take() {
+            Some((out, z)) if continues(&out, state) => {
+                (PhaseState { t: state.t, ..z }, self.guess(&state.q, dt))
+            }
+            _ => (self.phase_state(m, state), state.q + state.qd * dt),
         };
         let mut clock = Clock::new(state.t);
         let mut before = z;

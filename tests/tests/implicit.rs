@@ -534,3 +534,38 @@ fn phase_states_that_are_not_finite_are_refused() -> Result<(), Error> {
     }
     Ok(())
 }
+
+/// The variational midpoint's Newton starts from good guesses and an exact matrix (the
+/// damping's Jacobian included): over 100 steps of 0.05 s of a damped pendulum, at most the
+/// measured iterations in all (f64: 393), and over 100 steps alternating 0.05 and 0.02 s
+/// (335: the guess scales the last motion to the new step). A run (`integrate`) from a
+/// state set from outside starts afresh: bit for bit what a new method gives (it did not:
+/// the last run's motion seeded its first guess, a difference of an ulp).
+#[test]
+fn variational_newton_is_quick_and_restarts() -> Result<(), Error> {
+    let p = SimplePendulum::new(1.0, 1.0, 9.81, 0.5)?;
+    let start = State::new(0.0, [1.2], [0.4]);
+    let mut stepped = 0;
+    let mut s = start;
+    let mut w = VariationalMidpoint::default();
+    for _ in 0..100 {
+        s = w.step(&p, &s, 0.05)?;
+        stepped += w.last_step().iterations;
+    }
+    // Steps that alternate in length: the guess scales the last motion to the new step.
+    let mut varied = 0;
+    for k in 0..100 {
+        s = w.step(&p, &s, if k % 2 == 0 { 0.05 } else { 0.02 })?;
+        varied += w.last_step().iterations;
+    }
+    println!("variational midpoint: {stepped} iterations in 100 steps, {varied} alternating");
+    assert!(stepped <= 393, "{stepped} iterations");
+    assert!(varied <= 335, "{varied} iterations");
+    let mut v = VariationalMidpoint::default();
+    v.integrate(&p, &start, 0.05, 100)?;
+    let outside = State::new(3.0, [-0.7], [1.1]);
+    let again = v.integrate(&p, &outside, 0.05, 40)?;
+    let fresh = VariationalMidpoint::default().integrate(&p, &outside, 0.05, 40)?;
+    assert_eq!(again, fresh, "a run from outside did not start afresh");
+    Ok(())
+}
