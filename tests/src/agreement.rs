@@ -2,6 +2,7 @@
 //! closed-form equations agree with the automatic Euler-Lagrange path of its own Lagrangian.
 
 use crate::Rng;
+use lagrange_core::nalgebra::SVector;
 use lagrange_core::{Error, EulerLagrange, Lagrangian, Mechanism, Real, State};
 
 /// The largest relative disagreements found by [`agrees_with_automatic`].
@@ -104,6 +105,31 @@ where
         assert!(
             e < tolerance,
             "acceleration at {s:?}: hand {a:?} auto {b:?} ({e:e})"
+        );
+        worst.acceleration = worst.acceleration.max(e);
+        // The same law with an extra force that reads the state (an input, a drive), and
+        // the split form: M^-1 f from each one's own `rhs` and `solve_mass`.
+        let push = |x: &State<T, N>| {
+            SVector::<T, N>::from_fn(|i, _| x.qd[i] * T::from_f64(0.7) + T::from_f64(1.3))
+        };
+        let (a, b) = (
+            hand.acceleration_with(&s, &push)?,
+            auto.acceleration_with(&s, &push)?,
+        );
+        let e = relative(a.iter().copied(), b.iter().copied(), scale.acceleration);
+        assert!(
+            e < tolerance,
+            "acceleration with a force at {s:?}: hand {a:?} auto {b:?} ({e:e})"
+        );
+        worst.acceleration = worst.acceleration.max(e);
+        let (a, b) = (
+            hand.solve_mass(&s, &hand.rhs(&s))?,
+            auto.solve_mass(&s, &auto.rhs(&s))?,
+        );
+        let e = relative(a.iter().copied(), b.iter().copied(), scale.acceleration);
+        assert!(
+            e < tolerance,
+            "M^-1 rhs at {s:?}: hand {a:?} auto {b:?} ({e:e})"
         );
         worst.acceleration = worst.acceleration.max(e);
         let (ma, mb) = (hand.mass_matrix(&s), auto.mass_matrix(&s));

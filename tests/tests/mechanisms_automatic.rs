@@ -4,8 +4,8 @@
 
 use lagrange_core::{Error, Real, State};
 use lagrange_systems::{
-    Acrobot, CartPole, ElasticPendulum, Kepler, NLinkPendulum, SphericalPendulum, SpringMassDamper,
-    SwingingAtwood,
+    Acrobot, CartPole, ElasticPendulum, FallingParticle, Kepler, NLinkPendulum, SimplePendulum,
+    SphericalPendulum, SpringMassDamper, SwingingAtwood,
 };
 use lagrange_tests::{
     agrees_with_automatic, for_f32_and_f64, pick, random_state, Agreement, Rng, Scales,
@@ -116,6 +116,28 @@ chains!(
 /// 1.3e-6 Acrobot, below 7e-7 the rest), bound 5e-6.
 const OTHERS: (f64, f64) = (5e-6, 1.4e-14);
 
+fn simple_pendulum<T: Real>() -> Result<(), Error> {
+    over_sets::<T>("SimplePendulum", 207, |rng| {
+        let (m, l): (T, T) = (rng.uniform(0.1, 5.0), rng.uniform(0.2, 3.0));
+        let pendulum = SimplePendulum::new(m, l, T::from_f64(G), rng.uniform(0.0, 3.0))?;
+        let scale = scales(G / l.to_f64() + 1.0, (m * l).to_f64() * G);
+        agrees_with_automatic(&pendulum, scale, tolerance::<T>(OTHERS), STATES, rng, |r| {
+            random_state(r, ANGLES, RATES)
+        })
+    })
+}
+
+fn falling_particle<T: Real>() -> Result<(), Error> {
+    over_sets::<T>("FallingParticle", 208, |rng| {
+        let m: T = rng.uniform(0.1, 5.0);
+        let particle = FallingParticle::new(m, T::from_f64(G))?;
+        let scale = scales(G + 1.0, m.to_f64() * G);
+        agrees_with_automatic(&particle, scale, tolerance::<T>(OTHERS), STATES, rng, |r| {
+            random_state(r, (-10.0, 10.0), RATES)
+        })
+    })
+}
+
 fn spring_mass_damper<T: Real>() -> Result<(), Error> {
     over_sets::<T>("SpringMassDamper", 201, |rng| {
         let (m, k): (T, T) = (rng.uniform(0.1, 5.0), rng.uniform(0.0, 100.0));
@@ -208,6 +230,8 @@ fn kepler<T: Real>() -> Result<(), Error> {
 }
 
 for_f32_and_f64!(
+    simple_pendulum,
+    falling_particle,
     spring_mass_damper,
     elastic_pendulum,
     spherical_pendulum,
