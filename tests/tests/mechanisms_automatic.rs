@@ -4,8 +4,8 @@
 
 use lagrange_core::{Error, Real, State};
 use lagrange_systems::{
-    Acrobot, CartPole, ElasticPendulum, FallingParticle, Kepler, NLinkPendulum, SimplePendulum,
-    SphericalPendulum, SpringMassDamper, SwingingAtwood,
+    Acrobot, CartPole, DoublePendulum, ElasticPendulum, FallingParticle, Kepler, NLinkPendulum,
+    SimplePendulum, SphericalPendulum, SpringMassDamper, SwingingAtwood,
 };
 use lagrange_tests::{
     agrees_with_automatic, for_f32_and_f64, pick, random_state, Agreement, Rng, Scales,
@@ -127,6 +127,21 @@ fn simple_pendulum<T: Real>() -> Result<(), Error> {
     })
 }
 
+fn double_pendulum<T: Real>() -> Result<(), Error> {
+    over_sets::<T>("DoublePendulum", 209, |rng| {
+        let (m1, m2): (T, T) = (rng.uniform(0.1, 5.0), rng.uniform(0.1, 5.0));
+        let (l1, l2): (T, T) = (rng.uniform(0.2, 3.0), rng.uniform(0.2, 3.0));
+        let dp = DoublePendulum::new(m1, m2, l1, l2, T::from_f64(G))?;
+        let scale = scales(
+            G / l1.to_f64().min(l2.to_f64()) + 1.0,
+            (m1 + m2).to_f64() * (l1 + l2).to_f64() * G,
+        );
+        agrees_with_automatic(&dp, scale, tolerance::<T>(OTHERS), STATES, rng, |r| {
+            random_state(r, ANGLES, RATES)
+        })
+    })
+}
+
 fn falling_particle<T: Real>() -> Result<(), Error> {
     over_sets::<T>("FallingParticle", 208, |rng| {
         let m: T = rng.uniform(0.1, 5.0);
@@ -231,6 +246,7 @@ fn kepler<T: Real>() -> Result<(), Error> {
 
 for_f32_and_f64!(
     simple_pendulum,
+    double_pendulum,
     falling_particle,
     spring_mass_damper,
     elastic_pendulum,
