@@ -278,6 +278,8 @@ const ACCELERATIONS: &str = "impl Mechanism|impl Constraints|small_solve|::terms
 /// The test binaries of the systems' areas.
 const SYSTEM_TESTS: &[&str] = &[
     "--test",
+    "mechanisms_bad_input",
+    "--test",
     "mechanisms_automatic",
     "--test",
     "mechanisms_reference",
