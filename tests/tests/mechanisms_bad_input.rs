@@ -144,12 +144,17 @@ fn inputs_refuse_non_finite<T: Real>() -> Result<(), Error> {
     Ok(())
 }
 
-/// `Err(Singularity)` at `s`.
+/// `Err(Singularity)` at `s`, from the law and from the split form's `solve_mass`.
 fn singular<T: Real, const N: usize>(m: &impl Mechanism<T, N>, s: &State<T, N>) {
     let a = m.acceleration(s);
     assert!(
         matches!(a, Err(Error::Singularity { .. })),
         "at {s:?}: {a:?}"
+    );
+    let x = m.solve_mass(s, &lagrange_core::nalgebra::SVector::from_element(T::one()));
+    assert!(
+        matches!(x, Err(Error::Singularity { .. })),
+        "solve_mass at {s:?}: {x:?}"
     );
 }
 
