@@ -99,6 +99,16 @@ impl<T: Real, const N: usize, M: Mechanism<T, N>> Mechanism<T, N> for Counting<M
     }
 }
 
+/// A pendulum (1 kg, 1 m) with viscous damping `b`, its law and Jacobian calls counted.
+fn pendulum<T: Real>(b: f64) -> Result<Counting<SimplePendulum<T>>, Error> {
+    Ok(Counting::new(SimplePendulum::new(
+        T::one(),
+        T::one(),
+        T::from_f64(9.81),
+        T::from_f64(b),
+    )?))
+}
+
 /// Four steps of `method` (from `start`, twice from its own result, once from a state set
 /// from outside), each one's reported work against the counted calls; returns the
 /// evaluations counted over all four, so that the caller can see the method did work.
@@ -109,12 +119,7 @@ fn counts<T: Real, I: Integrator<T, 1, Counting<SimplePendulum<T>>>>(
     mut method: I,
 ) -> Result<u32, Error> {
     // Damped, so that a guess carried over from a step is not exact (and Newton iterates).
-    let m = Counting::new(SimplePendulum::new(
-        T::one(),
-        T::one(),
-        T::from_f64(9.81),
-        T::from_f64(damping),
-    )?);
+    let m = pendulum(damping)?;
     let dt = T::from_f64(dt);
     let outside = State::new(T::from_f64(0.2), [T::from_f64(-1.1)], [T::from_f64(0.7)]);
     let mut s = State::new(T::zero(), [T::from_f64(0.9)], [T::from_f64(-0.4)]);
@@ -167,12 +172,7 @@ fn counts<T: Real, I: Integrator<T, 1, Counting<SimplePendulum<T>>>>(
 /// follows its documented `COST` on every step, fresh or continuing, alone or composed by
 /// Yoshida. Counted here as the evaluations of `V`, one per evaluation of `L`.
 fn variational<T: Real>() -> Result<(), Error> {
-    let m = Counting::new(SimplePendulum::new(
-        T::one(),
-        T::one(),
-        T::from_f64(9.81),
-        T::from_f64(0.3),
-    )?);
+    let m = pendulum(0.3)?;
     let mut method = VariationalMidpoint::default();
     let dt = T::from_f64(0.05);
     let outside = State::new(T::from_f64(0.2), [T::from_f64(-1.1)], [T::from_f64(0.7)]);
@@ -271,12 +271,7 @@ fn every_method<T: Real>() -> Result<(), Error> {
 /// in f32 on every step, also from a turning point (`v = 0`, step 5), where the weights are
 /// the kick's alone: a worse guess takes more, weights that are off take more or fewer.
 fn stormer_verlet_reuses<T: Real>() -> Result<(), Error> {
-    let m = Counting::new(SimplePendulum::new(
-        T::one(),
-        T::one(),
-        T::from_f64(9.81),
-        T::from_f64(0.3),
-    )?);
+    let m = pendulum(0.3)?;
     let iterations = if T::EPSILON > T::from_f64(1e-10) {
         3
     } else {
@@ -305,12 +300,7 @@ fn stormer_verlet_reuses<T: Real>() -> Result<(), Error> {
 /// its accepted and rejected steps add up to the work of each call: over runs that reject
 /// (a tight tolerance from a first step fixed far too long) and a fresh start in between.
 fn adaptive_statistics<T: Real>() -> Result<(), Error> {
-    let m = Counting::new(SimplePendulum::new(
-        T::one(),
-        T::one(),
-        T::from_f64(9.81),
-        T::from_f64(0.3),
-    )?);
+    let m = pendulum(0.3)?;
     let settings = AdaptiveSettings::new(T::from_f64(1e-5), T::from_f64(1e-5))?
         .with_initial_step(T::from_f64(0.5))?;
     let mut dp = DormandPrince54::new(settings);
