@@ -154,20 +154,30 @@ const CHECKS: [&[&str]; 2] = [
 const DOC_TEST: [&[&str]; 1] = [&["test", "--workspace", "--doc", "--quiet"]];
 
 /// Long runs (10^6 steps and more) are `#[ignore]`d in the quick debug test run and run here,
-/// optimised. They all live in the `tests` crate, so the bench crate's heavy dependencies are
-/// not built in release for them; and only the test targets that hold an `#[ignore]`d test
-/// are built in release (found by reading `tests/tests/`), not all seventy.
+/// optimised. They live in the `tests` crate (so the bench crate's heavy dependencies are not
+/// built in release for them) and, for `fast_trig`'s exhaustive sweep, in `lagrange-core`'s
+/// own tests; only the test targets that hold an `#[ignore]`d test are built in release
+/// (found by reading the test directories), not all seventy.
 fn long_test() -> Result<(), String> {
-    let mut args: Vec<String> = ["test", "-p", "lagrange-tests", "--release", "--quiet"]
-        .map(String::from)
-        .to_vec();
-    for target in targets_with_ignored(&cmd::project_root().join("tests/tests"))? {
-        args.push("--test".into());
-        args.push(target);
+    for (package, dir) in LONG_TEST_DIRS {
+        let mut args: Vec<String> = ["test", "-p", package, "--release", "--quiet"]
+            .map(String::from)
+            .to_vec();
+        for target in targets_with_ignored(&cmd::project_root().join(dir))? {
+            args.push("--test".into());
+            args.push(target);
+        }
+        args.extend(["--", "--ignored"].map(String::from));
+        cmd::run(cmd::cargo().args(&args))?;
     }
-    args.extend(["--", "--ignored"].map(String::from));
-    cmd::run(cmd::cargo().args(&args))
+    Ok(())
 }
+
+/// The packages whose integration tests hold long runs, and their test directories.
+const LONG_TEST_DIRS: [(&str, &str); 2] = [
+    ("lagrange-tests", "tests/tests"),
+    ("lagrange-core", "lagrange-core/tests"),
+];
 
 /// The test targets of `dir` (a file `NAME.rs`, or a directory `NAME/` with its `main.rs` and
 /// modules) with a line that starts with `#[ignore` (an attribute, not a comment), sorted.
@@ -233,8 +243,11 @@ mod tests {
     /// files with an `#[ignore]`d test, not the campaign, whose `ignore` is only a word.
     #[test]
     fn long_runs_are_found() -> Result<(), String> {
-        let targets = super::targets_with_ignored(&crate::cmd::project_root().join("tests/tests"))?;
-        for expected in ["stress", "long_run_energy", "fast_trig"] {
+        let root = crate::cmd::project_root();
+        let core = super::targets_with_ignored(&root.join("lagrange-core/tests"))?;
+        assert_eq!(core, ["fast_trig"]);
+        let targets = super::targets_with_ignored(&root.join("tests/tests"))?;
+        for expected in ["stress", "long_run_energy"] {
             assert!(
                 targets.iter().any(|t| t == expected),
                 "{expected} in {targets:?}"

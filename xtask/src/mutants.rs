@@ -53,7 +53,10 @@ struct Area {
     files: &'static [&'static str],
     /// Only mutants whose name matches this regex (the functions of the area), if any.
     only: Option<&'static str>,
-    /// Arguments of `cargo test -p lagrange-tests` for each mutant: the test binaries to run.
+    /// The package whose test binaries run for each mutant: `lagrange-tests`, or the mutated
+    /// package itself when its own integration tests suffice (a build of one crate, not five).
+    test_package: &'static str,
+    /// Arguments of `cargo test -p <test_package>` for each mutant: the test binaries to run.
     tests: &'static [&'static str],
     /// Also run the mutated package's own unit tests (`--lib`): for private kernels tested
     /// where they live (the step-size controller's `log2` and `exp2`). Costs a second build
@@ -66,6 +69,7 @@ const AREAS: [Area; 9] = [
     Area {
         name: "explicit",
         package: "lagrange-integrators",
+        test_package: "lagrange-tests",
         files: &[
             "lagrange-integrators/src/rk4.rs",
             "lagrange-integrators/src/explicit_euler.rs",
@@ -96,6 +100,7 @@ const AREAS: [Area; 9] = [
     Area {
         name: "implicit",
         package: "lagrange-integrators",
+        test_package: "lagrange-tests",
         files: &[
             "lagrange-integrators/src/implicit_rk.rs",
             "lagrange-integrators/src/implicit_midpoint.rs",
@@ -125,6 +130,7 @@ const AREAS: [Area; 9] = [
     Area {
         name: "adaptive",
         package: "lagrange-integrators",
+        test_package: "lagrange-tests",
         files: &[
             "lagrange-integrators/src/adaptive/embedded.rs",
             "lagrange-integrators/src/adaptive/dopri5.rs",
@@ -149,6 +155,7 @@ const AREAS: [Area; 9] = [
     Area {
         name: "impacts",
         package: "lagrange-core",
+        test_package: "lagrange-tests",
         files: &["lagrange-core/src/constraints/contact/impulse.rs"],
         only: None,
         tests: &[
@@ -168,6 +175,7 @@ const AREAS: [Area; 9] = [
     Area {
         name: "constraints",
         package: "lagrange-core",
+        test_package: "lagrange-tests",
         files: &[
             "lagrange-core/src/constraints/constrained.rs",
             "lagrange-core/src/constraints/schur.rs",
@@ -197,21 +205,16 @@ const AREAS: [Area; 9] = [
     Area {
         name: "fast-trig",
         package: "lagrange-core",
+        test_package: "lagrange-core",
         files: &["lagrange-core/src/fast_trig.rs"],
         only: None,
-        tests: &[
-            "--test",
-            "fast_trig",
-            "--test",
-            "fast_trig_pendulum",
-            "--test",
-            "lanes",
-        ],
+        tests: &["--test", "fast_trig"],
         unit_tests: false,
     },
     Area {
         name: "systems-one",
         package: "lagrange-systems",
+        test_package: "lagrange-tests",
         files: &[
             "lagrange-systems/src/simple_pendulum.rs",
             "lagrange-systems/src/falling_particle.rs",
@@ -225,6 +228,7 @@ const AREAS: [Area; 9] = [
     Area {
         name: "systems-two",
         package: "lagrange-systems",
+        test_package: "lagrange-tests",
         files: &[
             "lagrange-systems/src/double_pendulum.rs",
             "lagrange-systems/src/elastic_pendulum.rs",
@@ -242,6 +246,7 @@ const AREAS: [Area; 9] = [
     Area {
         name: "systems-chains",
         package: "lagrange-systems",
+        test_package: "lagrange-tests",
         files: &[
             "lagrange-systems/src/n_link_pendulum.rs",
             "lagrange-systems/src/cartesian_pendulum.rs",
@@ -292,12 +297,37 @@ const SYSTEM_TESTS: &[&str] = &[
 /// The outcome classes of `cargo-mutants`, by the file it lists them in.
 const OUTCOMES: [(&str, Outcome); 5] = [
     ("caught.txt", Outcome::Killed),
-    // With `--iterate`: the mutants an earlier run caught, not run again.
+    // With `--iterate`: the mutants an earlier run caught *or found unviable*, not run again;
+    // those in the area's [`UNVIABLE_LEDGER`] count as unviable, the others as killed.
     ("previously_caught.txt", Outcome::Killed),
     ("missed.txt", Outcome::Survived),
     ("timeout.txt", Outcome::TimedOut),
     ("unviable.txt", Outcome::Unviable),
 ];
+
+/// Every mutant of an area found unviable since its last full run, one per line, beside the
+/// area's `mutants.out`: cargo-mutants keeps only the last run's `unviable.txt`, and with
+/// `--iterate` lists the earlier unviable mutants among the previously caught.
+const UNVIABLE_LEDGER: &str = "unviable-ledger.txt";
+
+/// Adds the last run's unviable mutants of the area in `dir` to its ledger.
+fn update_ledger(dir: &Path) -> Result<(), String> {
+    let ledger = dir.join(UNVIABLE_LEDGER);
+    let mut names: std::collections::BTreeSet<String> = read_lines(&ledger).collect();
+    names.extend(read_lines(&dir.join("mutants.out").join("unviable.txt")));
+    let text: String = names.iter().map(|n| format!("{n}\n")).collect();
+    std::fs::write(&ledger, text).map_err(|e| format!("{}: {e}", ledger.display()))
+}
+
+/// The non-empty lines of a file (none if it is missing).
+fn read_lines(path: &Path) -> impl Iterator<Item = String> {
+    let text = std::fs::read_to_string(path).unwrap_or_default();
+    text.lines()
+        .filter(|l| !l.trim().is_empty())
+        .map(String::from)
+        .collect::<Vec<_>>()
+        .into_iter()
+}
 
 /// What happened to one mutant.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -403,15 +433,23 @@ pub fn run(args: &[String]) -> Result<(), String> {
             baseline
                 .env("CARGO_PROFILE_DEV_DEBUG", "0")
                 .env("CARGO_PROFILE_DEV_OPT_LEVEL", "1")
-                .args(["test", "--quiet", "-p", "lagrange-tests"])
+                .args(["test", "--quiet", "-p", area.test_package])
                 .args(area.tests);
             if area.unit_tests {
                 baseline.args(["-p", area.package, "--lib"]);
             }
             cmd::run(&mut baseline)
                 .map_err(|e| format!("area {}: the unmutated tests fail: {e}", area.name))?;
+            // Before the run moves the last one's outcomes aside, its unviable mutants join the
+            // ledger (a full run starts it over); after it, this run's.
+            if o.iterate {
+                update_ledger(&dir)?;
+            } else {
+                std::fs::remove_file(dir.join(UNVIABLE_LEDGER)).ok();
+            }
             // A surviving mutant is a finding, not a failure of the command: the report says.
             let status = cmd::run(&mut mutants_command(area, &out, &o, false));
+            update_ledger(&dir)?;
             println!(
                 "area {}: {:.0} s ({})",
                 area.name,
@@ -442,7 +480,7 @@ fn mutants_command(area: &Area, out: &Path, o: &Options, list: bool) -> Command 
         c.arg("--list");
         return c;
     }
-    c.args(["--test-package", "lagrange-tests", "--jobs", &o.jobs]);
+    c.args(["--test-package", area.test_package, "--jobs", &o.jobs]);
     if area.unit_tests {
         c.args(["--test-package", area.package, "--cargo-arg=--lib"]);
     }
@@ -556,11 +594,18 @@ fn report(root: &Path, out: &Path, areas: &[&Area]) -> Result<(), String> {
         if !dir.exists() {
             continue;
         }
+        let unviable: std::collections::BTreeSet<String> =
+            read_lines(&out.join(area.name).join(UNVIABLE_LEDGER)).collect();
         for (list, outcome) in OUTCOMES {
-            let text = std::fs::read_to_string(dir.join(list)).unwrap_or_default();
-            for listed in text.lines().filter(|l| !l.trim().is_empty()) {
+            for listed in read_lines(&dir.join(list)) {
+                let listed = listed.as_str();
                 let file = listed.split(':').next().unwrap_or_default().to_string();
                 let tally = files.entry(file).or_default();
+                let outcome = if list == "previously_caught.txt" && unviable.contains(listed) {
+                    Outcome::Unviable
+                } else {
+                    outcome
+                };
                 match outcome {
                     Outcome::Killed => tally.killed += 1,
                     Outcome::TimedOut => tally.timed_out += 1,

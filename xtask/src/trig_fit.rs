@@ -19,7 +19,7 @@
 //! Coefficients are fitted in `f64` and rounded once to `f32`; the unit test below asserts that
 //! the library's constants are exactly these roundings, so the library cannot drift from its
 //! derivation. The accuracy the rounded polynomials reach is measured by the dense sweeps of
-//! `tests/tests/fast_trig.rs`, not assumed from the fit.
+//! `lagrange-core/tests/fast_trig.rs`, not assumed from the fit.
 
 use lagrange_core::fast_trig;
 

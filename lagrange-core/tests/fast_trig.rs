@@ -1,10 +1,34 @@
 //! The pure-`f32` sine and cosine of `lagrange_core::fast_trig` against the exact values (`f64`
 //! `libm`, whose error is about 2^-29 of an `f32` ulp) and against `libm::sinf`/`cosf`, over
 //! dense sweeps of the reduced range, of every binade up to `f32::MAX`, of random arguments,
-//! and of the `f32`s nearest to multiples of pi/2 (where the reduction cancels most).
+//! and of the `f32`s nearest to multiples of pi/2 (where the reduction cancels most); and
+//! the lane sine and cosine against the scalar ones, bit for bit.
+//!
+//! They live in `lagrange-core` itself, not in `lagrange-tests`, so that a change to
+//! `fast_trig` rebuilds only this crate before they run (the mutation run of
+//! `cargo xtask mutants --area fast-trig` builds one crate per mutant, not five).
 
 use lagrange_core::fast_trig::{self, MAX_ULP_ERROR};
-use lagrange_tests::Rng;
+
+/// A seeded generator (SplitMix64), so every run draws the same arguments.
+struct Rng(u64);
+
+impl Rng {
+    /// Uniform in `[0, 1)`.
+    fn unit(&mut self) -> f64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^= z >> 31;
+        (z >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    /// Uniform in `[lo, hi)`, rounded to `f32`.
+    fn uniform(&mut self, lo: f64, hi: f64) -> f32 {
+        (lo + (hi - lo) * self.unit()) as f32
+    }
+}
 
 /// The size of one unit in the last place of an `f32` of magnitude `|y|`, in `f64`.
 fn ulp32(y: f64) -> f64 {
@@ -113,10 +137,10 @@ fn all_binades_sweep() {
 /// random bit patterns of finite values.
 #[test]
 fn random_arguments() {
-    let mut rng = Rng::new(0x5eed_7219);
+    let mut rng = Rng(0x5eed_7219);
     let mut worst = Worst::default();
     for _ in 0..200_000 {
-        worst.check(rng.uniform::<f32>(-100.0, 100.0));
+        worst.check(rng.uniform(-100.0, 100.0));
     }
     let mut drawn = 0;
     while drawn < 200_000 {
@@ -227,4 +251,55 @@ fn exhaustive_from_2_pow_minus_12_to_2_pow_20() {
             "{name}: {worst} ulp at {at:e}"
         );
     }
+}
+
+/// Lanes per group in the lane test (the scene's width on x86_64).
+const L: usize = 8;
+
+/// The lane sine and cosine against the scalar ones, bit for bit, over sweeps of every range
+/// (tiny, small, medium, the large reduction, the boundaries between them) and the special
+/// values.
+#[test]
+fn lane_trig_is_the_scalar_trig() {
+    let mut rng = Rng(7);
+    let special = [
+        0.0,
+        -0.0,
+        f32::MIN_POSITIVE,
+        1e-40,
+        f32::from_bits(0x3980_0000),
+        f32::from_bits(0x397f_ffff),
+        f32::from_bits(0x3f49_0fda),
+        f32::from_bits(0x3f49_0fdb),
+        511.999_97,
+        512.0,
+        -512.0,
+        1e30,
+        f32::MAX,
+        f32::INFINITY,
+        f32::NEG_INFINITY,
+        f32::NAN,
+    ];
+    let mut inputs: Vec<f32> = special.to_vec();
+    for scale in [1e-5, 0.5, 0.8, 3.0, 100.0, 600.0, 1e6] {
+        for _ in 0..2000 {
+            inputs.push(rng.uniform(-scale, scale));
+        }
+    }
+    let mut checked = 0;
+    for group in inputs.chunks(L) {
+        let mut x = [0.25f32; L];
+        x[..group.len()].copy_from_slice(group);
+        let (s, c) = fast_trig::sin_cos_lanes(x);
+        for (i, &xi) in x.iter().enumerate() {
+            let (es, ec) = fast_trig::sin_cos(xi);
+            assert_eq!(
+                (s[i].to_bits(), c[i].to_bits()),
+                (es.to_bits(), ec.to_bits()),
+                "x = {xi:e}"
+            );
+            checked += 1;
+        }
+    }
+    assert!(checked > 14_000);
 }
