@@ -523,47 +523,47 @@ fn ensure_cargo_mutants() -> Result<(), String> {
     ]))
 }
 
-/// One recorded equivalent mutant: the file, the mutation as `cargo-mutants` names it without
-/// its position, and the mutated source line (trimmed), so that an entry survives edits that
-/// move the line.
-#[derive(Debug, PartialEq, Eq, PartialOrd, Ord, Clone)]
+/// One mutant as the equivalent list names it: the file, the mutation as `cargo-mutants`
+/// names it without its position, and the mutated source line (trimmed), so that an entry
+/// survives edits that move the line.
+#[derive(Debug, PartialEq, Eq, Clone)]
 struct Key {
     file: String,
     mutation: String,
     line: String,
 }
 
-/// The entries of [`EQUIVALENT_LIST`]: `file | mutation | source line | reason` per line, `#`
-/// starting a comment.
-fn equivalents(root: &Path) -> Result<BTreeMap<Key, String>, String> {
+impl Key {
+    /// The start of this mutant's entry in the list: `file | mutation | line | `. Matched as a
+    /// prefix, not split on ` | `: a mutation (`replace | with ^`) or a line may hold one.
+    fn prefix(&self) -> String {
+        format!("{} | {} | {} | ", self.file, self.mutation, self.line)
+    }
+}
+
+/// The entries of [`EQUIVALENT_LIST`] (comments and blank lines aside), each with a reason.
+fn equivalents(root: &Path) -> Result<Vec<String>, String> {
     let path = root.join(EQUIVALENT_LIST);
     let text = std::fs::read_to_string(&path).unwrap_or_default();
-    let mut map = BTreeMap::new();
+    let mut entries = Vec::new();
     for (n, raw) in text.lines().enumerate() {
         let entry = raw.trim();
         if entry.is_empty() || entry.starts_with('#') {
             continue;
         }
-        let parts: Vec<&str> = entry.splitn(4, " | ").collect();
-        let [file, mutation, line, reason] = parts[..] else {
+        if entry.matches(" | ").count() < 3 {
             return Err(format!(
                 "{EQUIVALENT_LIST}:{}: expected `file | mutation | source line | reason`",
                 n + 1
             ));
-        };
-        map.insert(
-            Key {
-                file: file.into(),
-                mutation: mutation.into(),
-                line: line.into(),
-            },
-            reason.into(),
-        );
+        }
+        entries.push(entry.to_string());
     }
-    Ok(map)
+    Ok(entries)
 }
 
-/// `file:line:col: mutation` as `cargo-mutants` lists it, with the source line it mutates.
+/// The key of a mutant as `cargo-mutants` lists it (`file:line:col: mutation`), with the
+/// source line read from `root`.
 fn key_of(root: &Path, listed: &str) -> Option<Key> {
     let (file, rest) = listed.split_once(':')?;
     let (line, rest) = rest.split_once(':')?;
@@ -611,8 +611,10 @@ fn report(root: &Path, out: &Path, areas: &[&Area]) -> Result<(), String> {
                     Outcome::TimedOut => tally.timed_out += 1,
                     Outcome::Unviable => tally.unviable += 1,
                     Outcome::Survived => {
-                        let known = key_of(root, listed)
-                            .and_then(|k| equivalent.keys().position(|e| *e == k));
+                        let known = key_of(root, listed).and_then(|k| {
+                            let prefix = k.prefix();
+                            equivalent.iter().position(|e| e.starts_with(&prefix))
+                        });
                         if let Some(i) = known {
                             used[i] = true;
                             tally.equivalent += 1;
@@ -654,16 +656,16 @@ fn report(root: &Path, out: &Path, areas: &[&Area]) -> Result<(), String> {
             let _ = writeln!(md, "- {s}");
         }
     }
-    let stale: Vec<&Key> = equivalent
-        .keys()
+    let stale: Vec<&String> = equivalent
+        .iter()
         .zip(&used)
         .filter(|(_, u)| !**u)
-        .map(|(k, _)| k)
+        .map(|(e, _)| e)
         .collect();
     if !stale.is_empty() {
         md.push_str("\n## Entries of the equivalent list no survivor matched this run\n\n");
-        for k in stale {
-            let _ = writeln!(md, "- {} | {} | {}", k.file, k.mutation, k.line);
+        for e in stale {
+            let _ = writeln!(md, "- {e}");
         }
     }
     let path = out.join("report.md");
@@ -678,5 +680,50 @@ fn report(root: &Path, out: &Path, areas: &[&Area]) -> Result<(), String> {
             100.0 * GOAL,
             short.join(", ")
         ))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{equivalents, key_of};
+    use crate::cmd::project_root;
+
+    /// Every entry of the equivalent list names a file that holds the entry's source line.
+    #[test]
+    fn equivalent_entries_name_existing_lines() -> Result<(), String> {
+        let root = project_root();
+        for entry in equivalents(&root)? {
+            let file = entry.split(" | ").next().unwrap_or_default();
+            let source =
+                std::fs::read_to_string(root.join(file)).map_err(|e| format!("{file}: {e}"))?;
+            let held = source
+                .lines()
+                .any(|l| !l.trim().is_empty() && entry.contains(&format!(" | {} | ", l.trim())));
+            assert!(held, "no line of {file} is the one of `{entry}`");
+        }
+        Ok(())
+    }
+
+    /// A mutation that holds ` | ` itself (`replace | with ^`) still finds its entry.
+    #[test]
+    fn a_mutation_with_a_bar_matches_its_entry() -> Result<(), String> {
+        let root = project_root();
+        let file = "lagrange-integrators/src/adaptive/controller.rs";
+        let source = std::fs::read_to_string(root.join(file)).map_err(|e| e.to_string())?;
+        let line = source
+            .lines()
+            .position(|l| l.contains("0x007f_ffff) | 0x3f80_0000"))
+            .ok_or("the line of log2 moved")?
+            + 1;
+        let listed = format!("{file}:{line}:53: replace | with ^ in log2");
+        let key = key_of(&root, &listed).ok_or("no key")?;
+        assert_eq!(
+            equivalents(&root)?
+                .iter()
+                .filter(|e| e.starts_with(&key.prefix()))
+                .count(),
+            1
+        );
+        Ok(())
     }
 }
