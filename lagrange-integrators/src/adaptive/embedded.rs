@@ -534,6 +534,12 @@ where
             if y0.t + h == y0.t || (!last && h < self.settings.h_min()) {
                 return Err(Error::StepSizeUnderflow);
             }
+            if !last {
+                // The step the clock takes (t + h rounds to a multiple of t's ulp; the
+                // difference is exact): the state moves by as much time as its clock, or a
+                // late run (an f32 clock after an hour, an ulp of 2.4e-4 s) drifts in phase.
+                h = (y0.t + h) - y0.t;
+            }
             let mut y1 = y0;
             run_stages!(self, m, y0, h, y1; 1 2 3 4 5 6 7 8 9 10 11 12);
             if last {
