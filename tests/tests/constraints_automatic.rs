@@ -70,6 +70,19 @@ where
             worst = worst.max(e);
             assert!(e < tol, "at {s:?}: hand {a:?} auto {b:?} ({e:e})");
         }
+        // The open chain's split form too (a solve_mass of its own can hide a wrong matrix).
+        let free = EulerLagrange::new(hand.clone());
+        let (ma, mb) = (hand.mass_matrix(&s), free.mass_matrix(&s));
+        let e = relative(ma.iter().copied(), mb.iter().copied(), 1.0);
+        worst = worst.max(e);
+        assert!(
+            e < tol,
+            "mass matrix at {s:?}: hand {ma:?} auto {mb:?} ({e:e})"
+        );
+        let (ra, rb) = (hand.rhs(&s), free.rhs(&s));
+        let e = relative(ra.iter().copied(), rb.iter().copied(), scale);
+        worst = worst.max(e);
+        assert!(e < tol, "rhs at {s:?}: hand {ra:?} auto {rb:?} ({e:e})");
         let (ja, jb): (SMatrix<T, C, N>, SMatrix<T, C, N>) =
             (hand.jacobian(&s.q), auto.parts().rows().jacobian(&s.q));
         let e = relative(ja.iter().copied(), jb.iter().copied(), 1.0);

@@ -267,6 +267,8 @@ const AREAS: [Area; 9] = [
             "rolling_disk",
             "--test",
             "cartesian_pendulum",
+            "--test",
+            "constraints_automatic",
         ],
         unit_tests: false,
     },
