@@ -458,6 +458,53 @@ mod tests {
         Ok(())
     }
 
+    /// `c (x - 1) = 0` from `x = 0`: fixed-point iteration contracts by `1 - c` per
+    /// iteration (Newton solves it in one); counts the Newton matrices asked for.
+    struct Linear {
+        c: f64,
+        matrices: u32,
+    }
+    impl NewtonProblem<f64, 1, 1> for Linear {
+        fn residual(&mut self, x: &Blocks<f64, 1, 1>) -> Result<Blocks<f64, 1, 1>, Error> {
+            Ok([x[0].map(|v| self.c * (v - 1.0))])
+        }
+        fn newton_matrix(
+            &mut self,
+            _x: &Blocks<f64, 1, 1>,
+        ) -> Result<BlockMatrix<f64, 1, 1>, Error> {
+            self.matrices += 1;
+            Ok(BlockMatrix([[SMatrix::<f64, 1, 1>::new(self.c)]]))
+        }
+        fn weights(&self, x: &Blocks<f64, 1, 1>) -> Blocks<f64, 1, 1> {
+            [x[0].map(f64::abs)]
+        }
+    }
+
+    /// A fixed-point iteration that would not reach the tolerance within the limit (20),
+    /// contracting by 0.7 or 0.4 (its weighted rate at the second iteration 0.41 and 0.29:
+    /// below the half that switches at once, but too slow to finish), gives way to Newton at
+    /// its second iteration: one matrix, and the linear problem is solved at the fourth. One
+    /// that contracts by 0.1 or 0.05 finishes alone (about 16 and 12 iterations), without a
+    /// matrix.
+    #[test]
+    fn fixed_point_gives_way_to_newton_only_when_too_slow() -> Result<(), Error> {
+        for (c, matrices) in [(0.3, 1), (0.6, 1), (0.9, 0), (0.95, 0)] {
+            let mut problem = Linear { c, matrices: 0 };
+            let mut x = [SVector::<f64, 1>::new(0.0)];
+            let settings = NewtonSettings::default();
+            let iterations = solve(&mut problem, &mut x, &settings, Start::FixedPoint)?;
+            assert!(
+                (x[0][0] - 1.0).abs() <= 4.0 * f64::EPSILON,
+                "c = {c}: {x:?}"
+            );
+            assert_eq!(problem.matrices, matrices, "c = {c}");
+            if matrices == 1 {
+                assert_eq!(iterations, 4, "c = {c}");
+            }
+        }
+        Ok(())
+    }
+
     #[test]
     fn iteration_cap_gives_no_convergence() -> Result<(), Error> {
         let mut x = [SVector::<f64, 1>::new(1.0)];

@@ -59,7 +59,8 @@ struct Area {
     /// Arguments of `cargo test -p <test_package>` for each mutant: the test binaries to run.
     tests: &'static [&'static str],
     /// Also run the mutated package's own unit tests (`--lib`): for private kernels tested
-    /// where they live (the step-size controller's `log2` and `exp2`). Costs a second build
+    /// where they live (the step-size controller's `log2` and `exp2`, Newton's hand-over from
+    /// fixed-point iteration). Costs a second build
     /// of the mutated crate per mutant.
     unit_tests: bool,
 }
@@ -125,7 +126,7 @@ const AREAS: [Area; 9] = [
             "--test",
             "work_counts",
         ],
-        unit_tests: false,
+        unit_tests: true,
     },
     Area {
         name: "adaptive",
