@@ -60,8 +60,7 @@ struct Area {
     tests: &'static [&'static str],
     /// Also run the mutated package's own unit tests (`--lib`): for private kernels tested
     /// where they live (the step-size controller's `log2` and `exp2`, Newton's hand-over from
-    /// fixed-point iteration). Costs a second build
-    /// of the mutated crate per mutant.
+    /// fixed-point iteration). Costs a second build of the mutated crate per mutant.
     unit_tests: bool,
 }
 
