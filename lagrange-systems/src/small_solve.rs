@@ -87,3 +87,130 @@ pub(crate) fn finite<T: Real, const N: usize>(
         Err(error)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn state(q0: f64) -> State<f64, 2> {
+        State::new(0.0, [q0, 0.2], [0.3, -0.4])
+    }
+
+    /// The symmetric solve leaves a residual of a few ulps of `|m| |x|` on positive definite
+    /// systems with weak and strong coupling, and refuses a non-positive or non-finite
+    /// determinant and a result that overflows.
+    #[test]
+    fn symmetric_solve() {
+        for (a, c, d) in [
+            (2.0, 0.3, 1.5),
+            (1.0, -0.99, 1.0),
+            (5e3, 2.0, 3e-3),
+            (1.0, 0.0, 4.0),
+        ] {
+            let m = Matrix2::new(a, c, c, d);
+            let b = Vector2::new(0.7, -1.9);
+            for x in [solve_sym2(&m, &b), solve_sym2_det(&m, a * d - c * c, &b)] {
+                let x = x.unwrap_or_else(|e| panic!("{m:?}: {e}"));
+                let scale = m.abs().max() * x.abs().max();
+                assert!(
+                    (m * x - b).abs().max() <= 8.0 * f64::EPSILON * scale,
+                    "{m:?}: {x:?}"
+                );
+            }
+        }
+        let b = Vector2::new(1.0, 1.0);
+        let singular = Matrix2::new(1.0, 1.0, 1.0, 1.0);
+        assert_eq!(
+            solve_sym2(&singular, &b),
+            Err(Error::SingularMassMatrix { pivot: 1 })
+        );
+        let indefinite = Matrix2::new(1.0, 2.0, 2.0, 1.0);
+        assert_eq!(
+            solve_sym2(&indefinite, &b),
+            Err(Error::SingularMassMatrix { pivot: 1 })
+        );
+        let m = Matrix2::new(1.0, 0.0, 0.0, 1.0);
+        assert_eq!(solve_sym2_det(&m, f64::NAN, &b), Err(Error::NonFiniteState));
+        assert_eq!(
+            solve_sym2_det(&m, f64::INFINITY, &b),
+            Err(Error::NonFiniteState)
+        );
+        let tiny = Matrix2::new(1.0, 0.0, 0.0, 1e-300);
+        assert_eq!(
+            solve_sym2(&tiny, &Vector2::new(1.0, 1e10)),
+            Err(Error::NonFiniteState)
+        );
+    }
+
+    /// The diagonal solve divides by positive entries; an entry that is zero or negative (the
+    /// singular configuration), or a quotient that overflows, is the singularity named; a
+    /// state that is not finite is `NonFiniteState`.
+    #[test]
+    fn diagonal_solve() {
+        let b = Vector2::new(3.0, -2.0);
+        assert_eq!(
+            solve_diagonal2(&state(1.0), [2.0, 4.0], &b, "r = 0"),
+            Ok(Vector2::new(1.5, -0.5))
+        );
+        let singular = Err(Error::Singularity { what: "r = 0" });
+        for d in [
+            [-1.0, 4.0],
+            [2.0, -4.0],
+            [0.0, 4.0],
+            [2.0, 0.0],
+            [-1.0, -1.0],
+        ] {
+            assert_eq!(
+                solve_diagonal2(&state(1.0), d, &b, "r = 0"),
+                singular,
+                "{d:?}"
+            );
+        }
+        assert_eq!(
+            solve_diagonal2(
+                &state(1.0),
+                [1e-310, 1.0],
+                &Vector2::new(1e10, 1.0),
+                "r = 0"
+            ),
+            singular
+        );
+        assert_eq!(
+            solve_diagonal2(&state(f64::NAN), [2.0, 4.0], &b, "r = 0"),
+            Err(Error::NonFiniteState)
+        );
+    }
+
+    /// A positive radius passes; zero and negative are the singularity; NaN is not finite.
+    #[test]
+    fn radius() {
+        assert_eq!(positive_radius(&state(0.5), "r = 0"), Ok(()));
+        for r in [0.0, -0.5] {
+            assert_eq!(
+                positive_radius(&state(r), "r = 0"),
+                Err(Error::Singularity { what: "r = 0" })
+            );
+        }
+        assert_eq!(
+            positive_radius(&state(f64::NAN), "r = 0"),
+            Err(Error::NonFiniteState)
+        );
+    }
+
+    /// Every entry must be finite, not only one.
+    #[test]
+    fn finiteness() {
+        let e = Error::NonFiniteState;
+        assert_eq!(
+            finite(Vector2::new(1.0, 2.0), e),
+            Ok(Vector2::new(1.0, 2.0))
+        );
+        for bad in [
+            [1.0, f64::NAN],
+            [f64::INFINITY, 1.0],
+            [f64::NAN, f64::NEG_INFINITY],
+        ] {
+            assert_eq!(finite(Vector2::from(bad), e), Err(e), "{bad:?}");
+        }
+    }
+}
