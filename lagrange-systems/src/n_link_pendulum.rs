@@ -253,10 +253,11 @@ impl<T: Real, const N: usize> NLinkPendulum<T, N> {
         })
     }
 
-    /// [`Self::tension_solve`] under gravity alone, `(px_j, py_j) = (0, -g)` on every mass,
-    /// written out: the differences of the external forces per unit mass vanish past the first
-    /// rod, so gravity enters the first row of the tension system (`g cos th_1`) and the first
-    /// angle's acceleration (`-g sin th_1 / l_1`) only.
+    /// The tension recursion described on the type, for the chain in motion under gravity
+    /// alone (`(px_j, py_j) = (0, -g)` on every mass), written out: the differences of the
+    /// external forces per unit mass vanish past the first rod, so gravity enters the first
+    /// row of the tension system (`g cos th_1`) and the first angle's acceleration
+    /// (`-g sin th_1 / l_1`) only.
     #[inline(always)]
     fn falling(
         &self,
@@ -299,19 +300,19 @@ impl<T: Real, const N: usize> NLinkPendulum<T, N> {
         finite(qdd, Error::NonFiniteState)
     }
 
-    /// The tension recursion described on the type: `q''` of the chain at angles with sines
-    /// `sin` and cosines `cos`, rates `qd`, under external forces per unit mass `(px_j, py_j)`
-    /// on each mass (gravity is `(0, -g)` on every one).
+    /// The tension recursion described on the type, at rest: `q''` of the chain at angles
+    /// with sines `sin` and cosines `cos`, not moving, under external forces per unit mass
+    /// `(px_j, py_j)` on each mass. (The chain in motion under gravity is [`Self::falling`].)
     fn tension_solve(
         &self,
         (sin, cos): ([T; N], [T; N]),
-        qd: &SVector<T, N>,
         (px, py): ([T; N], [T; N]),
     ) -> Result<SVector<T, N>, Error> {
-        let (l, inv_m) = (&self.lengths, &self.inv_masses);
+        let inv_m = &self.inv_masses;
         // K tau = r, K tridiagonal: diagonal `d`, super-diagonal `off` (off[j] = K_j,j+1).
         // e_j = (sin, -cos), n_j = (cos, sin); sn[j] = e_{j+1} . n_j = sin(th_{j+1} - th_j).
-        // Row j: r_j = l_j th_j'^2 + (p_j - p_{j-1}) . e_j, with p_{-1} = 0 at the pivot.
+        // Row j: r_j = (p_j - p_{j-1}) . e_j, with p_{-1} = 0 at the pivot (and no
+        // centripetal term l_j th_j'^2: at rest).
         let mut d = [T::zero(); N];
         let mut off = [T::zero(); N];
         let mut sn = [T::zero(); N];
@@ -324,7 +325,7 @@ impl<T: Real, const N: usize> NLinkPendulum<T, N> {
                 dpy -= py[j - 1];
                 d[j] += inv_m[j - 1];
             }
-            r[j] = l[j] * qd[j] * qd[j] + dpx * sin[j] - dpy * cos[j];
+            r[j] = dpx * sin[j] - dpy * cos[j];
             if j + 1 < N {
                 off[j] = -(cos[j] * cos[j + 1] + sin[j] * sin[j + 1]) * inv_m[j];
                 sn[j] = sin[j + 1] * cos[j] - cos[j + 1] * sin[j];
@@ -404,7 +405,7 @@ impl<T: Real, const N: usize> Mechanism<T, N> for NLinkPendulum<T, N> {
             px[j] = (here.0 - next.0) * self.inv_masses[j];
             py[j] = (here.1 - next.1) * self.inv_masses[j];
         }
-        self.tension_solve((sin, cos), &SVector::zeros(), (px, py))
+        self.tension_solve((sin, cos), (px, py))
     }
 
     /// The closed form: the tension recursion under gravity alone (`falling`), plus
