@@ -42,23 +42,32 @@ fn damping_acts_through_the_rod<T: Real>() -> Result<(), Error> {
 }
 
 /// A drive torque `tau` on the rolling angle of the disk accelerates the rolling by
-/// `tau / (I_s + m R^2)` (the contact force makes the mass roll along), not by `tau / I_s`,
-/// and leaves the heading rate alone; to 8 ulps.
+/// `tau / (I_s + m R^2)` (the contact force makes the mass roll along), not by `tau / I_s`;
+/// a steering torque `tau_psi` turns the heading by `tau_psi / I_t` (the contact force has no
+/// moment about the vertical), whatever the heading and the rates (Newton's laws for the
+/// disk, not its Lagrangian: `I_t = m R^2 / 4`, `I_s = m R^2 / 2`); to 8 ulps.
 fn drive_torque_acts_through_the_contact<T: Real>() -> Result<(), Error> {
-    let (m, r, tau) = (T::from_f64(2.0), T::from_f64(0.4), T::from_f64(0.6));
+    let (m, r) = (T::from_f64(2.0), T::from_f64(0.4));
     let disk = Constrained::new(RollingDisk::new(m, r)?);
-    let driven = disk.with_force(Input::new([T::zero(), T::zero(), T::zero(), tau]));
-    let s = disk.parts().rolling(
-        T::zero(),
-        [T::zero(); 4],
-        T::from_f64(0.5),
-        T::from_f64(3.0),
-    )?;
-    let a = driven.acceleration(&s)?;
-    let expected = tau / (T::HALF * m * r * r + m * r * r);
-    let tol = T::from_f64(8.0) * T::EPSILON * expected;
-    assert!((a[3] - expected).abs() <= tol, "{} vs {expected}", a[3]);
-    assert!(a[2].abs() <= tol);
+    for (tau_psi, tau, heading) in [(0.0, 0.6, 0.0), (0.25, 0.6, 0.7), (-0.4, -0.1, 2.9)] {
+        let (tau_psi, tau) = (T::from_f64(tau_psi), T::from_f64(tau));
+        let driven = disk.with_force(Input::new([T::zero(), T::zero(), tau_psi, tau]));
+        let s = disk.parts().rolling(
+            T::zero(),
+            [T::zero(), T::zero(), T::from_f64(heading), T::zero()],
+            T::from_f64(0.5),
+            T::from_f64(3.0),
+        )?;
+        let a = driven.acceleration(&s)?;
+        let mr2 = m * r * r;
+        let (rolling, turning) = (
+            tau / (T::HALF * mr2 + mr2),
+            tau_psi / (T::HALF * T::HALF * mr2),
+        );
+        let tol = T::from_f64(8.0) * T::EPSILON * (rolling.abs() + turning.abs());
+        assert!((a[3] - rolling).abs() <= tol, "{} vs {rolling}", a[3]);
+        assert!((a[2] - turning).abs() <= tol, "{} vs {turning}", a[2]);
+    }
     Ok(())
 }
 

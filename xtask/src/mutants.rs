@@ -280,6 +280,8 @@ const AREAS: [Area; 10] = [
             "cartesian_pendulum",
             "--test",
             "constraints_automatic",
+            "--test",
+            "constrained_forces",
         ],
         unit_tests: false,
     },
