@@ -49,6 +49,8 @@ struct Worst {
     ours_at: f32,
     libm: f64,
     samples: u64,
+    /// Results (sine and cosine) that are not the exact value rounded to nearest.
+    misrounded: u64,
 }
 
 impl Worst {
@@ -68,16 +70,31 @@ impl Worst {
             self.ours = ours;
             self.ours_at = x;
         }
+        // The f64 reference rounds to the nearest f32 but within about 2^-29 ulp of a tie.
+        self.misrounded +=
+            u64::from(s != libm::sin(xd) as f32) + u64::from(c != libm::cos(xd) as f32);
         let theirs = ulps(libm::sinf(x), libm::sin(xd)).max(ulps(libm::cosf(x), libm::cos(xd)));
         self.libm = self.libm.max(theirs);
         self.samples += 1;
     }
 
-    /// Asserts the stated bound and reports the figures.
-    fn assert_within_bound(&self, what: &str) {
+    /// Asserts the stated bound, and that at most `misrounded_percent` of the results are not
+    /// correctly rounded, and reports the figures. The fraction is a fixed figure of these
+    /// fixed inputs; each bound sits about 10% above the measured one (in the comment at each
+    /// call), so that kernels as accurate pass and a less accurate one fails where the worst
+    /// case alone does not notice: the low part of a reduced argument scaled wrongly in
+    /// `sin_kernel_lo` keeps every error below 2 ulps but leaves 17.8% to 20.2% of the large
+    /// arguments misrounded.
+    fn assert_within_bound(&self, what: &str, misrounded_percent: f64) {
+        let misrounded = self.misrounded as f64 / (2 * self.samples) as f64 * 100.0;
         println!(
-            "{what}: {} inputs, max error {:.3} ulp at {:e} (libm::sinf/cosf: {:.3} ulp)",
-            self.samples, self.ours, self.ours_at, self.libm
+            "{what}: {} inputs, max error {:.3} ulp at {:e} (libm::sinf/cosf: {:.3} ulp), \
+             {:.3}% not correctly rounded",
+            self.samples, self.ours, self.ours_at, self.libm, misrounded
+        );
+        assert!(
+            misrounded <= misrounded_percent,
+            "{what}: {misrounded:.3}% not correctly rounded"
         );
         assert!(
             self.ours <= f64::from(MAX_ULP_ERROR),
@@ -121,7 +138,8 @@ fn reduced_range_dense_sweep() {
     bit_sweep(&mut worst, f32::MIN_POSITIVE, FRAC_PI_4_F32, 4096);
     assert!(f64::from(FRAC_PI_4_F32) <= std::f64::consts::FRAC_PI_4);
     assert!(f64::from(f32::from_bits(0x3f49_0fdb)) > std::f64::consts::FRAC_PI_4);
-    worst.assert_within_bound("|x| <= pi/4");
+    // Measured: 5.288% not correctly rounded.
+    worst.assert_within_bound("|x| <= pi/4", 5.8);
 }
 
 /// Every binade from pi/4 to `f32::MAX`: every 2003rd bit pattern (about 1.08 million inputs
@@ -130,7 +148,8 @@ fn reduced_range_dense_sweep() {
 fn all_binades_sweep() {
     let mut worst = Worst::default();
     bit_sweep(&mut worst, FRAC_PI_4_F32, f32::MAX, 2003);
-    worst.assert_within_bound("pi/4 < |x| <= f32::MAX");
+    // Measured: 14.743%.
+    worst.assert_within_bound("pi/4 < |x| <= f32::MAX", 16.2);
 }
 
 /// 400 000 seeded random arguments: uniform in `[-100, 100]` (where mechanisms live) and
@@ -151,7 +170,8 @@ fn random_arguments() {
             drawn += 1;
         }
     }
-    worst.assert_within_bound("random");
+    // Measured: 11.178%.
+    worst.assert_within_bound("random", 12.3);
 }
 
 /// The `f32`s nearest to `k pi/2` and their 4 neighbours on each side, for `k` up to 2^16
@@ -167,7 +187,8 @@ fn near_multiples_of_half_pi() {
             worst.check(f32::from_bits(d));
         }
     }
-    worst.assert_within_bound("near k pi/2");
+    // Measured: 2.510%.
+    worst.assert_within_bound("near k pi/2", 2.8);
 }
 
 /// Special values: zeros keep their sign in `sin`, infinities and NaN give NaN, subnormals
