@@ -505,6 +505,61 @@ mod tests {
         Ok(())
     }
 
+    /// The convergence measure: an unknown whose scale is zero is measured against 2^-20 of
+    /// the largest scale, and when every scale is zero against `MIN_POSITIVE / EPSILON`.
+    #[test]
+    fn weighted_size_floors_the_scales() {
+        let dx = [Vector2::new(1e-3, 1e-3)];
+        let w = [Vector2::new(1.0, 0.0)];
+        assert_eq!(weighted_size(&dx, &w), 1e-3 * 1_048_576.0);
+        let w = [Vector2::new(2.0, -4.0)];
+        assert_eq!(weighted_size(&dx, &w), 1e-3 / 2.0);
+        let zero = [Vector2::new(0.0, 0.0)];
+        assert_eq!(
+            weighted_size(&dx, &zero),
+            1e-3 / (f64::MIN_POSITIVE / f64::EPSILON)
+        );
+    }
+
+    /// `x = x - (x^2 - 2) / 3` whose residual is NaN past `x = 1.2`: the iteration stops with
+    /// `NonFiniteState` at the first NaN, by Newton and by fixed point, not after its limit.
+    struct Poisoned(u32);
+    impl NewtonProblem<f64, 1, 1> for Poisoned {
+        fn residual(&mut self, x: &Blocks<f64, 1, 1>) -> Result<Blocks<f64, 1, 1>, Error> {
+            self.0 += 1;
+            Ok([x[0].map(|v| {
+                if v > 1.2 {
+                    f64::NAN
+                } else {
+                    (v * v - 2.0) / 3.0
+                }
+            })])
+        }
+        fn newton_matrix(
+            &mut self,
+            x: &Blocks<f64, 1, 1>,
+        ) -> Result<BlockMatrix<f64, 1, 1>, Error> {
+            Ok(BlockMatrix([[x[0].map(|v| 2.0 * v / 3.0)]]))
+        }
+        fn weights(&self, x: &Blocks<f64, 1, 1>) -> Blocks<f64, 1, 1> {
+            [x[0].map(f64::abs)]
+        }
+    }
+
+    #[test]
+    fn a_non_finite_residual_stops_the_iteration() {
+        for start in [Start::Newton, Start::FixedPoint] {
+            let mut problem = Poisoned(0);
+            let mut x = [SVector::<f64, 1>::new(1.0)];
+            assert_eq!(
+                solve(&mut problem, &mut x, &NewtonSettings::default(), start),
+                Err(Error::NonFiniteState),
+                "{start:?}"
+            );
+            assert!(problem.0 <= 3, "{start:?}: {} residuals", problem.0);
+        }
+    }
+
     #[test]
     fn iteration_cap_gives_no_convergence() -> Result<(), Error> {
         let mut x = [SVector::<f64, 1>::new(1.0)];
