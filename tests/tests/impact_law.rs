@@ -160,3 +160,20 @@ fn friction_keeps_a_resting_row_at_rest() -> Result<(), Error> {
     assert_eq!(resting, [false, true]);
     Ok(())
 }
+
+/// A slow approach (1e-4 m/s, a tenth of the rest speed of 1e-3 m/s) is still an approach: a
+/// plastic impulse stops it, `q'+ = 0`, and the row rests. One far below the rest speed
+/// (1e-7 m/s, under the noise threshold of a thousandth of it) is no approach: the row comes
+/// to rest without an impulse (the projection at the end of the step takes the creep out).
+#[test]
+fn slow_approaches_stop_and_creep_settles() -> Result<(), Error> {
+    let model = plastic()?;
+    let unit = || Sheared { m: 1.0, c: 0.0 };
+    let (after, resting) = impact(unit(), &model, [0.0, -1e-4], [false, true], [false; 2])?;
+    assert!(after.abs().max() <= 1e-4 * ROUNDING, "{after:?}");
+    assert_eq!(resting, [false, true]);
+    let (after, resting) = impact(unit(), &model, [0.0, -1e-7], [false, true], [false; 2])?;
+    assert_eq!(after, Vector2::new(0.0, -1e-7));
+    assert_eq!(resting, [false, true]);
+    Ok(())
+}
