@@ -527,22 +527,17 @@ mod tests {
     impl NewtonProblem<f64, 1, 1> for Poisoned {
         fn residual(&mut self, x: &Blocks<f64, 1, 1>) -> Result<Blocks<f64, 1, 1>, Error> {
             self.0 += 1;
-            Ok([x[0].map(|v| {
-                if v > 1.2 {
-                    f64::NAN
-                } else {
-                    (v * v - 2.0) / 3.0
-                }
-            })])
+            let [r] = Sqrt2.residual(x)?;
+            Ok([r.zip_map(&x[0], |r, v| if v > 1.2 { f64::NAN } else { r })])
         }
         fn newton_matrix(
             &mut self,
             x: &Blocks<f64, 1, 1>,
         ) -> Result<BlockMatrix<f64, 1, 1>, Error> {
-            Ok(BlockMatrix([[x[0].map(|v| 2.0 * v / 3.0)]]))
+            Sqrt2.newton_matrix(x)
         }
         fn weights(&self, x: &Blocks<f64, 1, 1>) -> Blocks<f64, 1, 1> {
-            [x[0].map(f64::abs)]
+            Sqrt2.weights(x)
         }
     }
 
