@@ -35,10 +35,11 @@ const EQUIVALENT_LIST: &str = "xtask/mutants-equivalent.txt";
 /// mutants (a timed-out mutant counts as killed: the run detected it).
 const GOAL: f64 = 0.9;
 
-/// Seconds a mutant's tests may run before it counts as timed out (detected): the slowest
-/// subset runs in about 6 s unmutated at the mutants' `opt-level = 1`; a mutant that makes an
-/// adaptive pair crawl at tiny steps otherwise holds a job for minutes.
-const TEST_TIMEOUT_S: &str = "20";
+/// Seconds a mutant's tests may run before it counts as timed out (detected): five times the
+/// slowest subset unmutated and alone (6 s, the chains' at `opt-level = 0`), so that a clean
+/// run slowed by the other job is not taken for a detection; a mutant that makes an adaptive
+/// pair crawl at tiny steps otherwise holds a job for minutes.
+const TEST_TIMEOUT_S: &str = "30";
 
 /// Seconds a mutant's build may take (the baseline is ours, so cargo-mutants cannot scale it).
 const BUILD_TIMEOUT_S: &str = "600";
@@ -62,6 +63,22 @@ struct Area {
     /// where they live (the step-size controller's `log2` and `exp2`, Newton's hand-over from
     /// fixed-point iteration). Costs a second build of the mutated crate per mutant.
     unit_tests: bool,
+    /// Build the mutants at `opt-level = 1` rather than 0: only where the tests need it (the
+    /// exhaustive sweeps of `fast_trig`). Unoptimised, a mutant of a system rebuilds in under
+    /// 2 s and its tests run in at most 6 s; at `opt-level = 1` the rebuild alone took 10 s
+    /// (the monomorphised integrators and systems in every test binary are optimised again).
+    optimised: bool,
+}
+
+impl Area {
+    /// The dev profile the area's mutants (and its baseline) build in: without debug
+    /// information (a third of a link), optimised only where [`Area::optimised`] asks.
+    fn profile<'c>(&self, c: &'c mut Command) -> &'c mut Command {
+        c.env("CARGO_PROFILE_DEV_DEBUG", "0").env(
+            "CARGO_PROFILE_DEV_OPT_LEVEL",
+            if self.optimised { "1" } else { "0" },
+        )
+    }
 }
 
 /// The areas, in the order they run.
@@ -96,6 +113,7 @@ const AREAS: [Area; 10] = [
             "work_counts",
         ],
         unit_tests: false,
+        optimised: false,
     },
     Area {
         name: "implicit",
@@ -126,6 +144,7 @@ const AREAS: [Area; 10] = [
             "work_counts",
         ],
         unit_tests: true,
+        optimised: false,
     },
     Area {
         name: "adaptive",
@@ -151,6 +170,7 @@ const AREAS: [Area; 10] = [
             "issue15",
         ],
         unit_tests: true,
+        optimised: false,
     },
     Area {
         name: "impacts",
@@ -171,6 +191,7 @@ const AREAS: [Area; 10] = [
             "friction",
         ],
         unit_tests: false,
+        optimised: false,
     },
     Area {
         name: "constraints",
@@ -201,6 +222,7 @@ const AREAS: [Area; 10] = [
             "constraints_three_rows",
         ],
         unit_tests: false,
+        optimised: false,
     },
     Area {
         name: "fast-trig",
@@ -210,6 +232,7 @@ const AREAS: [Area; 10] = [
         only: None,
         tests: &["--test", "fast_trig"],
         unit_tests: false,
+        optimised: true,
     },
     Area {
         name: "systems-one",
@@ -224,6 +247,7 @@ const AREAS: [Area; 10] = [
         only: Some(ACCELERATIONS),
         tests: SYSTEM_TESTS,
         unit_tests: false,
+        optimised: false,
     },
     Area {
         name: "systems-two",
@@ -241,6 +265,7 @@ const AREAS: [Area; 10] = [
         only: Some(ACCELERATIONS),
         tests: SYSTEM_TESTS,
         unit_tests: false,
+        optimised: false,
     },
     Area {
         // The two-coordinate systems' shared solves, tested where they live: their callers
@@ -253,6 +278,7 @@ const AREAS: [Area; 10] = [
         only: None,
         tests: &["--lib"],
         unit_tests: false,
+        optimised: false,
     },
     Area {
         name: "systems-chains",
@@ -284,6 +310,7 @@ const AREAS: [Area; 10] = [
             "constrained_forces",
         ],
         unit_tests: false,
+        optimised: false,
     },
 ];
 
@@ -445,9 +472,7 @@ pub fn run(args: &[String]) -> Result<(), String> {
             // they are not: this is the baseline instead, and must pass for the run to mean
             // anything (a mutant that fails tests that already fail is not killed by them).
             let mut baseline = cmd::cargo();
-            baseline
-                .env("CARGO_PROFILE_DEV_DEBUG", "0")
-                .env("CARGO_PROFILE_DEV_OPT_LEVEL", "1")
+            area.profile(&mut baseline)
                 .args(["test", "--quiet", "-p", area.test_package])
                 .args(area.tests);
             if area.unit_tests {
@@ -480,10 +505,7 @@ pub fn run(args: &[String]) -> Result<(), String> {
 /// listing the mutants.
 fn mutants_command(area: &Area, out: &Path, o: &Options, list: bool) -> Command {
     let mut c = cmd::cargo();
-    // Mutants build in the dev profile: without debug information (a third of a link) and
-    // optimised a little, so that the tests of a mutant run in seconds, not a minute.
-    c.env("CARGO_PROFILE_DEV_DEBUG", "0")
-        .env("CARGO_PROFILE_DEV_OPT_LEVEL", "1");
+    area.profile(&mut c);
     c.args(["mutants", "--package", area.package]);
     for f in area.files {
         c.args(["--file", f]);
