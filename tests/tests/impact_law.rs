@@ -4,7 +4,7 @@
 //! worked out in its docs; the bounds are rounding (a few ulps of velocities of order 1).
 
 use lagrange_core::constraints::contact::Impacts;
-use lagrange_core::nalgebra::{Matrix2, SMatrix, SVector, Vector2};
+use lagrange_core::nalgebra::{Matrix2, Matrix3, SMatrix, SVector, Vector2, Vector3};
 use lagrange_core::{Constraints, Error, EulerLagrange, Lagrangian, Scalar, State};
 use lagrange_integrators::{ContactModel, Contacts};
 
@@ -175,5 +175,67 @@ fn slow_approaches_stop_and_creep_settles() -> Result<(), Error> {
     let (after, resting) = impact(unit(), &model, [0.0, -1e-7], [false, true], [false; 2])?;
     assert_eq!(after, Vector2::new(0.0, -1e-7));
     assert_eq!(resting, [false, true]);
+    Ok(())
+}
+
+/// A point in the corner of three walls `q_i >= 0` (row `i`, frictionless) with a constant
+/// mass matrix, no forces.
+struct Octant([[f64; 3]; 3]);
+
+impl Lagrangian<f64, 3> for Octant {
+    fn kinetic<S: Scalar<Real = f64>>(&self, _t: S, _q: &SVector<S, 3>, v: &SVector<S, 3>) -> S {
+        let mut t = S::from_f64(0.0);
+        for (i, row) in self.0.iter().enumerate() {
+            for (j, m) in row.iter().enumerate() {
+                t += v[i] * v[j] * (0.5 * m);
+            }
+        }
+        t
+    }
+    fn potential<S: Scalar<Real = f64>>(&self, _t: S, _q: &SVector<S, 3>) -> S {
+        S::from_f64(0.0)
+    }
+}
+
+impl Constraints<f64, 3, 3> for Octant {
+    fn position_residual(&self, q: &Vector3<f64>) -> Vector3<f64> {
+        *q
+    }
+    fn jacobian(&self, _q: &Vector3<f64>) -> Matrix3<f64> {
+        Matrix3::identity()
+    }
+    fn velocity_product(&self, _q: &Vector3<f64>, _qd: &Vector3<f64>) -> Vector3<f64> {
+        Vector3::zeros()
+    }
+}
+
+impl Contacts<f64, 3, 3> for Octant {}
+
+/// Row 2 strikes at 1 m/s (plastic) while rows 0 and 1 rest, with
+/// `M = [[2, 1, -0.2], [1, 2, -1], [-0.2, -1, 2]]` (`det = 4.32`). All three held would need
+/// `p = M (0, 0, 1) = (-0.2, -1, 2)`: both resting rows pull, row 1 the harder. It lets go
+/// alone, and with rows 0 and 2 held, `p = (0.3, 1.5)` (both push: row 0 pulled only because
+/// row 1 did) and `q'+ = (0, 0.5, 0)`: row 0 still rests. Dropping the weaker puller first
+/// leaves row 1 pulling, then nothing held but row 2: `q'+ = (-0.2, 0.6, 0)`, into wall 0.
+#[test]
+fn the_row_that_pulls_hardest_lets_go_first() -> Result<(), Error> {
+    let m = [[2.0, 1.0, -0.2], [1.0, 2.0, -1.0], [-0.2, -1.0, 2.0]];
+    let body = EulerLagrange::new(Octant(m));
+    let s = State::new(0.0, [0.0; 3], [0.0, 0.0, -1.0]);
+    let mut resting = [true, true, false];
+    let (after, _) = Impacts::new(&Octant(m), &plastic()?, [false; 3]).impact(
+        &body,
+        &s,
+        [false, false, true],
+        &mut resting,
+    )?;
+    assert!(
+        (after.qd - Vector3::new(0.0, 0.5, 0.0)).amax() < ROUNDING,
+        "{}",
+        after.qd
+    );
+    assert_eq!(resting, [true, false, true]);
+    let gain = body.kinetic_energy(&after) - body.kinetic_energy(&s);
+    assert!(gain <= ROUNDING, "the impact added {gain:e} J");
     Ok(())
 }
