@@ -89,7 +89,7 @@ impl Area {
 }
 
 /// The areas, in the order they run.
-const AREAS: [Area; 10] = [
+const AREAS: [Area; 13] = [
     Area {
         name: "explicit",
         package: "lagrange-integrators",
@@ -319,6 +319,62 @@ const AREAS: [Area; 10] = [
         unit_tests: false,
         optimised: false,
     },
+    Area {
+        name: "ragdoll",
+        package: "lagrange-systems",
+        test_package: "lagrange-tests",
+        files: &[
+            "lagrange-systems/src/ragdoll.rs",
+            "lagrange-systems/src/ragdoll_contacts.rs",
+        ],
+        only: Some(RAGDOLL),
+        tests: &["--test", "ragdoll"],
+        unit_tests: false,
+        optimised: false,
+    },
+    Area {
+        name: "core-solves",
+        package: "lagrange-core",
+        test_package: "lagrange-tests",
+        files: &[
+            "lagrange-core/src/cholesky.rs",
+            "lagrange-core/src/constraints/automatic.rs",
+            "lagrange-core/src/constraints/contact/active_rows.rs",
+        ],
+        only: None,
+        tests: &[
+            "--test",
+            "automatic_euler_lagrange",
+            "--test",
+            "constant_mass",
+            "--test",
+            "constraints_automatic",
+            "--test",
+            "constraints_three_rows",
+            "--test",
+            "bouncing_ball",
+            "--test",
+            "double_pendulum_floor",
+            "--test",
+            "pendulum_wall",
+            "--test",
+            "friction",
+            "--test",
+            "automatic_exactness",
+        ],
+        unit_tests: true,
+        optimised: false,
+    },
+    Area {
+        name: "events",
+        package: "lagrange-integrators",
+        test_package: "lagrange-tests",
+        files: &["lagrange-integrators/src/adaptive/events.rs"],
+        only: None,
+        tests: &["--test", "adaptive"],
+        unit_tests: false,
+        optimised: false,
+    },
 ];
 
 /// The mutants of a system that change how it moves: its equations (mass matrix, right-hand
@@ -328,6 +384,14 @@ const ACCELERATIONS: &str = "impl Mechanism|impl Constraints|small_solve|::terms
                              ::tension_solve|::solve_mass_from|::rhs_from|::phi_from|\
                              ::jacobian_from|::velocity_product_from|::solve_with|::inertias|\
                              ::weights|solve_diagonal2|solve_sym2";
+
+/// The ragdoll's [`ACCELERATIONS`]: its articulated-body law and the spatial algebra it
+/// runs on, its energies (the automatic path's oracle for that law), and its contact rows.
+const RAGDOLL: &str =
+    "impl Mechanism|impl Lagrangian|impl Constraints|impl Contacts|::articulated|\
+                       solve3|inertia_at|cross_motion|cross_force|\\bdot\\b|::segments|\
+                       Pose<S>::point|::pose\\b|\\bscale\\b|\\badd\\b|torso_axis|::world_point|\
+                       ::rates|::outward|::point_jacobians|::floor_points|::limits";
 
 /// The test binaries of the systems' areas.
 const SYSTEM_TESTS: &[&str] = &[
