@@ -766,6 +766,7 @@ fn report(root: &Path, out: &Path, areas: &[&Area]) -> Result<(), String> {
             let _ = writeln!(md, "- {s}");
         }
     }
+    md.push_str(&run_times(out, areas));
     let stale: Vec<&String> = equivalent
         .iter()
         .zip(&used)
@@ -793,9 +794,91 @@ fn report(root: &Path, out: &Path, areas: &[&Area]) -> Result<(), String> {
     }
 }
 
+/// The wall time of each area's last run, from cargo-mutants' own record (`start_time` and
+/// `end_time` of its `outcomes.json`; the area's baseline test run before it is not
+/// included), whether it was a full run or `--iterate`, and the sum of the full runs: what
+/// a whole run takes.
+fn run_times(out: &Path, areas: &[&Area]) -> String {
+    let mut md = String::from(
+        "\n## Run time of each area's last run\n\n\
+         | area | mutants run | kind | wall time |\n|---|---:|---|---:|\n",
+    );
+    let (mut total, mut every_full) = (0.0, true);
+    for area in areas {
+        let dir = out.join(area.name).join("mutants.out");
+        let Ok(json) = std::fs::read_to_string(dir.join("outcomes.json")) else {
+            every_full = false;
+            continue;
+        };
+        let seconds = json_time(&json, "end_time")
+            .zip(json_time(&json, "start_time"))
+            .map(|(end, start)| end - start);
+        let iterate = dir.join("previously_caught.txt").exists();
+        let run: usize = OUTCOMES
+            .iter()
+            .filter(|(list, _)| *list != "previously_caught.txt")
+            .map(|(list, _)| read_lines(&dir.join(list)).count())
+            .sum();
+        let kind = if iterate { "--iterate" } else { "full" };
+        let shown = seconds.map_or("-".to_string(), |s| format!("{s:.0} s"));
+        let _ = writeln!(md, "| {} | {run} | {kind} | {shown} |", area.name);
+        match seconds {
+            Some(s) if !iterate => total += s,
+            _ => every_full = false,
+        }
+    }
+    let _ = writeln!(
+        md,
+        "\nFull runs: {total:.0} s ({:.2} h){}.",
+        total / 3600.0,
+        if every_full {
+            ", every area"
+        } else {
+            "; some areas' last run was not a full one"
+        }
+    );
+    md
+}
+
+/// Seconds since 1970 of the timestamp `"key": "YYYY-MM-DDTHH:MM:SS.fffZ"` in `json`.
+fn json_time(json: &str, key: &str) -> Option<f64> {
+    let at = json.find(&format!("\"{key}\": \""))? + key.len() + 5;
+    let stamp = json.get(at..)?.split('"').next()?;
+    let (date, time) = stamp.trim_end_matches('Z').split_once('T')?;
+    let mut ymd = date.split('-').map(|x| x.parse::<i64>().ok());
+    let (y, m, d) = (ymd.next()??, ymd.next()??, ymd.next()??);
+    let mut hms = time.split(':');
+    let (h, min) = (
+        hms.next()?.parse::<f64>().ok()?,
+        hms.next()?.parse::<f64>().ok()?,
+    );
+    let sec = hms.next()?.parse::<f64>().ok()?;
+    // Days from 1970-01-01 to y-m-d in the proleptic Gregorian calendar (March-based years).
+    let y = if m <= 2 { y - 1 } else { y };
+    let era = y.div_euclid(400);
+    let yoe = y - era * 400;
+    let doy = (153 * ((m + 9) % 12) + 2) / 5 + d - 1;
+    let doe = yoe * 365 + yoe / 4 - yoe / 100 + doy;
+    let days = era * 146_097 + doe - 719_468;
+    Some(days as f64 * 86_400.0 + h * 3_600.0 + min * 60.0 + sec)
+}
+
 #[cfg(test)]
 mod tests {
-    use super::{equivalents, key_of};
+    use super::{equivalents, json_time, key_of};
+
+    /// Timestamps as cargo-mutants writes them: the epoch, a leap day, and a run over midnight
+    /// at the end of a year.
+    #[test]
+    fn timestamps_are_read_as_seconds() {
+        let at = |s: &str| json_time(&format!("{{\"t\": \"{s}\"}}"), "t");
+        assert_eq!(at("1970-01-01T00:00:00Z"), Some(0.0));
+        assert_eq!(at("2000-03-01T00:00:00Z"), Some(951_868_800.0));
+        assert_eq!(at("2024-02-29T12:00:00.5Z"), Some(1_709_208_000.5));
+        let (a, b) = (at("2026-12-31T23:59:30Z"), at("2027-01-01T00:00:10.25Z"));
+        assert_eq!(b.zip(a).map(|(b, a)| b - a), Some(40.25));
+        assert_eq!(at("not a time"), None);
+    }
     use crate::cmd::project_root;
 
     /// Every entry of the equivalent list names a file that holds the entry's source line.
