@@ -605,12 +605,12 @@ fn variational_newton_is_quick_and_restarts() -> Result<(), Error> {
 /// it starts (for a quadratic `T` one Newton step solves it from anywhere).
 struct Relativistic;
 
-impl Lagrangian<f64, 1> for Relativistic {
-    fn kinetic<S: Scalar<Real = f64>>(&self, _t: S, _q: &SVector<S, 1>, qd: &SVector<S, 1>) -> S {
-        (S::one() - (S::one() - qd[0] * qd[0]).sqrt()) * 1.0
+impl<T: Real> Lagrangian<T, 1> for Relativistic {
+    fn kinetic<S: Scalar<Real = T>>(&self, _t: S, _q: &SVector<S, 1>, qd: &SVector<S, 1>) -> S {
+        S::one() - (S::one() - qd[0] * qd[0]).sqrt()
     }
-    fn potential<S: Scalar<Real = f64>>(&self, _t: S, q: &SVector<S, 1>) -> S {
-        q[0] * q[0] * 2.0
+    fn potential<S: Scalar<Real = T>>(&self, _t: S, q: &SVector<S, 1>) -> S {
+        q[0] * q[0] * T::TWO
     }
 }
 
@@ -620,40 +620,46 @@ impl Lagrangian<f64, 1> for Relativistic {
 /// `p / m`, faster than light) meets the square root of a negative number. The velocities of
 /// every run's end are found from the last step's motion `(q1 - q0) / h`, always slower than
 /// light: every end state is finite and below c, and the energy `m c^2 (gamma - 1) + k q^2 / 2`
-/// stays within 1e-3 of its start over 1,000 steps of 2 ms (measured 2.1e-6). A fresh run's
-/// first step starts Newton from `q0 + q0' h`: at most the measured iterations (5).
-#[test]
-fn variational_inverts_a_legendre_transform_that_is_not_linear() -> Result<(), Error> {
+/// stays near its start of 2 over 1,000 steps of 2 ms (measured drift: f64 2.1e-6, the
+/// method's own; f32 3.9e-6; bounds about 5 times those). A fresh run's first
+/// step starts Newton from `q0 + q0' h`: at most the measured iterations (f64 5, f32 3: its tolerance is
+/// looser).
+fn variational_inverts_a_legendre_transform_that_is_not_linear<T: Real>() -> Result<(), Error> {
     let m = EulerLagrange::new(Relativistic);
-    let start = State::new(0.0, [1.0], [0.0]);
-    let dt = 2e-3;
+    let start = State::new(T::zero(), [T::one()], [T::zero()]);
+    let dt = T::from_f64(2e-3);
     // The conserved energy is the Hamiltonian, not T + V: `p q' - L`.
-    let energy =
-        |s: &State<f64, 1>| (1.0 - s.qd[0] * s.qd[0]).sqrt().recip() - 1.0 + 2.0 * s.q[0] * s.q[0];
+    let energy = |s: &State<T, 1>| {
+        let (q, v) = (s.q[0].to_f64(), s.qd[0].to_f64());
+        (1.0 - v * v).sqrt().recip() - 1.0 + 2.0 * q * q
+    };
     let mut w = VariationalMidpoint::default();
     let (mut s, mut fastest, mut drift) = (start, 0.0f64, 0.0f64);
     for _ in 0..100 {
         s = w.integrate(&m, &s, dt, 10)?;
-        assert!(s.qd[0].abs() < 1.0, "faster than light: {s:?}");
-        fastest = fastest.max(s.qd[0].abs());
+        assert!(s.qd[0].abs() < T::one(), "faster than light: {s:?}");
+        fastest = fastest.max(s.qd[0].abs().to_f64());
         drift = drift.max((energy(&s) - energy(&start)).abs());
     }
     println!("relativistic oscillator: fastest end {fastest:.3} c, energy drift {drift:.2e}");
     // The premise: some ends are beyond the momentum m c (0.707 c).
     assert!(fastest > 0.9, "fastest {fastest}");
-    assert!(drift < 1e-3, "energy drift {drift}");
+    assert!(drift < pick::<T>(2e-5, 1e-5), "energy drift {drift}");
     // Stepped: each step converts to velocities from its own motion too.
     let mut stepped = VariationalMidpoint::default();
     let mut t = start;
     for _ in 0..300 {
         t = stepped.step(&m, &t, dt)?;
-        assert!(t.qd[0].abs() < 1.0, "faster than light: {t:?}");
+        assert!(t.qd[0].abs() < T::one(), "faster than light: {t:?}");
     }
-    let moving = State::new(0.0, [0.3], [0.8]);
+    let moving = State::new(T::zero(), [T::from_f64(0.3)], [T::from_f64(0.8)]);
     let mut fresh = VariationalMidpoint::default();
-    fresh.integrate(&m, &moving, 0.05, 1)?;
+    fresh.integrate(&m, &moving, T::from_f64(0.05), 1)?;
     let iterations = fresh.last_step().iterations;
     println!("relativistic oscillator: {iterations} iterations in a fresh first step");
-    assert!(iterations <= 5, "{iterations} iterations");
+    let measured = pick::<T>(3.0, 5.0) as u32;
+    assert!(iterations <= measured, "{iterations} iterations");
     Ok(())
 }
+
+for_f32_and_f64!(variational_inverts_a_legendre_transform_that_is_not_linear);
