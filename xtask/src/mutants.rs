@@ -35,11 +35,14 @@ const EQUIVALENT_LIST: &str = "xtask/mutants-equivalent.txt";
 /// mutants (a timed-out mutant counts as killed: the run detected it).
 const GOAL: f64 = 0.9;
 
-/// Seconds a mutant's tests may run before it counts as timed out (detected): five times the
-/// slowest subset unmutated and alone (6 s, the chains' at `opt-level = 0`), so that a clean
-/// run slowed by the other job is not taken for a detection; a mutant that makes an adaptive
-/// pair crawl at tiny steps otherwise holds a job for minutes.
-const TEST_TIMEOUT_S: &str = "30";
+/// A mutant's tests may run this many times as long as the area's unmutated tests before it
+/// counts as timed out (detected): a clean run slowed by the other job is not taken for a
+/// detection, and a mutant that makes an adaptive pair crawl at tiny steps does not hold a job
+/// for long (with a fixed 30 s, the adaptive area's 50-odd such mutants took half its time).
+const TEST_TIMEOUT_FACTOR: f64 = 5.0;
+
+/// The shortest timeout, seconds: the start of a test binary and cargo's own work.
+const TEST_TIMEOUT_MIN_S: f64 = 10.0;
 
 /// Seconds a mutant's build may take (the baseline is ours, so cargo-mutants cannot scale it).
 const BUILD_TIMEOUT_S: &str = "600";
@@ -526,7 +529,7 @@ pub fn run(args: &[String]) -> Result<(), String> {
     let out = root.join("target").join("mutants");
     if o.list {
         for area in &o.areas {
-            let n = mutants_command(area, &out, &o, true)
+            let n = mutants_command(area, &out, &o, None)
                 .output()
                 .map_err(|e| format!("cargo mutants --list: {e}"))?;
             let count = String::from_utf8_lossy(&n.stdout).lines().count();
@@ -542,16 +545,29 @@ pub fn run(args: &[String]) -> Result<(), String> {
             // cargo-mutants' own baseline runs the area's tests in the mutated package, where
             // they are not: this is the baseline instead, and must pass for the run to mean
             // anything (a mutant that fails tests that already fail is not killed by them).
-            let mut baseline = cmd::cargo();
-            area.profile(&mut baseline)
-                .args(["test", "--quiet", "--config", DEPENDENCIES_OPTIMISED])
-                .args(["-p", area.test_package])
-                .args(area.tests);
-            if area.unit_tests {
-                baseline.args(["-p", area.package, "--lib"]);
-            }
-            cmd::run(&mut baseline)
-                .map_err(|e| format!("area {}: the unmutated tests fail: {e}", area.name))?;
+            // Built first, then timed alone: the time of the tests sets the mutants' timeout.
+            let baseline = |build: bool| {
+                let mut c = cmd::cargo();
+                area.profile(&mut c)
+                    .args(["test", "--quiet", "--config", DEPENDENCIES_OPTIMISED])
+                    .args(["-p", area.test_package])
+                    .args(area.tests);
+                if area.unit_tests {
+                    c.args(["-p", area.package, "--lib"]);
+                }
+                if build {
+                    c.arg("--no-run");
+                }
+                cmd::run(&mut c)
+                    .map_err(|e| format!("area {}: the unmutated tests fail: {e}", area.name))
+            };
+            baseline(true)?;
+            let tests = Instant::now();
+            baseline(false)?;
+            let timeout = (tests.elapsed().as_secs_f64() * TEST_TIMEOUT_FACTOR)
+                .max(TEST_TIMEOUT_MIN_S)
+                .ceil();
+            println!("area {}: test timeout {timeout} s", area.name);
             // Before the run moves the last one's outcomes aside, its unviable mutants join the
             // ledger (a full run starts it over); after it, this run's.
             if o.iterate {
@@ -560,7 +576,7 @@ pub fn run(args: &[String]) -> Result<(), String> {
                 std::fs::remove_file(dir.join(UNVIABLE_LEDGER)).ok();
             }
             // A surviving mutant is a finding, not a failure of the command: the report says.
-            let status = cmd::run(&mut mutants_command(area, &out, &o, false));
+            let status = cmd::run(&mut mutants_command(area, &out, &o, Some(timeout)));
             update_ledger(&dir)?;
             println!(
                 "area {}: {:.0} s ({})",
@@ -573,9 +589,9 @@ pub fn run(args: &[String]) -> Result<(), String> {
     report(&root, &out, &o.areas)
 }
 
-/// `cargo mutants` for one area, its outcomes under `out/<area>/mutants.out`; with `list`, only
-/// listing the mutants.
-fn mutants_command(area: &Area, out: &Path, o: &Options, list: bool) -> Command {
+/// `cargo mutants` for one area, its outcomes under `out/<area>/mutants.out`, each mutant's
+/// tests stopped after `timeout` seconds; with no timeout, only listing the mutants.
+fn mutants_command(area: &Area, out: &Path, o: &Options, timeout: Option<f64>) -> Command {
     let mut c = cmd::cargo();
     area.profile(&mut c);
     c.args(["mutants", "--package", area.package]);
@@ -586,20 +602,16 @@ fn mutants_command(area: &Area, out: &Path, o: &Options, list: bool) -> Command 
     if let Some(re) = area.only {
         c.args(["--re", re]);
     }
-    if list {
+    let Some(timeout) = timeout else {
         c.arg("--list");
         return c;
-    }
+    };
     c.args(["--test-package", area.test_package, "--jobs", &o.jobs]);
     if area.unit_tests {
         c.args(["--test-package", area.package, "--cargo-arg=--lib"]);
     }
-    c.args([
-        "--timeout",
-        TEST_TIMEOUT_S,
-        "--build-timeout",
-        BUILD_TIMEOUT_S,
-    ]);
+    c.args(["--timeout", &timeout.to_string()]);
+    c.args(["--build-timeout", BUILD_TIMEOUT_S]);
     c.arg("--baseline=skip");
     c.args(["--cap-lints", "true", "--no-shuffle"]);
     c.arg("--output").arg(out.join(area.name));
