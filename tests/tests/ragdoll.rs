@@ -446,14 +446,15 @@ fn documented_segments(b: &RagdollBody<f64>, q: &SVector<f64, N>) -> [[[f64; 2];
 }
 
 /// The ragdoll against its documented body, at 5 random bodies of 40 random states: its
-/// segments are the documented frame's to rounding (measured 8.9e-16 m); its potential energy
+/// segments and its contacts' floor gaps are the documented frame's to rounding (measured
+/// 8.9e-16 m), its joint damping is `-c q'` on the joints; its potential energy
 /// is `g sum m_k y_k` at the segments' midpoints and its kinetic energy
 /// `sum (m_k |v_k|^2 + m_k L_k^2 / 12 w_k^2) / 2` with each midpoint's velocity by
 /// fourth-order central differences along `q'` (h = 1e-3 / (1 + |q'|)) and each link's
-/// absolute rate the sum of its joints' (uniform rods): measured relative differences 2.3e-16
-/// and 2.9e-12 (the differences' truncation and rounding), bounds about 5 times those. The hand law agrees
-/// with the automatic path of these energies (above), so a wrong attachment, rest angle or
-/// centre of mass shows here even where it would change both alike.
+/// absolute rate the sum of its joints' (uniform rods): measured relative differences
+/// 3.0e-16 and 1.6e-12 (the differences' truncation and rounding), bounds about 5 times
+/// those. The hand law agrees with the automatic path of these energies (above), so a wrong
+/// attachment, rest angle or centre of mass shows here even where it would change both alike.
 #[test]
 fn the_body_is_the_documented_one() -> Result<(), Error> {
     let mut rng = Rng::new(31);
@@ -461,6 +462,8 @@ fn the_body_is_the_documented_one() -> Result<(), Error> {
     for _ in 0..5 {
         let body = random_body::<f64>(&mut rng);
         let doll = Ragdoll::new(body)?;
+        let floor = rng.uniform(-1.0, 1.0);
+        let contacts = RagdollContacts::new(&doll, floor, ADULT_JOINT_LIMITS)?;
         let masses = [
             body.torso,
             body.head,
@@ -483,6 +486,28 @@ fn the_body_is_the_documented_one() -> Result<(), Error> {
                 for (p, w) in got.iter().zip(want) {
                     place = place.max((p[0] - w[0]).abs().max((p[1] - w[1]).abs()));
                 }
+            }
+            // The floor rows' points, as the contacts' docs list them: the top of the head,
+            // the shoulders, the hips (the upper arms' and thighs' starts), the elbows, the
+            // hands, the knees and the feet (ends), left before right.
+            let e = &expected;
+            let points = [
+                e[1][1], e[2][0], e[4][0], e[6][0], e[8][0], e[2][1], e[4][1], e[3][1], e[5][1],
+                e[6][1], e[8][1], e[7][1], e[9][1],
+            ];
+            let gaps = contacts.position_residual(&s.q);
+            for (i, p) in points.iter().enumerate() {
+                place = place.max((gaps[i] - (p[1] - floor)).abs());
+            }
+            // Joint damping, as documented: `Q = -c [0, 0, 0, q_3' .. q_11']`.
+            let damping = doll.non_conservative_force(&s);
+            for i in 0..N {
+                let want = if i < 3 {
+                    0.0
+                } else {
+                    -body.joint_damping * s.qd[i]
+                };
+                assert_eq!(damping[i], want, "Q[{i}]");
             }
             let v: f64 = masses
                 .iter()
@@ -526,8 +551,8 @@ fn the_body_is_the_documented_one() -> Result<(), Error> {
          {potential:.1e}, kinetic energy {kinetic:.1e}"
     );
     assert!(place < 5e-15, "segments {place:e}");
-    assert!(potential < 1.2e-15, "potential {potential:e}");
-    assert!(kinetic < 1.5e-11, "kinetic {kinetic:e}");
+    assert!(potential < 1.5e-15, "potential {potential:e}");
+    assert!(kinetic < 8e-12, "kinetic {kinetic:e}");
     Ok(())
 }
 
