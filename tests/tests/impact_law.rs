@@ -3,9 +3,9 @@
 //! friction impulse of a body heavier than one kilogram. Each case has a closed-form answer,
 //! worked out in its docs; the bounds are rounding (a few ulps of velocities of order 1).
 
-use lagrange_core::constraints::contact::Impacts;
+use lagrange_core::constraints::contact::{ActiveRows, Impacts};
 use lagrange_core::nalgebra::{Matrix2, Matrix3, SMatrix, SVector, Vector2, Vector3};
-use lagrange_core::{Constraints, Error, EulerLagrange, Lagrangian, Scalar, State};
+use lagrange_core::{Constraints, Error, EulerLagrange, Lagrangian, Mechanism, Scalar, State};
 use lagrange_integrators::{ContactModel, Contacts};
 
 /// Rounding of velocities of order 1 after a 2x2 solve.
@@ -237,5 +237,53 @@ fn the_row_that_pulls_hardest_lets_go_first() -> Result<(), Error> {
     assert_eq!(resting, [true, false, true]);
     let gain = body.kinetic_energy(&after) - body.kinetic_energy(&s);
     assert!(gain <= ROUNDING, "the impact added {gain:e} J");
+    Ok(())
+}
+
+/// The walls `q0 >= 0` twice (rows 0 and 1: a contact that depends on another) and
+/// `q1 >= 0` (row 2).
+struct DoubledWall;
+
+impl Constraints<f64, 2, 3> for DoubledWall {
+    fn position_residual(&self, q: &Vector2<f64>) -> Vector3<f64> {
+        Vector3::new(q[0], q[0], q[1])
+    }
+    fn jacobian(&self, _q: &Vector2<f64>) -> SMatrix<f64, 3, 2> {
+        SMatrix::<f64, 3, 2>::new(1.0, 0.0, 1.0, 0.0, 0.0, 1.0)
+    }
+    fn velocity_product(&self, _q: &Vector2<f64>, _qd: &Vector2<f64>) -> Vector3<f64> {
+        Vector3::zeros()
+    }
+}
+
+impl Contacts<f64, 2, 3> for DoubledWall {}
+
+/// Between events (`ActiveRows`): a unit point at rest in the corner, pushed by
+/// `F = (-1, 1)`, into wall 0 and away from wall 2, with every row resting. Row 1 repeats row
+/// 0: a contact that depends on the others carries no force of its own and is left out, not
+/// reported. Row 2 would pull (`lambda = -F_1 = -1`) and lets go: the rows still in force are
+/// 0 alone, and the point accelerates at `(0, 1)` along wall 0. The same repeated row held
+/// as bilateral is the user's error: `RedundantConstraints`, naming it.
+#[test]
+fn rows_in_force_leave_out_pulling_and_repeated_contacts() -> Result<(), Error> {
+    let point = EulerLagrange::new(Sheared { m: 1.0, c: 0.0 })
+        .with_force(|_: &State<f64, 2>| Vector2::new(-1.0, 1.0));
+    let s = State::at_rest([0.0, 0.0]);
+    let model = plastic()?;
+    let rows = ActiveRows::new(&point, &DoubledWall, &model, &[false; 3], &[true; 3]);
+    assert_eq!(rows.still_in_force(&s)?, [true, false, false]);
+    let a = rows.acceleration(&s)?;
+    assert!((a - Vector2::new(0.0, 1.0)).amax() < ROUNDING, "{a}");
+    let held = ActiveRows::new(
+        &point,
+        &DoubledWall,
+        &model,
+        &[true, true, false],
+        &[false; 3],
+    );
+    assert_eq!(
+        held.acceleration(&s),
+        Err(Error::RedundantConstraints { row: 1 })
+    );
     Ok(())
 }

@@ -363,6 +363,8 @@ const AREAS: [Area; 13] = [
             "--test",
             "friction",
             "--test",
+            "impact_law",
+            "--test",
             "automatic_exactness",
         ],
         unit_tests: true,
