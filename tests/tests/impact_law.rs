@@ -3,7 +3,7 @@
 //! friction impulse of a body heavier than one kilogram. Each case has a closed-form answer,
 //! worked out in its docs; the bounds are rounding (a few ulps of velocities of order 1).
 
-use lagrange_core::constraints::contact::{ActiveRows, Impacts};
+use lagrange_core::constraints::contact::{drop_dependent_contacts, ActiveRows, Impacts};
 use lagrange_core::nalgebra::{Matrix2, Matrix3, SMatrix, SVector, Vector2, Vector3};
 use lagrange_core::{Constraints, Error, EulerLagrange, Lagrangian, Mechanism, Scalar, State};
 use lagrange_integrators::{ContactModel, Contacts};
@@ -262,8 +262,10 @@ impl Contacts<f64, 2, 3> for DoubledWall {}
 /// `F = (-1, 1)`, into wall 0 and away from wall 2, with every row resting. Row 1 repeats row
 /// 0: a contact that depends on the others carries no force of its own and is left out, not
 /// reported. Row 2 would pull (`lambda = -F_1 = -1`) and lets go: the rows still in force are
-/// 0 alone, and the point accelerates at `(0, 1)` along wall 0. The same repeated row held
-/// as bilateral is the user's error: `RedundantConstraints`, naming it.
+/// 0 alone, and the point accelerates at `(0, 1)` along wall 0. Pushed by `(-1, 0)`, row 2
+/// carries exactly no force and stays in force (only a pulling row lets go).
+/// `drop_dependent_contacts` leaves the repeated row out before any solve. The same repeated
+/// row held as bilateral is the user's error: `RedundantConstraints`, naming it.
 #[test]
 fn rows_in_force_leave_out_pulling_and_repeated_contacts() -> Result<(), Error> {
     let point = EulerLagrange::new(Sheared { m: 1.0, c: 0.0 })
@@ -274,6 +276,15 @@ fn rows_in_force_leave_out_pulling_and_repeated_contacts() -> Result<(), Error> 
     assert_eq!(rows.still_in_force(&s)?, [true, false, false]);
     let a = rows.acceleration(&s)?;
     assert!((a - Vector2::new(0.0, 1.0)).amax() < ROUNDING, "{a}");
+    // Pushed into wall 0 only, row 2 carries exactly no force: it stays in force.
+    let pressed = EulerLagrange::new(Sheared { m: 1.0, c: 0.0 })
+        .with_force(|_: &State<f64, 2>| Vector2::new(-1.0, 0.0));
+    let resting = ActiveRows::new(&pressed, &DoubledWall, &model, &[false; 3], &[true; 3]);
+    assert_eq!(resting.still_in_force(&s)?, [true, false, true]);
+    // The same choice before any solve: the repeated contact is left out.
+    let mut active = [true; 3];
+    drop_dependent_contacts(&point, &DoubledWall, &s, &mut active, &[false; 3])?;
+    assert_eq!(active, [true, false, true]);
     let held = ActiveRows::new(
         &point,
         &DoubledWall,
@@ -285,5 +296,27 @@ fn rows_in_force_leave_out_pulling_and_repeated_contacts() -> Result<(), Error> 
         held.acceleration(&s),
         Err(Error::RedundantConstraints { row: 1 })
     );
+    Ok(())
+}
+
+/// Between events, the three walls and `M = [[2, 1, -0.2], [1, 2, -1], [-0.2, -1, 2]]` of
+/// [`the_row_that_pulls_hardest_lets_go_first`], at rest, all three rows resting, pushed by
+/// `F = -M (0, 0, 1)`: held together the rows would need `lambda = -F = (-0.2, -1, 2)`, rows 0
+/// and 1 pulling, row 1 the harder. It lets go alone; then row 0 pushes (`A lambda =
+/// (0, 1)` over rows 0 and 2, `lambda = (0.3, 1.5)`), and `q'' = (0, 0.5, 0)`. Pushed by
+/// `F = (1, 0, -1) M`-free `(0, 0, -1)` instead... (see below) a row with exactly no force
+/// stays in force. `drop_dependent_contacts` leaves the repeated wall out.
+#[test]
+fn between_events_the_hardest_puller_lets_go_first() -> Result<(), Error> {
+    let m = [[2.0, 1.0, -0.2], [1.0, 2.0, -1.0], [-0.2, -1.0, 2.0]];
+    let f = Vector3::new(0.2, 1.0, -2.0);
+    let body = EulerLagrange::new(Octant(m)).with_force(move |_: &State<f64, 3>| f);
+    let s = State::at_rest([0.0; 3]);
+    let model = plastic()?;
+    let walls = Octant(m);
+    let rows = ActiveRows::new(&body, &walls, &model, &[false; 3], &[true; 3]);
+    assert_eq!(rows.still_in_force(&s)?, [true, false, true]);
+    let a = rows.acceleration(&s)?;
+    assert!((a - Vector3::new(0.0, 0.5, 0.0)).amax() < ROUNDING, "{a}");
     Ok(())
 }
