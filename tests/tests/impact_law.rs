@@ -320,3 +320,45 @@ fn between_events_the_hardest_puller_lets_go_first() -> Result<(), Error> {
     assert!((a - Vector3::new(0.0, 0.5, 0.0)).amax() < ROUNDING, "{a}");
     Ok(())
 }
+
+/// A floor `q2 >= 0` (row 0, a contact) and a rail `q1 = 0` (row 1, bilateral), both with
+/// the tangent along `q0`.
+struct Rail;
+
+impl Constraints<f64, 3, 2> for Rail {
+    fn position_residual(&self, q: &Vector3<f64>) -> Vector2<f64> {
+        Vector2::new(q[2], q[1])
+    }
+    fn jacobian(&self, _q: &Vector3<f64>) -> SMatrix<f64, 2, 3> {
+        SMatrix::<f64, 2, 3>::new(0.0, 0.0, 1.0, 0.0, 1.0, 0.0)
+    }
+    fn velocity_product(&self, _q: &Vector3<f64>, _qd: &Vector3<f64>) -> Vector2<f64> {
+        Vector2::zeros()
+    }
+}
+
+impl Contacts<f64, 3, 2> for Rail {
+    fn tangent_jacobian(&self, _q: &Vector3<f64>) -> Option<SMatrix<f64, 2, 3>> {
+        Some(SMatrix::<f64, 2, 3>::new(1.0, 0.0, 0.0, 1.0, 0.0, 0.0))
+    }
+}
+
+/// Between events, sliding friction acts at resting contacts only: a unit point sliding at
+/// 1 m/s (far above the slip speed) along a floor it rests on (normal force g) and a rail it
+/// is pressed against (the rail's force 1 N, positive), mu = 0.5: `q'' = (-mu g, 0, 0)`. The
+/// rail is bilateral: it holds without friction (with it, `-mu (g + 1)`).
+#[test]
+fn sliding_friction_acts_at_resting_contacts_only() -> Result<(), Error> {
+    const G: f64 = 9.81;
+    let body = EulerLagrange::new(Octant([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]))
+        .with_force(|_: &State<f64, 3>| Vector3::new(0.0, -1.0, -G));
+    let s = State::new(0.0, [0.0; 3], [1.0, 0.0, 0.0]);
+    let model = plastic()?.with_friction(0.5)?;
+    let rows = ActiveRows::new(&body, &Rail, &model, &[false, true], &[true, false]);
+    let a = rows.acceleration(&s)?;
+    assert!(
+        (a - Vector3::new(-0.5 * G, 0.0, 0.0)).amax() < ROUNDING,
+        "{a}"
+    );
+    Ok(())
+}
