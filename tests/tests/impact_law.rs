@@ -285,6 +285,11 @@ fn rows_in_force_leave_out_pulling_and_repeated_contacts() -> Result<(), Error> 
     let mut active = [true; 3];
     drop_dependent_contacts(&point, &DoubledWall, &s, &mut active, &[false; 3])?;
     assert_eq!(active, [true, false, true]);
+    let mut held = [true; 3];
+    assert_eq!(
+        drop_dependent_contacts(&point, &DoubledWall, &s, &mut held, &[true, true, false]),
+        Err(Error::RedundantConstraints { row: 1 })
+    );
     let held = ActiveRows::new(
         &point,
         &DoubledWall,
