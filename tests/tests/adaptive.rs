@@ -981,3 +981,124 @@ fn failed_call_changes_nothing() -> Result<(), Error> {
     }
     Ok(())
 }
+
+/// Where and how fast a crossing is located: the pendulum from rest at `TH0` (DP5, rtol 1e-6,
+/// steps of about a tenth of a second) crosses `th = level` for levels 0 (at a quarter
+/// period) and `TH0 / 2`; the guard counts its calls. Each located time is the dense
+/// output's root (`|th - level|` at it below `1e-12 |th'|`) and the exact crossing to the
+/// dense output's own error (bound 1e-6 s; measured 2.4e-8 and 2.8e-8). Guard calls beyond
+/// one per step, at most the measured: 28 at level 0 (the default tolerance is a few ulps of
+/// the time, and near it the guard's values are rounding, which the Illinois halvings chase)
+/// and 8 at `TH0 / 2`. With a loose event tolerance of 1e-3 s it stops sooner (measured 2
+/// and 3 calls) and within it (misses 1.5e-8 and 1.5e-5 s).
+#[test]
+fn crossings_are_located_in_few_guard_calls() -> Result<(), Error> {
+    let p = SimplePendulum::new(1.0, 1.0, G, 0.0)?;
+    let period = pendulum_period(TH0, G.sqrt())?;
+    // The first time the exact solution falls to `level`, by bisection.
+    let exact = |level: f64| -> Result<f64, Error> {
+        let (mut a, mut b) = (0.0, 0.25 * period + 1e-9);
+        for _ in 0..200 {
+            let m = 0.5 * (a + b);
+            if pendulum_from_rest(TH0, G.sqrt(), m)?.0 > level {
+                a = m;
+            } else {
+                b = m;
+            }
+        }
+        Ok(a)
+    };
+    for (tolerance, measured) in [(None, [28, 8]), (Some(1e-3), [2, 3])] {
+        for (level, most) in [0.0, 0.5 * TH0].into_iter().zip(measured) {
+            let mut settings = AdaptiveSettings::new(1e-6, 1e-8)?;
+            if let Some(t) = tolerance {
+                settings = settings.with_event_tolerance(t)?;
+            }
+            let mut i = DormandPrince54::new(settings);
+            let mut calls = 0u32;
+            let stop = i.integrate_until_event(&p, &State::at_rest([TH0]), T_END, |s| {
+                calls += 1;
+                s.q[0] - level
+            })?;
+            let Stop::Event(s) = stop else {
+                return Err(Error::NoConvergence { iterations: 0 });
+            };
+            let steps = i.statistics().accepted as u32;
+            let located = calls - steps - 1;
+            let miss = s.t - exact(level)?;
+            println!(
+                "level {level:.3}, event tolerance {tolerance:?}: {steps} steps, {located} \
+                 guard calls to locate, miss {miss:.1e} s, guard {:.1e}",
+                s.q[0] - level
+            );
+            assert!(located <= most, "{located} guard calls");
+            let allowed = tolerance.unwrap_or(1e-6);
+            assert!(miss.abs() < allowed, "missed by {miss:e} s");
+            if tolerance.is_none() {
+                assert!((s.q[0] - level).abs() < 1e-12 * s.qd[0].abs(), "{s:?}");
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The dense output covers the last step and nothing else: none before the first step; after
+/// a located event, `[start of the step, event]`, where it is the event state at its end and
+/// refuses a time on either side; a run that lands short of a step's end and continues finds
+/// a crossing in that step's rest (the pendulum's first zero, 0.01 s after the landing).
+#[test]
+fn dense_output_covers_the_last_step_only() -> Result<(), Error> {
+    let p = SimplePendulum::new(1.0, 1.0, G, 0.0)?;
+    let settings = AdaptiveSettings::new(1e-6, 1e-8)?;
+    let mut i = DormandPrince54::new(settings);
+    assert_eq!(i.dense_interval(), None);
+    assert!(i.dense_output(0.0).is_err());
+    let Stop::Event(s) = i.integrate_until_event(&p, &State::at_rest([TH0]), T_END, |s| s.q[0])?
+    else {
+        return Err(Error::NoConvergence { iterations: 0 });
+    };
+    let (t0, t1) = i
+        .dense_interval()
+        .ok_or(Error::NoConvergence { iterations: 0 })?;
+    assert!(t0 < t1 && t1 == s.t, "{t0} {t1} {}", s.t);
+    assert_eq!(i.dense_output(t1)?, s);
+    assert!(i.dense_output(t1 + 1e-9).is_err());
+    assert!(i.dense_output(t0 - 1e-9).is_err());
+    assert!(i.dense_output(0.5 * (t0 + t1))?.q[0] > 0.0);
+    // Landing 0.01 s before the crossing, then looking for it from there.
+    let period = pendulum_period(TH0, G.sqrt())?;
+    let mut j = DormandPrince54::new(settings);
+    let landed = j.integrate_to(&p, &State::at_rest([TH0]), 0.25 * period - 0.01)?;
+    let Stop::Event(e) = j.integrate_until_event(&p, &landed, T_END, |s| s.q[0])? else {
+        return Err(Error::NoConvergence { iterations: 0 });
+    };
+    assert!(
+        (e.t - 0.25 * period).abs() < 1e-6,
+        "{} against {}",
+        e.t,
+        0.25 * period
+    );
+    Ok(())
+}
+
+/// A search for an event that never comes stops after the settings' most steps:
+/// `TooManySteps`, after exactly that many; without that bound, at the end time.
+#[test]
+fn an_event_search_stops_after_the_most_steps() -> Result<(), Error> {
+    let p = SimplePendulum::new(1.0, 1.0, G, 0.0)?;
+    let settings = AdaptiveSettings::new(1e-6, 1e-8)?.with_max_steps(5)?;
+    let mut i = DormandPrince54::new(settings);
+    let r = i.integrate_until_event(&p, &State::at_rest([TH0]), T_END, |_| 1.0);
+    match r {
+        Err(f) => assert_eq!(f.error, Error::TooManySteps { steps: 5 }),
+        Ok(stop) => panic!("no stop: {stop:?}"),
+    }
+    // Without the bound, the search ends at the end time, there and no further.
+    let mut j = DormandPrince54::new(AdaptiveSettings::new(1e-6, 1e-8)?);
+    let end = j.integrate_until_event(&p, &State::at_rest([TH0]), 1.0, |_| 1.0)?;
+    match end {
+        Stop::End(s) => assert_eq!(s.t, 1.0),
+        Stop::Event(s) => panic!("an event at {}", s.t),
+    }
+    Ok(())
+}
