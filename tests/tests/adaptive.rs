@@ -5,7 +5,8 @@
 use lagrange_core::nalgebra::{SVector, Vector1};
 use lagrange_core::{Error, EulerLagrange, Lagrangian, Mechanism, Real, Scalar, State};
 use lagrange_integrators::{
-    AdaptiveSettings, DormandPrince54, DormandPrince853, EmbeddedPair, EmbeddedRungeKutta, Stop,
+    AdaptiveSettings, DormandPrince54, DormandPrince853, EmbeddedPair, EmbeddedRungeKutta,
+    Integrator, Stop,
 };
 use lagrange_systems::exact::{pendulum_from_rest, pendulum_period, DrivenOscillator};
 use lagrange_systems::{SimplePendulum, SpringMassDamper};
@@ -1078,6 +1079,20 @@ fn dense_output_covers_the_last_step_only() -> Result<(), Error> {
         e.t,
         0.25 * period
     );
+    // The same from a landing inside a step: a fixed step of the pair (`Integrator::step`)
+    // lands by the dense output of the step that passed it, 1e-4 s before the crossing.
+    let mut k = DormandPrince54::new(settings);
+    let t_land = 0.25 * period - 1e-4;
+    let s = Integrator::step(&mut k, &p, &State::at_rest([TH0]), t_land)?;
+    let Stop::Event(e) = k.integrate_until_event(&p, &s, T_END, |s| s.q[0])? else {
+        return Err(Error::NoConvergence { iterations: 0 });
+    };
+    assert!(
+        (e.t - 0.25 * period).abs() < 1e-6,
+        "{} against {}",
+        e.t,
+        0.25 * period
+    );
     Ok(())
 }
 
@@ -1097,5 +1112,7 @@ fn an_event_search_stops_after_the_most_steps() -> Result<(), Error> {
     let mut j = DormandPrince54::new(AdaptiveSettings::new(1e-6, 1e-8)?);
     let end = j.integrate_until_event(&p, &State::at_rest([TH0]), 1.0, |_| 1.0)?;
     assert!(matches!(end, Stop::End(s) if s.t == 1.0), "{end:?}");
+    // No event: no dense output to read (it is made by `next_step` and at an event).
+    assert_eq!(j.dense_interval(), None);
     Ok(())
 }
