@@ -621,8 +621,8 @@ impl<T: Real> Lagrangian<T, 1> for Relativistic {
 /// every run's end are found from the last step's motion `(q1 - q0) / h`, always slower than
 /// light: every end state is finite and below c, and the energy `m c^2 (gamma - 1) + k q^2 / 2`
 /// stays near its start of 2 over 1,000 steps of 2 ms (measured drift: f64 2.1e-6, the
-/// method's own; f32 3.9e-6; bounds about 5 times those). A fresh run's first
-/// step starts Newton from `q0 + q0' h`: at most the measured iterations (f64 5, f32 3: its tolerance is
+/// method's own; f32 3.9e-6; bounds about 5 times those). A fresh run's first step starts
+/// Newton from `q0 + q0' h`: at most the measured iterations (f64 5, f32 3: its tolerance is
 /// looser).
 fn variational_inverts_a_legendre_transform_that_is_not_linear<T: Real>() -> Result<(), Error> {
     let m = EulerLagrange::new(Relativistic);

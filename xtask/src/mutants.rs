@@ -392,11 +392,10 @@ const ACCELERATIONS: &str = "impl Mechanism|impl Constraints|small_solve|::terms
 
 /// The ragdoll's [`ACCELERATIONS`]: its articulated-body law and the spatial algebra it
 /// runs on, its energies (the automatic path's oracle for that law), and its contact rows.
-const RAGDOLL: &str =
-    "impl Mechanism|impl Lagrangian|impl Constraints|impl Contacts|::articulated|\
-                       solve3|inertia_at|cross_motion|cross_force|\\bdot\\b|::segments|\
-                       Pose<S>::point|::pose\\b|\\bscale\\b|\\badd\\b|torso_axis|::world_point|\
-                       ::rates|::outward|::point_jacobians|::floor_points|::limits";
+const RAGDOLL: &str = "impl Mechanism|impl Lagrangian|impl Constraints|impl Contacts|\
+                       ::articulated|solve3|inertia_at|cross_motion|cross_force|\\bdot\\b|\
+                       ::segments|Pose<S>::point|::pose\\b|\\bscale\\b|\\badd\\b|torso_axis|\
+                       ::world_point|::rates|::outward|::point_jacobians|::floor_points|::limits";
 
 /// The test binaries of the systems' areas.
 const SYSTEM_TESTS: &[&str] = &[
