@@ -21,7 +21,7 @@ const DT: f64 = 1e-3;
 struct Ground;
 
 impl<T: Real> HolonomicConstraints<T, 1, 1> for Ground {
-    fn phi<S: Scalar<Real = T>>(&self, q: &SVector<S, 1>) -> SVector<S, 1> {
+    fn phi<S: Scalar<Real = T> + 'static>(&self, q: &SVector<S, 1>) -> SVector<S, 1> {
         *q
     }
 }
@@ -32,7 +32,7 @@ impl<T: Real> HolonomicConstraints<T, 1, 1> for Ground {
 struct FloorAndLimits;
 
 impl HolonomicConstraints<f64, 2, 4> for FloorAndLimits {
-    fn phi<S: Scalar<Real = f64>>(&self, q: &SVector<S, 2>) -> SVector<S, 4> {
+    fn phi<S: Scalar<Real = f64> + 'static>(&self, q: &SVector<S, 2>) -> SVector<S, 4> {
         let y1 = -q[0].cos();
         let y2 = y1 - q[1].cos();
         let relative = q[1] - q[0];

@@ -3,6 +3,7 @@
 
 use crate::jet::Jet;
 use crate::mechanism::finite;
+use crate::tape;
 use crate::{
     central_difference_jacobian, solve_spd, Cholesky, Dual, Error, GeneralizedForce, Jacobian,
     Mechanism, Real, Scalar, State,
@@ -18,7 +19,9 @@ use nalgebra::{SMatrix, SVector};
 /// from them, and every hand-derived [`Mechanism`] is one of these too (and is checked against
 /// the automatic path). A scalar mixes with plain numbers on its right, so `T` and `V` read
 /// like the formulas: `qd[0] * qd[0] * (0.5 * self.m)`. Do all math through [`Scalar`]'s
-/// methods (`q[0].cos()`), so that `f32` and `f64` give the same bits on every target.
+/// methods (`q[0].cos()`), so that `f32` and `f64` give the same bits on every target, and
+/// index the vectors rather than calling nalgebra's arithmetic on them (`qd.dot(qd)` asks for
+/// a `'static` scalar, which the automatic path's need not be; see [`Scalar`]).
 ///
 /// ```
 /// use lagrange_core::prelude::*;
@@ -119,6 +122,16 @@ type Directional<T> = Dual<T, 1>;
 /// `N^2 + 3 N + 2` numbers, which for a long chain (kilobytes at `N = 20`) makes copying them
 /// a large part of the cost.
 ///
+/// So from 11 coordinates on, `T` and `V` are instead recorded on a tape on the stack (each
+/// operation a node with its parents and partial derivatives) and swept: one reverse pass
+/// gives `dT/dq` and `dV/dq`, one forward pass each node's gradient in `q'` (only over the
+/// coordinates it depends on) and its rate along `(q', 1)`, and each node that is not linear
+/// in its parents adds a rank-one or rank-two term to `M` and its share of the mixed term.
+/// The cost is then a few nanoseconds a node each way plus the rank updates, whatever `N`:
+/// measured on a 20-link chain, about 20 times the hand-derived law where the jet takes 150
+/// times. A tape holds up to 1,024 nodes (about 140 kB of stack at `N = 20`); a `T` or `V`
+/// that needs more is differentiated by the jet and the dual number, as below 11.
+///
 /// Its [`Mechanism::law_jacobian`] is exact too: differentiating `M q'' = f + Q + extra` gives
 /// `M dq''/dx = d(f + Q + extra)/dx - (dM/dx) q''`, with `dM/dx` and `df/dx` from `M` and `f`
 /// computed once more per coordinate and per velocity over a one-direction dual number (third
@@ -163,17 +176,12 @@ impl<T: Real, const N: usize, L: defmt::Format> defmt::Format for EulerLagrange<
 }
 
 /// `M = d2T/dq'dq'` and `T`'s part of `f`, `dT/dq - (d2T/dq'dq) q' - d2T/dq'dt`, from `T` at
-/// `(t, q, q')` over a [`Jet`] (velocities seeded, coordinates seeded and moving at `q'`, and
-/// time at unit rate where [`Lagrangian::EXPLICIT_TIME`], so that the jet's directional parts
-/// give the mixed and time terms).
+/// `(t, q, q')`: over a [`Jet`] below [`tape::FROM`] coordinates, over a tape from there on
+/// (or where `T` does not fit the largest tape).
 ///
-/// The one place that evaluates `T` over a jet, for every use (the law, `M` alone, `f`
-/// alone, the time term), and kept out of line, so that each scalar's `T` over a jet has this
-/// one caller: the compiler may then inline it here, where every seed's flags are known, and
-/// fold the jet's tests of them away. (Whether it does depends on the size of `T`; the
-/// automatic-cost bench measured no difference from two callers on this machine.)
-#[inline(never)]
-fn kinetic_jet<T, S, L, const N: usize>(
+/// The one place that evaluates `T` for its derivatives, for every use (the law, `M` alone,
+/// `f` alone, the time term).
+fn kinetic_terms<T, S, L, const N: usize>(
     l: &L,
     t: S,
     q: &SVector<S, N>,
@@ -181,7 +189,35 @@ fn kinetic_jet<T, S, L, const N: usize>(
 ) -> (SMatrix<S, N, N>, SVector<S, N>)
 where
     T: Real,
-    S: Scalar<Real = T>,
+    S: Scalar<Real = T> + 'static,
+    L: Lagrangian<T, N>,
+{
+    if N >= tape::FROM {
+        if let Some(terms) = tape::terms::kinetic(l, t, q, qd) {
+            return terms;
+        }
+    }
+    kinetic_jet(l, t, q, qd)
+}
+
+/// [`kinetic_terms`] over a [`Jet`] (velocities seeded, coordinates seeded and moving at
+/// `q'`, and time at unit rate where [`Lagrangian::EXPLICIT_TIME`], so that the jet's
+/// directional parts give the mixed and time terms).
+///
+/// Kept out of line, so that each scalar's `T` over a jet has this one caller: the compiler
+/// may then inline it here, where every seed's flags are known, and fold the jet's tests of
+/// them away. (Whether it does depends on the size of `T`; the automatic-cost bench measured
+/// no difference from two callers on this machine.)
+#[inline(never)]
+pub(crate) fn kinetic_jet<T, S, L, const N: usize>(
+    l: &L,
+    t: S,
+    q: &SVector<S, N>,
+    qd: &SVector<S, N>,
+) -> (SMatrix<S, N, N>, SVector<S, N>)
+where
+    T: Real,
+    S: Scalar<Real = T> + 'static,
     L: Lagrangian<T, N>,
 {
     let t = if L::EXPLICIT_TIME {
@@ -198,11 +234,31 @@ where
     )
 }
 
-/// `dV/dq` over any scalar `S`, from one evaluation of `V` over `Dual<S, N>`.
+/// `dV/dq` over any scalar `S`: over `Dual<S, N>` below [`tape::FROM`] coordinates, over a
+/// tape and one reverse pass from there on.
 fn potential_gradient<T, S, L, const N: usize>(l: &L, t: S, q: &SVector<S, N>) -> SVector<S, N>
 where
     T: Real,
-    S: Scalar<Real = T>,
+    S: Scalar<Real = T> + 'static,
+    L: Lagrangian<T, N>,
+{
+    if N >= tape::FROM {
+        if let Some(g) = tape::terms::potential_gradient(l, t, q) {
+            return g;
+        }
+    }
+    potential_dual(l, t, q)
+}
+
+/// [`potential_gradient`] from one evaluation of `V` over `Dual<S, N>`.
+pub(crate) fn potential_dual<T, S, L, const N: usize>(
+    l: &L,
+    t: S,
+    q: &SVector<S, N>,
+) -> SVector<S, N>
+where
+    T: Real,
+    S: Scalar<Real = T> + 'static,
     L: Lagrangian<T, N>,
 {
     let v = l.potential(
@@ -222,10 +278,10 @@ fn mass_matrix_in<T, S, L, const N: usize>(
 ) -> SMatrix<S, N, N>
 where
     T: Real,
-    S: Scalar<Real = T>,
+    S: Scalar<Real = T> + 'static,
     L: Lagrangian<T, N>,
 {
-    kinetic_jet(l, t, q, qd).0
+    kinetic_terms(l, t, q, qd).0
 }
 
 /// `M` and `f = dT/dq - dV/dq - (d2T/dq'dq) q' - d2T/dq'dt` over any scalar `S`, from one
@@ -241,7 +297,7 @@ fn terms_in<T, S, L, const N: usize>(
 ) -> (SMatrix<S, N, N>, SVector<S, N>)
 where
     T: Real,
-    S: Scalar<Real = T>,
+    S: Scalar<Real = T> + 'static,
     L: Lagrangian<T, N>,
 {
     let dv = potential_gradient(l, t, q);
@@ -250,11 +306,11 @@ where
         let mut f = -dv;
         if L::EXPLICIT_TIME {
             // T's part is then -d2T/dq'dt alone (dT/dq = 0 and d2T/dq'dq = 0).
-            f += kinetic_jet(l, t, q, qd).1;
+            f += kinetic_terms(l, t, q, qd).1;
         }
         return (SMatrix::zeros(), f);
     }
-    let (m, f) = kinetic_jet(l, t, q, qd);
+    let (m, f) = kinetic_terms(l, t, q, qd);
     (m, f - dv)
 }
 

@@ -61,6 +61,7 @@ pub mod prelude;
 mod scalar;
 mod scalar_trig;
 mod state;
+mod tape;
 pub mod validate;
 
 pub use cholesky::{solve_spd, Cholesky};

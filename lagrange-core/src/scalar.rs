@@ -18,11 +18,18 @@ use crate::scalar_trig;
 /// (parameters, literals) on its right: `qd[0] * qd[0] * (0.5 * self.m)`, `q[1] * self.g`,
 /// `x + 1.0`, `r / 2.0`. (Put the plain number on the right: Rust cannot make `0.5 * x` mean a
 /// dual number `x` in code generic over `S`; there, [`Scalar::from_real`] lifts a value.)
+///
+/// A scalar need not be `'static`: for mechanisms of many coordinates the automatic path
+/// records `T` and `V` on a tape on the stack, in numbers that borrow it. So nalgebra's
+/// methods that ask for a `'static` scalar (`dot`, `norm_squared`, matrix products,
+/// `SVector::new`) are not available on `S` inside a kinetic or potential energy: index the
+/// vectors and sum with iterators (`qd.iter().fold(S::zero(), |s, &x| s + x * x)`). The
+/// constraint traits, whose rows are only ever differentiated by dual numbers, ask for
+/// `S: Scalar + 'static` and may use them.
 pub trait Scalar:
     Copy
     + Debug
     + PartialEq
-    + 'static
     + Add<Output = Self>
     + Sub<Output = Self>
     + Mul<Output = Self>
@@ -83,7 +90,7 @@ pub(crate) mod sealed {
 
 /// A floating-point type the library computes in: `f32` or `f64` (sealed).
 pub trait Real:
-    Scalar<Real = Self> + PartialOrd + Default + Display + LowerExp + sealed::Sealed
+    Scalar<Real = Self> + 'static + PartialOrd + Default + Display + LowerExp + sealed::Sealed
 {
     /// 1/2.
     const HALF: Self;

@@ -52,7 +52,7 @@ use lagrange_core::{Error, Mechanism, Real, State};
 /// /// The ground at y = 0.
 /// struct Ground;
 /// impl HolonomicConstraints<f64, 1, 1> for Ground {
-///     fn phi<S: Scalar<Real = f64>>(&self, q: &SVector<S, 1>) -> SVector<S, 1> {
+///     fn phi<S: Scalar<Real = f64> + 'static>(&self, q: &SVector<S, 1>) -> SVector<S, 1> {
 ///         *q
 ///     }
 /// }

@@ -145,7 +145,7 @@ impl<T: Real> Constraints<T, 2, 1> for CartesianPendulum<T> {
 }
 
 impl<T: Real> HolonomicConstraints<T, 2, 1> for CartesianPendulum<T> {
-    fn phi<S: Scalar<Real = T>>(&self, q: &SVector<S, 2>) -> SVector<S, 1> {
+    fn phi<S: Scalar<Real = T> + 'static>(&self, q: &SVector<S, 2>) -> SVector<S, 1> {
         let l = S::from_real(self.length);
         Vector1::new((q[0] * q[0] + q[1] * q[1] - l * l) / (l + l))
     }

@@ -379,7 +379,7 @@ impl<T: Real> Trig<T> {
 }
 
 impl<T: Real> HolonomicConstraints<T, 3, 2> for FourBarLinkage<T> {
-    fn phi<S: Scalar<Real = T>>(&self, q: &SVector<S, 3>) -> SVector<S, 2> {
+    fn phi<S: Scalar<Real = T> + 'static>(&self, q: &SVector<S, 3>) -> SVector<S, 2> {
         let [d, a, b, c] = self.lengths.map(S::from_real);
         Vector2::new(
             a * q[0].sin() + b * q[1].sin() - c * q[2].sin() - d,

@@ -142,7 +142,7 @@ impl<T: Real> Constraints<T, 4, 2> for RollingDisk<T> {
 }
 
 impl<T: Real> PfaffianConstraints<T, 4, 2> for RollingDisk<T> {
-    fn matrix<S: Scalar<Real = T>>(&self, q: &SVector<S, 4>) -> SMatrix<S, 2, 4> {
+    fn matrix<S: Scalar<Real = T> + 'static>(&self, q: &SVector<S, 4>) -> SMatrix<S, 2, 4> {
         let (s, c) = q[2].sin_cos();
         let r = S::from_real(self.radius);
         let (zero, one) = (S::zero(), S::one());

@@ -12,7 +12,7 @@ use lagrange_tests::{for_f32_and_f64, pick};
 struct Ground;
 
 impl<T: Real> HolonomicConstraints<T, 1, 1> for Ground {
-    fn phi<S: Scalar<Real = T>>(&self, q: &SVector<S, 1>) -> SVector<S, 1> {
+    fn phi<S: Scalar<Real = T> + 'static>(&self, q: &SVector<S, 1>) -> SVector<S, 1> {
         *q
     }
 }
@@ -109,7 +109,7 @@ for_f32_and_f64!(ball_bounces_to_rest);
 struct GroundTwice;
 
 impl HolonomicConstraints<f64, 1, 2> for GroundTwice {
-    fn phi<S: Scalar<Real = f64>>(&self, q: &SVector<S, 1>) -> SVector<S, 2> {
+    fn phi<S: Scalar<Real = f64> + 'static>(&self, q: &SVector<S, 1>) -> SVector<S, 2> {
         SVector::from([q[0], q[0]])
     }
 }

@@ -124,7 +124,7 @@ fn inconsistent_start_is_refused<T: Real>() -> Result<(), Error> {
 struct Twice;
 
 impl<T: Real> HolonomicConstraints<T, 2, 2> for Twice {
-    fn phi<S: Scalar<Real = T>>(&self, q: &SVector<S, 2>) -> SVector<S, 2> {
+    fn phi<S: Scalar<Real = T> + 'static>(&self, q: &SVector<S, 2>) -> SVector<S, 2> {
         let c = (q[0] * q[0] + q[1] * q[1] - S::one()) * S::from_f64(0.5);
         Vector2::new(c, c * S::from_f64(3.0))
     }
@@ -200,7 +200,7 @@ fn linkage_that_cannot_close<T: Real>() -> Result<(), Error> {
 struct Ground;
 
 impl<T: Real> HolonomicConstraints<T, 1, 1> for Ground {
-    fn phi<S: Scalar<Real = T>>(&self, q: &SVector<S, 1>) -> SVector<S, 1> {
+    fn phi<S: Scalar<Real = T> + 'static>(&self, q: &SVector<S, 1>) -> SVector<S, 1> {
         *q
     }
 }

@@ -12,7 +12,9 @@ struct Point;
 
 impl Lagrangian<f64, 3> for Point {
     fn kinetic<S: Scalar<Real = f64>>(&self, _t: S, _q: &SVector<S, 3>, v: &SVector<S, 3>) -> S {
-        v.dot(v) * S::from_f64(0.5)
+        // By iterator, not `v.dot(v)`: the automatic path's scalars need not be `'static`,
+        // which nalgebra's arithmetic methods ask of theirs.
+        v.iter().fold(S::zero(), |sum, &x| sum + x * x) * S::from_f64(0.5)
     }
     fn potential<S: Scalar<Real = f64>>(&self, _t: S, _q: &SVector<S, 3>) -> S {
         S::from_f64(0.0)

@@ -388,7 +388,7 @@ impl<T: Real> Lagrangian<T, 2> for Plane {
 struct NanCircle<T>(T);
 
 impl<T: Real> HolonomicConstraints<T, 2, 1> for NanCircle<T> {
-    fn phi<S: Scalar<Real = T>>(&self, q: &SVector<S, 2>) -> SVector<S, 1> {
+    fn phi<S: Scalar<Real = T> + 'static>(&self, q: &SVector<S, 2>) -> SVector<S, 1> {
         Vector1::new((q[0] * q[0] + q[1] * q[1]) * self.0)
     }
 }

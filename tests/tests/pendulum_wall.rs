@@ -23,7 +23,7 @@ const DT: f64 = 1e-3;
 struct JointLimit;
 
 impl<T: Real> HolonomicConstraints<T, 1, 1> for JointLimit {
-    fn phi<S: Scalar<Real = T>>(&self, q: &SVector<S, 1>) -> SVector<S, 1> {
+    fn phi<S: Scalar<Real = T> + 'static>(&self, q: &SVector<S, 1>) -> SVector<S, 1> {
         SVector::from([q[0] - S::from_f64(WALL)])
     }
 }
@@ -33,7 +33,7 @@ impl<T: Real> HolonomicConstraints<T, 1, 1> for JointLimit {
 struct RodAndWall;
 
 impl<T: Real> HolonomicConstraints<T, 2, 2> for RodAndWall {
-    fn phi<S: Scalar<Real = T>>(&self, q: &SVector<S, 2>) -> SVector<S, 2> {
+    fn phi<S: Scalar<Real = T> + 'static>(&self, q: &SVector<S, 2>) -> SVector<S, 2> {
         Vector2::new(
             (q[0] * q[0] + q[1] * q[1] - S::one()) * S::from_f64(0.5),
             q[0] - S::from_f64(WALL.sin()),

@@ -326,7 +326,7 @@ fn heavily_damped_props_settle_and_sleep<T: Real>() -> Result<(), Error> {
 struct Floor;
 
 impl<T: Real> HolonomicConstraints<T, 1, 1> for Floor {
-    fn phi<S: Scalar<Real = T>>(&self, q: &SVector<S, 1>) -> SVector<S, 1> {
+    fn phi<S: Scalar<Real = T> + 'static>(&self, q: &SVector<S, 1>) -> SVector<S, 1> {
         *q
     }
 }

@@ -109,7 +109,7 @@ const BEND: f64 = 2.5;
 pub struct FloorAndLimits;
 
 impl<T: Real> HolonomicConstraints<T, 2, 4> for FloorAndLimits {
-    fn phi<S: Scalar<Real = T>>(&self, q: &SVector<S, 2>) -> SVector<S, 4> {
+    fn phi<S: Scalar<Real = T> + 'static>(&self, q: &SVector<S, 2>) -> SVector<S, 4> {
         let (floor, bend) = (S::from_f64(FLOOR), S::from_f64(BEND));
         let y1 = -q[0].cos();
         let y2 = y1 - q[1].cos();

@@ -1359,7 +1359,7 @@ class Generator:
         o.append(f"impl<T: Real> HolonomicConstraints<T, {n}, {c}> for {s.name}<T> {{")
         qv = "q" if b["phi_generic"].used_inputs else "_q"
         self.fn(
-            f"fn phi<S: Scalar<Real = T>>(&self, {qv}: &SVector<S, {n}>) -> SVector<S, {c}>",
+            f"fn phi<S: Scalar<Real = T> + 'static>(&self, {qv}: &SVector<S, {n}>) -> SVector<S, {c}>",
             b["phi_generic"],
             self.vector(b["phi_generic"], 0, c, want="S"),
         )

@@ -25,7 +25,7 @@ const BALLS: usize = 200;
 pub struct Floor;
 
 impl HolonomicConstraints<f32, 1, 1> for Floor {
-    fn phi<S: Scalar<Real = f32>>(&self, q: &SVector<S, 1>) -> SVector<S, 1> {
+    fn phi<S: Scalar<Real = f32> + 'static>(&self, q: &SVector<S, 1>) -> SVector<S, 1> {
         *q
     }
 }

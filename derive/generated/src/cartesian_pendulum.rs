@@ -190,7 +190,7 @@ impl<T: Real> Constraints<T, 2, 1> for CartesianPendulum<T> {
 
 /// The rows written generic over the scalar, for the automatic path (`Holonomic`).
 impl<T: Real> HolonomicConstraints<T, 2, 1> for CartesianPendulum<T> {
-    fn phi<S: Scalar<Real = T>>(&self, q: &SVector<S, 2>) -> SVector<S, 1> {
+    fn phi<S: Scalar<Real = T> + 'static>(&self, q: &SVector<S, 2>) -> SVector<S, 1> {
         let x = q[0];
         let y = q[1];
         SVector::from([(x * x) * self.k2 + (y * y) * self.k2 - self.k3])

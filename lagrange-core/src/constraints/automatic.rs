@@ -18,7 +18,7 @@ use nalgebra::{SMatrix, SVector};
 /// struct Circle { l: f64 }
 ///
 /// impl HolonomicConstraints<f64, 2, 1> for Circle {
-///     fn phi<S: Scalar<Real = f64>>(&self, q: &SVector<S, 2>) -> SVector<S, 1> {
+///     fn phi<S: Scalar<Real = f64> + 'static>(&self, q: &SVector<S, 2>) -> SVector<S, 1> {
 ///         let l = S::from_real(self.l);
 ///         Vector1::new((q[0] * q[0] + q[1] * q[1] - l * l) * S::from_f64(0.5))
 ///     }
@@ -32,14 +32,14 @@ use nalgebra::{SMatrix, SVector};
 /// ```
 pub trait HolonomicConstraints<T: Real, const N: usize, const C: usize> {
     /// The position residuals `phi(q)`, zero on the constraint manifold.
-    fn phi<S: Scalar<Real = T>>(&self, q: &SVector<S, N>) -> SVector<S, C>;
+    fn phi<S: Scalar<Real = T> + 'static>(&self, q: &SVector<S, N>) -> SVector<S, C>;
 }
 
 /// `C` Pfaffian (velocity-level, possibly nonholonomic) constraints `A(q) q' = 0`, with `A`
 /// written generic over the scalar. Wrap them in [`Pfaffian`] to get [`Constraints`].
 pub trait PfaffianConstraints<T: Real, const N: usize, const C: usize> {
     /// The constraint matrix `A(q)`.
-    fn matrix<S: Scalar<Real = T>>(&self, q: &SVector<S, N>) -> SMatrix<S, C, N>;
+    fn matrix<S: Scalar<Real = T> + 'static>(&self, q: &SVector<S, N>) -> SMatrix<S, C, N>;
 }
 
 /// The [`Constraints`] that [`HolonomicConstraints`] define:

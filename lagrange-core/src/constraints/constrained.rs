@@ -265,7 +265,7 @@ pub(crate) fn solve_kkt<T: Real, const N: usize, const C: usize>(
 /// /// On a rod of length 1 from the origin.
 /// struct Rod;
 /// impl HolonomicConstraints<f64, 2, 1> for Rod {
-///     fn phi<S: Scalar<Real = f64>>(&self, q: &SVector<S, 2>) -> SVector<S, 1> {
+///     fn phi<S: Scalar<Real = f64> + 'static>(&self, q: &SVector<S, 2>) -> SVector<S, 1> {
 ///         Vector1::new((q[0] * q[0] + q[1] * q[1] - 1.0) * 0.5)
 ///     }
 /// }

@@ -60,7 +60,7 @@ pub struct Circle<T> {
 }
 
 impl<T: Real> HolonomicConstraints<T, 2, 1> for Circle<T> {
-    fn phi<S: Scalar<Real = T>>(&self, q: &SVector<S, 2>) -> SVector<S, 1> {
+    fn phi<S: Scalar<Real = T> + 'static>(&self, q: &SVector<S, 2>) -> SVector<S, 1> {
         Vector1::new((q[0] * q[0] + q[1] * q[1] - S::from_real(self.r * self.r)) * T::HALF)
     }
 }
@@ -73,7 +73,7 @@ pub struct Box2<T> {
 }
 
 impl<T: Real> HolonomicConstraints<T, 2, 2> for Box2<T> {
-    fn phi<S: Scalar<Real = T>>(&self, q: &SVector<S, 2>) -> SVector<S, 2> {
+    fn phi<S: Scalar<Real = T> + 'static>(&self, q: &SVector<S, 2>) -> SVector<S, 2> {
         Vector2::new(
             q[1] - S::from_real(self.floor),
             S::from_real(self.wall) - q[0],
@@ -112,7 +112,7 @@ pub struct Ground<T> {
 }
 
 impl<T: Real> HolonomicConstraints<T, 1, 1> for Ground<T> {
-    fn phi<S: Scalar<Real = T>>(&self, q: &SVector<S, 1>) -> SVector<S, 1> {
+    fn phi<S: Scalar<Real = T> + 'static>(&self, q: &SVector<S, 1>) -> SVector<S, 1> {
         Vector1::new(q[0] - S::from_real(self.h))
     }
 }
