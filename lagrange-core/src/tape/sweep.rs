@@ -123,16 +123,23 @@ fn spread<S: Scalar, const N: usize>(g: Span, pool: &[S]) -> [S; N] {
     full
 }
 
-/// `h += c a a^T`, in the rows of `a`'s range. Whole rows of the fixed length `N` rather than
-/// the triangle in the range: a loop of known length the compiler unrolls and vectorises,
-/// faster than the fewer entries of short loops of varying length (the chain's rows are a
-/// few entries long).
+/// `h += c a a^T` over the square block of `a`'s range (both triangles: the matrix is
+/// read whole). Rows of one length per call, which the compiler vectorises; a triangle's rows
+/// of varying length measured slower for the chain's short ranges.
 fn add_square<S: Scalar, const N: usize>(h: &mut [[S; N]; N], pool: &[S], c: S, a: Span) {
-    let a = (a, spread::<S, N>(a, pool));
-    add_rows(h, c, &a, &a);
+    let part = a.part(pool);
+    let rows = h.get_mut(a.range()).unwrap_or_default();
+    for (row, ai) in rows.iter_mut().zip(part) {
+        let cai = c * *ai;
+        let block = row.get_mut(a.range()).unwrap_or_default();
+        for (e, aj) in block.iter_mut().zip(part) {
+            *e += cai * *aj;
+        }
+    }
 }
 
-/// `h += c (a b^T + b a^T)`, in the rows of the ranges (whole rows, as [`add_square`]).
+/// `h += c (a b^T + b a^T)`, in the rows of the ranges: whole rows of the fixed length `N`
+/// (the two ranges differ, and a loop of known length vectorises).
 fn add_outer<S: Scalar, const N: usize>(h: &mut [[S; N]; N], pool: &[S], c: S, a: Span, b: Span) {
     let (a, b) = ((a, spread::<S, N>(a, pool)), (b, spread::<S, N>(b, pool)));
     add_rows(h, c, &a, &b);

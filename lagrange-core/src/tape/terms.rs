@@ -25,7 +25,7 @@ where
     S: Scalar<Real = T> + 'static,
     L: Lagrangian<T, N>,
 {
-    kinetic_on::<T, S, L, N, 384, 2048>(l, t, q, qd)
+    kinetic_on::<T, S, L, N, 384, 1024>(l, t, q, qd)
         .or_else(|| kinetic_on::<T, S, L, N, 1024, 8192>(l, t, q, qd))
 }
 
