@@ -35,7 +35,7 @@ const TOLERANCE: f64 = 1e-13;
 /// at worst. The rest is `f`'s rounding: `f = dT/dq - d/dt dT/dq'` is a difference of terms up
 /// to 7 times larger than `f` at these rates (each agrees with the jet's to 1.7e-15 of its
 /// size), and the tape forms the two in different orders, where the jet (which was measured
-/// at 1.1e-13 here, at 7.5 times the cost) carries both through the same products, so that
+/// at 1.1e-13 here, at 8 times the cost) carries both through the same products, so that
 /// their roundings largely cancel.
 const CHAIN_20_ACCELERATION: f64 = 4e-13;
 
