@@ -1,5 +1,6 @@
 //! Automatic Euler-Lagrange: write `T` and `V` once, generic over a [`Scalar`], and get the
-//! equations of motion by differentiating them with forward-mode dual numbers.
+//! equations of motion by differentiating them: forward mode (a second-order jet and dual
+//! numbers) below 11 coordinates, reverse mode over a tape from 11 on.
 
 use crate::jet::Jet;
 use crate::mechanism::finite;
@@ -108,8 +109,9 @@ type Directional<T> = Dual<T, 1>;
 /// f   = dT/dq - dV/dq - (d2T/dq'dq) q' - d2T/dq'dt
 /// ```
 ///
-/// each entry exact to rounding, from forward-mode derivatives: one evaluation of `T` over a
-/// second-order jet and one of `V` over a [`Dual`] number give both. The jet carries `T`'s
+/// each entry exact to rounding, from automatic derivatives: below 11 coordinates, one
+/// evaluation of `T` over a second-order jet and one of `V` over a [`Dual`] number give both
+/// (from 11 on, a tape: below). The jet carries `T`'s
 /// gradients in `q` and `q'`, the upper half of its Hessian in `q'` (that is `M`), and the
 /// derivative of its velocity gradient along `(dq, dt) = (q', 1)` (the mixed and time terms
 /// at once, `O(N)` per operation instead of a second Hessian); parts that are exactly zero (a
@@ -269,7 +271,7 @@ where
 }
 
 /// `M = d2T/dq'dq'` over any scalar `S` (plain for the mass matrix, a dual number for its
-/// derivatives), from one evaluation of `T` over a [`Jet`].
+/// derivatives), from one evaluation of `T` ([`kinetic_terms`]).
 fn mass_matrix_in<T, S, L, const N: usize>(
     l: &L,
     t: S,
@@ -285,7 +287,7 @@ where
 }
 
 /// `M` and `f = dT/dq - dV/dq - (d2T/dq'dq) q' - d2T/dq'dt` over any scalar `S`, from one
-/// evaluation of `T` over a [`Jet`] and one of `V` over `Dual<S, N>`. Where
+/// evaluation of `T` ([`kinetic_terms`]) and one of `V` ([`potential_gradient`]). Where
 /// [`Lagrangian::CONSTANT_MASS`] holds, `f` skips `T` but for the time term, and `M` is not
 /// computed (zero here: use the factor made once).
 #[inline(always)]

@@ -5,13 +5,17 @@
 //! lives on the stack for one evaluation of `T`. Each node keeps its (at most two) parents and
 //! the first and second partial derivatives of its operation at the parents' values: that is
 //! all [`sweep`] needs to get `M = d2T/dq'2`, `dT/dq` and the mixed term, from one reverse
-//! and one forward pass over the nodes (see there). A value is two words and an index, so the
-//! user's `T` runs at about the speed of plain arithmetic however large `N` is, where a
-//! [`Jet`](crate::jet::Jet) of a 20-link chain is kilobytes.
+//! and one forward pass over the nodes (see there). A value is two numbers (its value and a
+//! scale, below), a reference and an index, so the user's `T` runs at about the speed of
+//! plain arithmetic however large `N` is, where a [`Jet`](crate::jet::Jet) of a 20-link chain
+//! is kilobytes.
 //!
 //! The tape holds at most `CAP` nodes; a `T` that needs more marks it full, and the caller
-//! falls back to the jet. Its storage is not initialised ahead (`heapless::Vec`), so a large
-//! capacity costs stack, not time.
+//! falls back to the jet. The tape's storage is not initialised ahead (`heapless::Vec`); the
+//! sweep's work space is (arrays of `CAP` numbers and a pool of gradients), so a capacity
+//! costs stack and the time to clear it: about 140 kB for the largest tape over `f64` at
+//! `N = 20`, twice that over the dual numbers of the law's Jacobian. Only mechanisms of
+//! [`FROM`] coordinates or more use a tape, none of the embedded targets' cases.
 
 pub(crate) mod sweep;
 pub(crate) mod terms;
@@ -47,7 +51,7 @@ pub(crate) struct Node<S> {
     pub(crate) haa: S,
     pub(crate) hab: S,
     pub(crate) hbb: S,
-    /// False for an operation linear in its parents (sums, scalings, inputs).
+    /// False for an operation linear in its parents (sums, differences, inputs).
     pub(crate) curved: bool,
 }
 
@@ -63,6 +67,8 @@ pub(crate) struct Tape<'s, S, const CAP: usize> {
 impl<'s, S: Scalar, const CAP: usize> Tape<'s, S, CAP> {
     /// An empty tape in `storage`.
     pub(crate) fn new(storage: &'s mut heapless::Vec<Node<S>, CAP>) -> Self {
+        // Node indices are `u16`, `NONE` kept out of them.
+        const { assert!(CAP < NONE as usize) };
         storage.clear();
         Self {
             nodes: RefCell::new(storage),
@@ -77,14 +83,13 @@ impl<'s, S: Scalar, const CAP: usize> Tape<'s, S, CAP> {
             self.full.set(true);
             return NONE;
         };
-        let at = nodes.len();
-        match u16::try_from(at) {
-            Ok(i) if i != NONE && nodes.push(node).is_ok() => i,
-            _ => {
-                self.full.set(true);
-                NONE
-            }
+        // `CAP < NONE` (checked in `new`): an index that fits the storage fits a `u16`.
+        let at = u16::try_from(nodes.len()).unwrap_or(NONE);
+        if nodes.push(node).is_err() {
+            self.full.set(true);
+            return NONE;
         }
+        at
     }
 
     /// An input: a node with no parents, its value `v`.
@@ -195,22 +200,25 @@ impl<S: Scalar, const CAP: usize> Taped<'_, '_, S, CAP> {
     }
 
     /// `phi(self, o)` with value `v`, first partials `p` and second partials
-    /// `h = [d2/da2, d2/dadb, d2/db2]` (`curved` false where `phi` is linear); both operands
-    /// on the tape.
+    /// `h = [d2/da2, d2/dadb, d2/db2]` (`curved` false where `phi` is linear). An operand
+    /// that is a constant is no parent: its partials are zero, whatever `p` and `h` say
+    /// (which may be infinite: a constant divisor of zero).
     #[inline]
     fn binary(self, o: Self, v: S, p: [S; 2], h: [S; 3], curved: bool) -> Self {
         let Some(tape) = self.tape.or(o.tape) else {
             return Self::constant(v);
         };
-        let (sa, sb) = (self.scale, o.scale);
+        let z = S::zero();
+        let ((a, sa), (b, sb)) = (self.node(), o.node());
+        let on = |node: u16, x: S| if node == NONE { z } else { x };
         let at = tape.push(Node {
-            a: self.at,
-            b: o.at,
-            pa: p[0] * sa,
-            pb: p[1] * sb,
-            haa: h[0] * sa * sa,
-            hab: h[1] * sa * sb,
-            hbb: h[2] * sb * sb,
+            a,
+            b,
+            pa: on(a, p[0] * sa),
+            pb: on(b, p[1] * sb),
+            haa: on(a, h[0] * sa * sa),
+            hab: on(a, on(b, h[1] * sa * sb)),
+            hbb: on(b, h[2] * sb * sb),
             curved,
         });
         Self {
@@ -224,6 +232,9 @@ impl<S: Scalar, const CAP: usize> Taped<'_, '_, S, CAP> {
     /// A linear function of `self` with slope `c` and value `v`: no node.
     #[inline]
     fn affine(self, c: S, v: S) -> Self {
+        if self.tape.is_none() {
+            return Self::constant(v);
+        }
         Self {
             v,
             scale: self.scale * c,

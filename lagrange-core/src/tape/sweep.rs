@@ -13,13 +13,14 @@
 //! `N`-vector, and its tangent along `e`, a number) give `M` (the sum with velocity gradients
 //! on both sides) and the mixed term (velocity gradients on one side, tangents on the other),
 //! and the adjoints of the coordinates are `dT/dq`. Only curved nodes whose parents move with
-//! `q'` add to `M`, each a rank-one or rank-two update of its upper triangle.
+//! `q'` add to `M`, each a rank-one or rank-two update (of both triangles: `M` is read whole).
 
 use super::{Node, NONE};
 use crate::Scalar;
 use nalgebra::{SMatrix, SVector};
 
-/// Where the inputs sit on the tape, and the direction `e` of the mixed term.
+/// Where the inputs sit on the tape (its first nodes: time where it is one, then `q`, then
+/// `q'`), and the direction `e` of the mixed term.
 pub(crate) struct Inputs<'a, S, const N: usize> {
     /// The node of time, [`NONE`] where time is a constant (then `dt = 0` along `e`).
     pub(crate) time: u16,
@@ -36,7 +37,7 @@ pub(crate) struct Inputs<'a, S, const N: usize> {
 /// mechanism's energy a few at a time (a chain's link `i` moves with the first `i + 1`
 /// rates), and keeping only the range both saves copying `N`-vectors and keeps each update to
 /// the entries it touches.
-#[derive(Clone, Copy, Default)]
+#[derive(Clone, Copy)]
 struct Span {
     at: u32,
     lo: u16,
@@ -92,7 +93,7 @@ fn combine<S: Scalar>(
     };
     let at = *used;
     let end = at + usize::from(hi - lo);
-    let (old, rest) = pool.split_at_mut(at);
+    let (old, rest) = pool.split_at_mut_checked(at)?;
     let new = rest.get_mut(..end - at)?;
     for (g, c) in [(ga, pa), (gb, pb)] {
         let from = usize::from(g.lo.saturating_sub(lo));
@@ -141,17 +142,17 @@ fn add_square<S: Scalar, const N: usize>(h: &mut [[S; N]; N], pool: &[S], c: S, 
 /// `h += c (a b^T + b a^T)`, in the rows of the ranges: whole rows of the fixed length `N`
 /// (the two ranges differ, and a loop of known length vectorises).
 fn add_outer<S: Scalar, const N: usize>(h: &mut [[S; N]; N], pool: &[S], c: S, a: Span, b: Span) {
-    let (a, b) = ((a, spread::<S, N>(a, pool)), (b, spread::<S, N>(b, pool)));
-    add_rows(h, c, &a, &b);
-    add_rows(h, c, &b, &a);
+    let (fa, fb) = (spread::<S, N>(a, pool), spread::<S, N>(b, pool));
+    add_rows(h, c, (a, &fa), &fb);
+    add_rows(h, c, (b, &fb), &fa);
 }
 
-/// `h += c x y^T` in the rows of `x`'s range, each gradient with its range and spread out.
+/// `h += c x y^T` in the rows of `x`'s range, `x` with its range, both spread out.
 fn add_rows<S: Scalar, const N: usize>(
     h: &mut [[S; N]; N],
     c: S,
-    (xs, x): &(Span, [S; N]),
-    (_, y): &(Span, [S; N]),
+    (xs, x): (Span, &[S; N]),
+    y: &[S; N],
 ) {
     let rows = h.get_mut(xs.range()).unwrap_or_default();
     for (row, xi) in rows.iter_mut().zip(x.get(xs.range()).unwrap_or_default()) {
@@ -162,27 +163,17 @@ fn add_rows<S: Scalar, const N: usize>(
     }
 }
 
-/// `M` and `dT/dq - d/de dT/dq'` of the `T` recorded in `nodes`, its value a multiple
-/// `out.1` of the node `out.0`;
-/// `None` where the work space (`CAP` nodes, `POOL` numbers of gradients) is too small.
-#[inline(never)]
-pub(crate) fn kinetic_terms<
-    S: Scalar + 'static,
-    const N: usize,
-    const CAP: usize,
-    const POOL: usize,
->(
+/// The adjoints `w_v = dT/dv` of the value recorded in `nodes` (a multiple `out.1` of the
+/// node `out.0`), by one reverse pass, and which nodes the curved terms need the gradient and
+/// tangent of: the parents of curved nodes with a non-zero adjoint, and everything they are
+/// made of (a node made only of such, like `T`'s running sum, needs neither).
+fn reverse<S: Scalar, const CAP: usize>(
     nodes: &[Node<S>],
     out: (u16, S),
-    inputs: &Inputs<'_, S, N>,
-) -> Option<(SMatrix<S, N, N>, SVector<S, N>)> {
+) -> ([S; CAP], [bool; CAP]) {
     let z = S::zero();
-
     // Plain arrays, not `heapless::Vec`s: a push stores the length to memory, and a loop of
     // pushes waits on that store each time (measured: most of the sweep's time).
-    // Reverse: w_v = dT/dv, and which nodes the curved terms need the gradient and tangent
-    // of (the parents of curved nodes with a non-zero adjoint, and everything they are
-    // made of): a node made only of such, like T's running sum, needs neither.
     let mut adj = [z; CAP];
     let mut needed = [false; CAP];
     if let Some(w) = adj.get_mut(usize::from(out.0)) {
@@ -208,9 +199,28 @@ pub(crate) fn kinetic_terms<
             *x += node.pb * w;
         }
     }
+    (adj, needed)
+}
 
-    // Forward: tangents along e, velocity gradients (only nodes that move with q' have
-    // one), and the curved nodes' terms.
+/// `M` and `dT/dq - d/de dT/dq'` of the `T` recorded in `nodes`, its value a multiple
+/// `out.1` of the node `out.0`; `None` where the pool (`POOL` numbers of gradients) is too
+/// small.
+#[inline(never)]
+pub(crate) fn second_order<
+    S: Scalar + 'static,
+    const N: usize,
+    const CAP: usize,
+    const POOL: usize,
+>(
+    nodes: &[Node<S>],
+    out: (u16, S),
+    inputs: &Inputs<'_, S, N>,
+) -> Option<(SMatrix<S, N, N>, SVector<S, N>)> {
+    let z = S::zero();
+    let (adj, needed) = reverse::<S, CAP>(nodes, out);
+
+    // Forward: tangents along e, velocity gradients (only for the nodes that need them), and
+    // the curved nodes' terms.
     let mut tangent = [z; CAP];
     let mut span = [Span::ZERO; CAP];
     let mut pool = [z; POOL];
@@ -229,41 +239,45 @@ pub(crate) fn kinetic_terms<
         if !curved && !need {
             continue;
         }
+        // A parent that is not a node (NONE) has no tangent and no gradient.
         let ta = tangent.get(usize::from(node.a)).copied().unwrap_or(z);
         let tb = tangent.get(usize::from(node.b)).copied().unwrap_or(z);
-        let ga = span.get(usize::from(node.a)).copied().unwrap_or_default();
-        let gb = span.get(usize::from(node.b)).copied().unwrap_or_default();
+        let ga = span.get(usize::from(node.a)).copied().unwrap_or(Span::ZERO);
+        let gb = span.get(usize::from(node.b)).copied().unwrap_or(Span::ZERO);
         if curved {
             curved_terms(&mut h, &mut dp, &pool, w, node, (ga, ta), (gb, tb));
         }
         if !need {
             continue;
         }
-        let (t, g) = if node.a == NONE && node.b == NONE {
-            // An input.
-            if v == time {
-                (S::one(), Span::ZERO)
-            } else if (q0..q0 + N).contains(&v) {
-                (inputs.rates[v - q0], Span::ZERO)
-            } else if (qd0..qd0 + N).contains(&v) {
-                *pool.get_mut(used)? = S::one();
-                let k = u16::try_from(v - qd0).ok()?;
-                let at = u32::try_from(used).ok()?;
-                used += 1;
-                (
-                    z,
-                    Span {
-                        at,
-                        lo: k,
-                        hi: k + 1,
-                    },
-                )
-            } else {
-                (z, Span::ZERO)
-            }
+        // The inputs are the first nodes, by index (see `Inputs`).
+        let (t, g) = if v == time {
+            (S::one(), Span::ZERO)
+        } else if (q0..q0 + N).contains(&v) {
+            (inputs.rates.get(v - q0).copied().unwrap_or(z), Span::ZERO)
+        } else if (qd0..qd0 + N).contains(&v) {
+            *pool.get_mut(used)? = S::one();
+            let k = u16::try_from(v - qd0).ok()?;
+            let at = u32::try_from(used).ok()?;
+            used += 1;
+            (
+                z,
+                Span {
+                    at,
+                    lo: k,
+                    hi: k + 1,
+                },
+            )
         } else {
             let g = combine(&mut pool, &mut used, (node.pa, ga), (node.pb, gb))?;
-            (node.pa * ta + node.pb * tb, g)
+            let mut t = z;
+            if node.a != NONE {
+                t += node.pa * ta;
+            }
+            if node.b != NONE {
+                t += node.pb * tb;
+            }
+            (t, g)
         };
         *tangent.get_mut(v)? = t;
         *span.get_mut(v)? = g;
@@ -316,32 +330,13 @@ fn curved_terms<S: Scalar, const N: usize>(
 }
 
 /// The gradient of the value recorded in `nodes` (a multiple `out.1` of the node `out.0`) in
-/// the `N` inputs from the node `first`: one reverse pass; `None` where the work space is
-/// too small.
+/// the `N` inputs from the node `first`: one reverse pass.
 pub(crate) fn gradient<S: Scalar + 'static, const N: usize, const CAP: usize>(
     nodes: &[Node<S>],
     out: (u16, S),
     first: u16,
-) -> Option<SVector<S, N>> {
-    let z = S::zero();
-    let mut adj = [z; CAP];
-    if let Some(w) = adj.get_mut(usize::from(out.0)) {
-        *w = out.1;
-    }
-    for (v, node) in nodes.iter().enumerate().rev() {
-        let w = adj.get(v).copied().unwrap_or(z);
-        if w.is_zero() {
-            continue;
-        }
-        if let Some(x) = adj.get_mut(usize::from(node.a)) {
-            *x += node.pa * w;
-        }
-        if let Some(x) = adj.get_mut(usize::from(node.b)) {
-            *x += node.pb * w;
-        }
-    }
+) -> SVector<S, N> {
+    let (adj, _) = reverse::<S, CAP>(nodes, out);
     let first = usize::from(first);
-    Some(SVector::from_fn(|i, _| {
-        adj.get(first + i).copied().unwrap_or(z)
-    }))
+    SVector::from_fn(|i, _| adj.get(first + i).copied().unwrap_or_else(S::zero))
 }

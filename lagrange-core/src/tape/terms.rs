@@ -1,10 +1,12 @@
 //! A Lagrangian's kinetic energy and potential recorded on tapes and swept: what
 //! [`EulerLagrange`](crate::EulerLagrange) uses from [`FROM`](super::FROM) coordinates on.
 //!
-//! Each tries tapes of growing size (one a little larger than a chain of `N` links needs,
-//! then a larger one) and gives up (`None`, the caller falls back to the jet) where `T` or
-//! `V` needs more nodes than the largest holds. Each size is its own function kept out of
-//! line, so that the stack of a large tape is taken only while it is used.
+//! Each tries two tapes: one of 384 nodes and 1,024 numbers of gradients, which holds a chain
+//! of 20 links (10 nodes a link in `T` and 2 an input; its gradients about 500 numbers; a test
+//! below checks), then one of 1,024 nodes and 8,192 numbers; it gives up (`None`, the caller falls back to the jet) where
+//! `T` or `V` needs more. A `T` that needs the larger tape is recorded twice per call. Each
+//! size is its own function kept out of line, so that the stack of the larger tape is taken
+//! only while it is used.
 
 use super::sweep::{self, Inputs};
 use super::{Node, Tape, Taped, NONE};
@@ -81,7 +83,7 @@ where
         (r.node(), inputs)
     };
     let nodes = tape.nodes()?;
-    sweep::kinetic_terms::<S, N, CAP, POOL>(&nodes, out, &inputs)
+    sweep::second_order::<S, N, CAP, POOL>(&nodes, out, &inputs)
 }
 
 /// [`potential_gradient`] on a tape of `CAP` nodes.
@@ -108,7 +110,7 @@ where
         (v.node(), first)
     };
     let nodes = tape.nodes()?;
-    sweep::gradient::<S, N, CAP>(&nodes, out, first)
+    Some(sweep::gradient::<S, N, CAP>(&nodes, out, first))
 }
 
 /// The tape against the jet and the dual number, which differentiate the same `T` and `V`
@@ -120,7 +122,7 @@ mod tests {
     use crate::lagrangian::{kinetic_jet, potential_dual};
     use crate::Dual;
 
-    /// Coordinates: at least [`super::super::FROM`], so that the dispatch takes the tape too.
+    /// Coordinates: as many as a mechanism that takes the tape has.
     const N: usize = 12;
 
     /// A kinetic energy and a potential that use every operation of [`Scalar`], with
@@ -226,6 +228,74 @@ mod tests {
     #[test]
     fn the_tape_agrees_with_the_jet() -> Result<(), &'static str> {
         agree::<false>()
+    }
+
+    /// The tapes the automatic path tries, smaller first, give the same.
+    #[test]
+    fn the_tapes_tried_agree_with_the_largest() -> Result<(), &'static str> {
+        let l = Everything::<true>;
+        for seed in 0..20 {
+            let (t, q, qd) = state(seed);
+            let large = kinetic_on::<f64, f64, _, N, 1024, 8192>(&l, t, &q, &qd);
+            let tried = kinetic(&l, t, &q, &qd);
+            assert_eq!(tried, large);
+            assert_eq!(
+                potential_gradient(&l, t, &q),
+                potential_on::<f64, f64, _, N, 1024>(&l, t, &q)
+            );
+            tried.ok_or("T does not fit")?;
+        }
+        Ok(())
+    }
+
+    /// A chain of `N` links, as `NLinkPendulum` writes its energies.
+    struct Chain<const N: usize>;
+
+    impl<const N: usize> Lagrangian<f64, N> for Chain<N> {
+        fn kinetic<S: Scalar<Real = f64>>(
+            &self,
+            _t: S,
+            q: &SVector<S, N>,
+            qd: &SVector<S, N>,
+        ) -> S {
+            let (mut vx, mut vy, mut t) = (S::zero(), S::zero(), S::zero());
+            for (j, (th, w)) in q.iter().zip(qd.iter()).enumerate() {
+                let (sin, cos) = th.sin_cos();
+                let u = *w * (1.0 + 0.1 * j as f64);
+                vx += u * cos;
+                vy += u * sin;
+                t += (vx * vx + vy * vy) * 0.5;
+            }
+            t
+        }
+        fn potential<S: Scalar<Real = f64>>(&self, _t: S, q: &SVector<S, N>) -> S {
+            let (mut y, mut v) = (S::zero(), S::zero());
+            for th in q.iter() {
+                y -= th.cos();
+                v += y * 9.81;
+            }
+            v
+        }
+    }
+
+    /// The smaller tape holds a chain of 20 links (recorded once per call, not twice), and a
+    /// chain of 40 needs the larger.
+    #[test]
+    fn the_smaller_tape_holds_a_chain_of_twenty() {
+        let (q, qd) = (
+            SVector::from_fn(|i, _| 0.1 * i as f64),
+            SVector::from_element(0.5),
+        );
+        let c = Chain::<20>;
+        assert!(kinetic_on::<f64, f64, _, 20, 384, 1024>(&c, 0.0, &q, &qd).is_some());
+        assert!(potential_on::<f64, f64, _, 20, 384>(&c, 0.0, &q).is_some());
+        let (q, qd) = (
+            SVector::from_fn(|i, _| 0.1 * i as f64),
+            SVector::from_element(0.5),
+        );
+        let c = Chain::<40>;
+        assert!(kinetic_on::<f64, f64, _, 40, 384, 1024>(&c, 0.0, &q, &qd).is_none());
+        assert!(kinetic_on::<f64, f64, _, 40, 1024, 8192>(&c, 0.0, &q, &qd).is_some());
     }
 
     #[test]
