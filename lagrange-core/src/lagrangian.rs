@@ -1,6 +1,6 @@
 //! Automatic Euler-Lagrange: write `T` and `V` once, generic over a [`Scalar`], and get the
-//! equations of motion by differentiating them: forward mode (a second-order jet and dual
-//! numbers) below 11 coordinates, reverse mode over a tape from 11 on.
+//! equations of motion by differentiating them: `T` by forward mode (a second-order jet)
+//! below 11 coordinates and by reverse mode over a tape from 11 on, `V` by dual numbers.
 
 use crate::jet::Jet;
 use crate::mechanism::finite;
@@ -109,9 +109,9 @@ type Directional<T> = Dual<T, 1>;
 /// f   = dT/dq - dV/dq - (d2T/dq'dq) q' - d2T/dq'dt
 /// ```
 ///
-/// each entry exact to rounding, from automatic derivatives: below 11 coordinates, one
-/// evaluation of `T` over a second-order jet and one of `V` over a [`Dual`] number give both
-/// (from 11 on, a tape: below). The jet carries `T`'s
+/// each entry exact to rounding, from automatic derivatives: one evaluation of `T` over a
+/// second-order jet (from 11 coordinates on, a tape: below) and one of `V` over a [`Dual`]
+/// number give both. The jet carries `T`'s
 /// gradients in `q` and `q'`, the upper half of its Hessian in `q'` (that is `M`), and the
 /// derivative of its velocity gradient along `(dq, dt) = (q', 1)` (the mixed and time terms
 /// at once, `O(N)` per operation instead of a second Hessian); parts that are exactly zero (a
@@ -124,15 +124,15 @@ type Directional<T> = Dual<T, 1>;
 /// `N^2 + 3 N + 2` numbers, which for a long chain (kilobytes at `N = 20`) makes copying them
 /// a large part of the cost.
 ///
-/// So from 11 coordinates on, `T` and `V` are instead recorded on a tape on the stack (each
-/// operation a node with its parents and partial derivatives) and swept: one reverse pass
-/// gives `dT/dq` and `dV/dq`, one forward pass each node's gradient in `q'` (only over the
-/// coordinates it depends on) and its rate along `(q', 1)`, and each node that is not linear
-/// in its parents adds a rank-one or rank-two term to `M` and its share of the mixed term.
-/// The cost is then a few nanoseconds a node each way plus the rank updates, whatever `N`:
-/// measured on a 20-link chain, about 20 times the hand-derived law where the jet takes 150
-/// times. A tape holds up to 1,024 nodes (about 140 kB of stack at `N = 20`); a `T` or `V`
-/// that needs more is differentiated by the jet and the dual number, as below 11.
+/// So from 11 coordinates on, `T` is instead recorded on a tape on the stack (each operation
+/// a node with its parents and partial derivatives) and swept: one reverse pass gives
+/// `dT/dq`, one forward pass each node's gradient in `q'` (only over the coordinates it
+/// depends on) and its rate along `(q', 1)`, and each node that is not linear in its parents
+/// adds a rank-one or rank-two term to `M` and its share of the mixed term. The cost is then
+/// about 20 ns a node plus the rank updates, whatever `N`: measured on a 20-link chain, about
+/// 19 times the hand-derived law where the jet takes 150 times. A tape holds up to 1,024
+/// nodes (about 140 kB of stack at `N = 20`); a `T` that needs more is differentiated by the
+/// jet, as below 11.
 ///
 /// Its [`Mechanism::law_jacobian`] is exact too: differentiating `M q'' = f + Q + extra` gives
 /// `M dq''/dx = d(f + Q + extra)/dx - (dM/dx) q''`, with `dM/dx` and `df/dx` from `M` and `f`
@@ -236,28 +236,11 @@ where
     )
 }
 
-/// `dV/dq` over any scalar `S`: over `Dual<S, N>` below [`tape::FROM`] coordinates, over a
-/// tape and one reverse pass from there on.
+/// `dV/dq` over any scalar `S`, from one evaluation of `V` over `Dual<S, N>`: at every `N`,
+/// since `V` is a function of `q` alone and a dual number is only `N + 1` numbers. (A tape
+/// measured slower for `V`: its 20 ns or so a node each way against a few ns an operation of
+/// the dual, on the N-body of the bench, 14 and 28 coordinates, 2.7 and 2.2 times.)
 fn potential_gradient<T, S, L, const N: usize>(l: &L, t: S, q: &SVector<S, N>) -> SVector<S, N>
-where
-    T: Real,
-    S: Scalar<Real = T> + 'static,
-    L: Lagrangian<T, N>,
-{
-    if N >= tape::FROM {
-        if let Some(g) = tape::terms::potential_gradient(l, t, q) {
-            return g;
-        }
-    }
-    potential_dual(l, t, q)
-}
-
-/// [`potential_gradient`] from one evaluation of `V` over `Dual<S, N>`.
-pub(crate) fn potential_dual<T, S, L, const N: usize>(
-    l: &L,
-    t: S,
-    q: &SVector<S, N>,
-) -> SVector<S, N>
 where
     T: Real,
     S: Scalar<Real = T> + 'static,

@@ -26,10 +26,10 @@ use core::fmt;
 use core::ops::{Add, AddAssign, Div, DivAssign, Mul, MulAssign, Neg, Sub, SubAssign};
 use num_traits::{One, Zero};
 
-/// From how many coordinates [`EulerLagrange`](crate::EulerLagrange) differentiates `T` and
-/// `V` over a tape rather than a [`Jet`](crate::jet::Jet) and a dual number. A jet holds
-/// `N^2 + 3 N + 2` numbers and every operation of `T` makes one; a tape costs a few
-/// nanoseconds a node each way whatever `N` is. Measured on the chain (the automatic-cost
+/// From how many coordinates [`EulerLagrange`](crate::EulerLagrange) differentiates `T` over
+/// a tape rather than a [`Jet`](crate::jet::Jet). A jet holds `N^2 + 3 N + 2` numbers and
+/// every operation of `T` makes one; a tape costs about 20 ns a node over all its passes
+/// whatever `N` is. Measured on the chain (the automatic-cost
 /// bench's `NLinkPendulum`): the jet is faster up to ten links (3.4 against 4.2 us), the tape
 /// from twelve (5.3 against 6.0 us; at twenty, 10.7 against 81 us).
 pub(crate) const FROM: usize = 11;

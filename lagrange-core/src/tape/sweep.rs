@@ -328,15 +328,3 @@ fn curved_terms<S: Scalar, const N: usize>(
         }
     }
 }
-
-/// The gradient of the value recorded in `nodes` (a multiple `out.1` of the node `out.0`) in
-/// the `N` inputs from the node `first`: one reverse pass.
-pub(crate) fn gradient<S: Scalar + 'static, const N: usize, const CAP: usize>(
-    nodes: &[Node<S>],
-    out: (u16, S),
-    first: u16,
-) -> SVector<S, N> {
-    let (adj, _) = reverse::<S, CAP>(nodes, out);
-    let first = usize::from(first);
-    SVector::from_fn(|i, _| adj.get(first + i).copied().unwrap_or_else(S::zero))
-}

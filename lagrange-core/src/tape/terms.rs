@@ -1,10 +1,10 @@
-//! A Lagrangian's kinetic energy and potential recorded on tapes and swept: what
+//! A Lagrangian's kinetic energy recorded on a tape and swept: what
 //! [`EulerLagrange`](crate::EulerLagrange) uses from [`FROM`](super::FROM) coordinates on.
 //!
-//! Each tries two tapes: one of 384 nodes and 1,024 numbers of gradients, which holds a chain
+//! It tries two tapes: one of 384 nodes and 1,024 numbers of gradients, which holds a chain
 //! of 20 links (10 nodes a link in `T` and 2 an input; its gradients about 500 numbers; a test
-//! below checks), then one of 1,024 nodes and 8,192 numbers; it gives up (`None`, the caller falls back to the jet) where
-//! `T` or `V` needs more. A `T` that needs the larger tape is recorded twice per call. Each
+//! below checks), then one of 1,024 nodes and 8,192 numbers; it gives up (`None`, the caller
+//! falls back to the jet) where `T` needs more. A `T` that needs the larger tape is recorded twice per call. Each
 //! size is its own function kept out of line, so that the stack of the larger tape is taken
 //! only while it is used.
 
@@ -29,20 +29,6 @@ where
 {
     kinetic_on::<T, S, L, N, 384, 1024>(l, t, q, qd)
         .or_else(|| kinetic_on::<T, S, L, N, 1024, 8192>(l, t, q, qd))
-}
-
-/// `dV/dq` from `V` at `(t, q)`; `None` where `V` does not fit the largest tape.
-pub(crate) fn potential_gradient<T, S, L, const N: usize>(
-    l: &L,
-    t: S,
-    q: &SVector<S, N>,
-) -> Option<SVector<S, N>>
-where
-    T: Real,
-    S: Scalar<Real = T> + 'static,
-    L: Lagrangian<T, N>,
-{
-    potential_on::<T, S, L, N, 384>(l, t, q).or_else(|| potential_on::<T, S, L, N, 1024>(l, t, q))
 }
 
 /// [`kinetic`] on a tape of `CAP` nodes with `POOL` numbers for the sweep's gradients.
@@ -86,47 +72,19 @@ where
     sweep::second_order::<S, N, CAP, POOL>(&nodes, out, &inputs)
 }
 
-/// [`potential_gradient`] on a tape of `CAP` nodes.
-#[inline(never)]
-fn potential_on<T, S, L, const N: usize, const CAP: usize>(
-    l: &L,
-    t: S,
-    q: &SVector<S, N>,
-) -> Option<SVector<S, N>>
-where
-    T: Real,
-    S: Scalar<Real = T> + 'static,
-    L: Lagrangian<T, N>,
-{
-    let mut storage = heapless::Vec::<Node<S>, CAP>::new();
-    let tape = Tape::new(&mut storage);
-    let (out, first) = {
-        let tq: [Taped<'_, '_, S, CAP>; N] = core::array::from_fn(|k| tape.input(q[k]));
-        let first = tq.first().map_or(NONE, |x| x.node().0);
-        let v = l.potential(
-            Taped::constant(t),
-            &SVector::from_array_storage(ArrayStorage([tq])),
-        );
-        (v.node(), first)
-    };
-    let nodes = tape.nodes()?;
-    Some(sweep::gradient::<S, N, CAP>(&nodes, out, first))
-}
-
-/// The tape against the jet and the dual number, which differentiate the same `T` and `V`
-/// by forward mode: every operation of [`Scalar`] on a tape, its partials and its second
-/// partials.
+/// The tape against the jet, which differentiates the same `T` by forward mode: every
+/// operation of [`Scalar`] on a tape, its partials and its second partials.
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::lagrangian::{kinetic_jet, potential_dual};
+    use crate::lagrangian::kinetic_jet;
     use crate::Dual;
 
     /// Coordinates: as many as a mechanism that takes the tape has.
     const N: usize = 12;
 
-    /// A kinetic energy and a potential that use every operation of [`Scalar`], with
-    /// constants on either side, and time where `TIMED`.
+    /// A kinetic energy that uses every operation of [`Scalar`], with constants on either
+    /// side, and time where `TIMED` (and a potential, which the tape does not take).
     struct Everything<const TIMED: bool>;
 
     impl<const TIMED: bool> Lagrangian<f64, N> for Everything<TIMED> {
@@ -203,23 +161,19 @@ mod tests {
         (a - b).amax() / b.amax().max(1.0)
     }
 
-    /// Both agree to rounding: measured worst 3.0e-16 (M), 8.0e-16 (f) and 2.5e-16 (dV/dq)
-    /// over 200 states; bound 1e-13, far under what a wrong partial of any one operation
-    /// makes (each of those planted moved M, f or dV/dq by more than 1e-4).
+    /// Both agree to rounding: measured worst 3.0e-16 (M) and 8.0e-16 (f) over 200 states;
+    /// bound 1e-13, far under what a wrong partial of any one operation makes (each of those
+    /// planted moved M or f by more than 1e-4).
     fn agree<const TIMED: bool>() -> Result<(), &'static str> {
         let l = Everything::<TIMED>;
-        let mut worst = [0.0f64; 3];
+        let mut worst = [0.0f64; 2];
         for seed in 0..200 {
             let (t, q, qd) = state(seed);
             let (mt, ft) = kinetic_on::<f64, f64, _, N, 1024, 8192>(&l, t, &q, &qd)
                 .ok_or("T does not fit the tape")?;
             let (mj, fj) = kinetic_jet(&l, t, &q, &qd);
-            let gt =
-                potential_on::<f64, f64, _, N, 1024>(&l, t, &q).ok_or("V does not fit the tape")?;
-            let gd = potential_dual(&l, t, &q);
             worst[0] = worst[0].max(relative(&mt, &mj));
             worst[1] = worst[1].max(relative(&ft, &fj));
-            worst[2] = worst[2].max(relative(&gt, &gd));
         }
         assert!(worst.iter().all(|&e| e < 1e-13), "worst {worst:?}");
         Ok(())
@@ -239,10 +193,6 @@ mod tests {
             let large = kinetic_on::<f64, f64, _, N, 1024, 8192>(&l, t, &q, &qd);
             let tried = kinetic(&l, t, &q, &qd);
             assert_eq!(tried, large);
-            assert_eq!(
-                potential_gradient(&l, t, &q),
-                potential_on::<f64, f64, _, N, 1024>(&l, t, &q)
-            );
             tried.ok_or("T does not fit")?;
         }
         Ok(())
@@ -288,7 +238,6 @@ mod tests {
         );
         let c = Chain::<20>;
         assert!(kinetic_on::<f64, f64, _, 20, 384, 1024>(&c, 0.0, &q, &qd).is_some());
-        assert!(potential_on::<f64, f64, _, 20, 384>(&c, 0.0, &q).is_some());
         let (q, qd) = (
             SVector::from_fn(|i, _| 0.1 * i as f64),
             SVector::from_element(0.5),
@@ -355,7 +304,6 @@ mod tests {
         let (t, q, qd) = state(1);
         assert!(kinetic_on::<f64, f64, _, N, 64, 8192>(&l, t, &q, &qd).is_none());
         assert!(kinetic_on::<f64, f64, _, N, 1024, 16>(&l, t, &q, &qd).is_none());
-        assert!(potential_on::<f64, f64, _, N, 16>(&l, t, &q).is_none());
         assert!(kinetic(&l, t, &q, &qd).is_some());
     }
 }
