@@ -29,9 +29,9 @@ use num_traits::{One, Zero};
 /// From how many coordinates [`EulerLagrange`](crate::EulerLagrange) differentiates `T` over
 /// a tape rather than a [`Jet`](crate::jet::Jet). A jet holds `N^2 + 3 N + 2` numbers and
 /// every operation of `T` makes one; a tape costs about 20 ns a node over all its passes
-/// whatever `N` is. Measured on the chain (the automatic-cost
-/// bench's `NLinkPendulum`): the jet is faster up to ten links (3.4 against 4.2 us), the tape
-/// from twelve (5.3 against 6.0 us; at twenty, 10.7 against 81 us).
+/// whatever `N` is. Measured on the chain (the automatic-cost bench's `NLinkPendulum`): the
+/// jet is faster up to ten links (3.4 against 4.2 us), the tape from twelve (5.3 against
+/// 6.0 us; at twenty, 10.7 against 81 us).
 pub(crate) const FROM: usize = 11;
 
 /// The index of no node: a constant's, or a parent that is a constant.
@@ -173,9 +173,10 @@ impl<S: Scalar, const CAP: usize> Taped<'_, '_, S, CAP> {
         }
     }
 
-    /// `f(self)` with value `v`, `f' = d`, `f'' = dd` (`curved` false where `f` is linear).
+    /// `f(self)` with value `v`, `f' = d`, `f'' = dd` (a function of one argument that is not
+    /// linear: the linear ones are [`Taped::affine`], which makes no node).
     #[inline]
-    fn unary(self, v: S, d: S, dd: S, curved: bool) -> Self {
+    fn unary(self, v: S, d: S, dd: S) -> Self {
         let Some(tape) = self.tape else {
             return Self::constant(v);
         };
@@ -189,7 +190,7 @@ impl<S: Scalar, const CAP: usize> Taped<'_, '_, S, CAP> {
             haa: dd * s * s,
             hab: z,
             hbb: z,
-            curved,
+            curved: true,
         });
         Self {
             v,
@@ -395,35 +396,35 @@ impl<S: Scalar<Real = R>, R: Real, const CAP: usize> Scalar for Taped<'_, '_, S,
     }
     fn sin(self) -> Self {
         let (s, c) = self.v.sin_cos();
-        self.unary(s, c, -s, true)
+        self.unary(s, c, -s)
     }
     fn cos(self) -> Self {
         let (s, c) = self.v.sin_cos();
-        self.unary(c, -s, -c, true)
+        self.unary(c, -s, -c)
     }
     fn sin_cos(self) -> (Self, Self) {
         let (s, c) = self.v.sin_cos();
-        (self.unary(s, c, -s, true), self.unary(c, -s, -c, true))
+        (self.unary(s, c, -s), self.unary(c, -s, -c))
     }
     fn tan(self) -> Self {
         let t = self.v.tan();
         let d = S::one() + t * t;
-        self.unary(t, d, (t + t) * d, true)
+        self.unary(t, d, (t + t) * d)
     }
     fn sqrt(self) -> Self {
         let r = self.v.sqrt();
         let d = (r + r).recip();
         // d/dx (1 / 2r) = -1 / (4 r^3) = -2 d^3.
         let d3 = d * d * d;
-        self.unary(r, d, -(d3 + d3), true)
+        self.unary(r, d, -(d3 + d3))
     }
     fn exp(self) -> Self {
         let e = self.v.exp();
-        self.unary(e, e, e, true)
+        self.unary(e, e, e)
     }
     fn ln(self) -> Self {
         let inv = self.v.recip();
-        self.unary(self.v.ln(), inv, -(inv * inv), true)
+        self.unary(self.v.ln(), inv, -(inv * inv))
     }
     fn powi(self, n: i32) -> Self {
         powi_by_squaring(self, n)
@@ -448,6 +449,6 @@ impl<S: Scalar<Real = R>, R: Real, const CAP: usize> Scalar for Taped<'_, '_, S,
     fn recip(self) -> Self {
         let r = self.v.recip();
         let r2 = r * r;
-        self.unary(r, -r2, (r2 + r2) * r, true)
+        self.unary(r, -r2, (r2 + r2) * r)
     }
 }
