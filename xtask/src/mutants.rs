@@ -92,7 +92,7 @@ impl Area {
 }
 
 /// The areas, in the order they run.
-const AREAS: [Area; 13] = [
+const AREAS: [Area; 14] = [
     Area {
         name: "explicit",
         package: "lagrange-integrators",
@@ -368,6 +368,22 @@ const AREAS: [Area; 13] = [
             "automatic_exactness",
         ],
         unit_tests: true,
+        optimised: false,
+    },
+    Area {
+        // The automatic path's tape (reverse mode for long mechanisms): tested where it lives,
+        // against the jet, by `lagrange-core`'s unit tests; a build of one crate per mutant.
+        name: "tape",
+        package: "lagrange-core",
+        test_package: "lagrange-core",
+        files: &[
+            "lagrange-core/src/tape/mod.rs",
+            "lagrange-core/src/tape/sweep.rs",
+            "lagrange-core/src/tape/terms.rs",
+        ],
+        only: None,
+        tests: &["--lib"],
+        unit_tests: false,
         optimised: false,
     },
     Area {
