@@ -26,6 +26,7 @@
 //! on it.
 
 use crate::scalar::{powi_by_squaring, Real, Scalar};
+use crate::trig_memo::TrigMemo;
 use core::marker::PhantomData;
 use core::ops::{Add, AddAssign, Div, DivAssign, Mul, MulAssign, Neg, Sub, SubAssign};
 use num_traits::{One, Zero};
@@ -46,7 +47,7 @@ const DP: u8 = 16;
 /// velocity gradient (see the module's docs). A part whose flag is clear is exactly zero, in
 /// its storage too.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct Jet<S: Scalar, const N: usize, R = <S as Scalar>::Real> {
+pub(crate) struct Jet<'m, S: Scalar, const N: usize, R = <S as Scalar>::Real> {
     /// The value.
     pub(crate) v: S,
     /// `dx/de` along the seeded direction.
@@ -61,7 +62,20 @@ pub(crate) struct Jet<S: Scalar, const N: usize, R = <S as Scalar>::Real> {
     pub(crate) dp: [S; N],
     /// `d2x/dq'_i dq'_j` for `i <= j` (the rest stays zero).
     pub(crate) h: [[S; N]; N],
+    /// Where its sines and cosines are remembered, if anywhere.
+    memo: Memo<'m, S>,
     real: PhantomData<R>,
+}
+
+/// The [`TrigMemo`] a jet's sines and cosines go through, if it has one (passed on to every
+/// value computed from it). Not part of the value: any two compare equal.
+#[derive(Debug, Clone, Copy)]
+struct Memo<'m, S: Scalar>(Option<&'m TrigMemo<S>>);
+
+impl<S: Scalar> PartialEq for Memo<'_, S> {
+    fn eq(&self, _: &Self) -> bool {
+        true
+    }
 }
 
 /// `x *= c`.
@@ -181,7 +195,7 @@ fn add_square<S: Scalar, const N: usize>(h: &mut [[S; N]; N], c: S, a: &[S; N]) 
     }
 }
 
-impl<S: Scalar<Real = R>, const N: usize, R: Real> Jet<S, N, R> {
+impl<'m, S: Scalar<Real = R>, const N: usize, R: Real> Jet<'m, S, N, R> {
     /// A constant: every derivative zero.
     #[inline(always)]
     pub(crate) fn constant(v: S) -> Self {
@@ -193,6 +207,7 @@ impl<S: Scalar<Real = R>, const N: usize, R: Real> Jet<S, N, R> {
             gp: [S::zero(); N],
             dp: [S::zero(); N],
             h: [[S::zero(); N]; N],
+            memo: Memo(None),
             real: PhantomData,
         }
     }
@@ -220,6 +235,31 @@ impl<S: Scalar<Real = R>, const N: usize, R: Real> Jet<S, N, R> {
         x.d = S::one();
         x.parts = D;
         x
+    }
+
+    /// `self`, its sines and cosines (and those of every value computed from it) remembered
+    /// in `memo` where given: only for plain numbers (see [`TrigMemo`]).
+    #[inline(always)]
+    pub(crate) fn remembering(mut self, memo: Option<&'m TrigMemo<S>>) -> Self {
+        self.memo = Memo(memo);
+        self
+    }
+
+    /// `(sin v, cos v)` of the value, through the memo where there is one.
+    #[inline(always)]
+    fn sin_cos_value(&self) -> (S, S) {
+        match self.memo.0 {
+            Some(memo) => memo.sin_cos(self.v),
+            None => self.v.sin_cos(),
+        }
+    }
+
+    /// Takes `o`'s memo where `self` has none (a constant combined with a variable).
+    #[inline(always)]
+    fn share_memo(&mut self, o: &Self) {
+        if self.memo.0.is_none() {
+            self.memo = o.memo;
+        }
     }
 
     /// Makes `self`, a constant, coordinate `k` at `q` moving at `rate`.
@@ -275,6 +315,7 @@ impl<S: Scalar<Real = R>, const N: usize, R: Real> Jet<S, N, R> {
     #[inline(always)]
     fn set_scaled(&mut self, c: S, o: &Self) {
         let p = o.parts;
+        self.share_memo(o);
         self.v = c * o.v;
         self.d = c * o.d;
         set_scaled(&mut self.gq, c, &o.gq);
@@ -331,6 +372,7 @@ impl<S: Scalar<Real = R>, const N: usize, R: Real> Jet<S, N, R> {
         add_square(&mut self.h, fbb, &b.gp);
         add_outer(&mut self.h, &a.gp, &b.gp.map(|x| x * fab));
         self.v = f0;
+        self.share_memo(b);
         self.parts = a.parts | b.parts;
         if self.parts & GP != 0 {
             self.parts |= H | DP;
@@ -342,6 +384,7 @@ impl<S: Scalar<Real = R>, const N: usize, R: Real> Jet<S, N, R> {
     #[inline(always)]
     fn add_jet<const PLUS: bool>(&mut self, o: &Self) {
         let p = o.parts;
+        self.share_memo(o);
         if PLUS {
             self.v += o.v;
             self.d += o.d;
@@ -386,6 +429,7 @@ impl<S: Scalar<Real = R>, const N: usize, R: Real> Jet<S, N, R> {
     #[inline(always)]
     fn mul_general(&mut self, o: &Self) {
         let (a, b) = (self.parts, o.parts);
+        self.share_memo(o);
         let (av, bv) = (self.v, o.v);
         // Second-order parts first: they read the first-order parts before those change.
         if a & H != 0 {
@@ -419,28 +463,28 @@ impl<S: Scalar<Real = R>, const N: usize, R: Real> Jet<S, N, R> {
     }
 }
 
-impl<S: Scalar<Real = R>, const N: usize, R: Real> AddAssign for Jet<S, N, R> {
+impl<'m, S: Scalar<Real = R>, const N: usize, R: Real> AddAssign for Jet<'m, S, N, R> {
     #[inline(always)]
     fn add_assign(&mut self, o: Self) {
         self.add_jet::<true>(&o);
     }
 }
 
-impl<S: Scalar<Real = R>, const N: usize, R: Real> SubAssign for Jet<S, N, R> {
+impl<'m, S: Scalar<Real = R>, const N: usize, R: Real> SubAssign for Jet<'m, S, N, R> {
     #[inline(always)]
     fn sub_assign(&mut self, o: Self) {
         self.add_jet::<false>(&o);
     }
 }
 
-impl<S: Scalar<Real = R>, const N: usize, R: Real> MulAssign for Jet<S, N, R> {
+impl<'m, S: Scalar<Real = R>, const N: usize, R: Real> MulAssign for Jet<'m, S, N, R> {
     #[inline(always)]
     fn mul_assign(&mut self, o: Self) {
         self.mul_jet(&o);
     }
 }
 
-impl<S: Scalar<Real = R>, const N: usize, R: Real> DivAssign for Jet<S, N, R> {
+impl<'m, S: Scalar<Real = R>, const N: usize, R: Real> DivAssign for Jet<'m, S, N, R> {
     #[inline(always)]
     fn div_assign(&mut self, o: Self) {
         if o.parts == 0 {
@@ -456,7 +500,7 @@ impl<S: Scalar<Real = R>, const N: usize, R: Real> DivAssign for Jet<S, N, R> {
 /// `a op b` from `a op= b`, for jets and for plain numbers on the right.
 macro_rules! by_value {
     ($op:ident, $f:ident, $assign:ident, $fa:ident) => {
-        impl<S: Scalar<Real = R>, const N: usize, R: Real> $op<R> for Jet<S, N, R> {
+        impl<'m, S: Scalar<Real = R>, const N: usize, R: Real> $op<R> for Jet<'m, S, N, R> {
             type Output = Self;
             #[inline(always)]
             fn $f(mut self, o: R) -> Self {
@@ -467,7 +511,7 @@ macro_rules! by_value {
     };
     ($op:ident, $f:ident, $assign:ident, $fa:ident, jets) => {
         by_value!($op, $f, $assign, $fa);
-        impl<S: Scalar<Real = R>, const N: usize, R: Real> $op for Jet<S, N, R> {
+        impl<'m, S: Scalar<Real = R>, const N: usize, R: Real> $op for Jet<'m, S, N, R> {
             type Output = Self;
             #[inline(always)]
             fn $f(mut self, o: Self) -> Self {
@@ -485,7 +529,7 @@ by_value!(Mul, mul, MulAssign, mul_assign);
 
 /// `c + x` with `c` a constant (a parameter, a literal) returns `x`'s own storage with `c`
 /// added to its value: a jet of a long chain is kilobytes, not worth writing again.
-impl<S: Scalar<Real = R>, const N: usize, R: Real> Add for Jet<S, N, R> {
+impl<'m, S: Scalar<Real = R>, const N: usize, R: Real> Add for Jet<'m, S, N, R> {
     type Output = Self;
     #[inline(always)]
     fn add(mut self, mut o: Self) -> Self {
@@ -501,7 +545,7 @@ impl<S: Scalar<Real = R>, const N: usize, R: Real> Add for Jet<S, N, R> {
 
 /// `c * x` with `c` a constant (the usual order in a kinetic energy: `S::from_real(m) * ...`)
 /// scales `x`'s own storage in place, as `x * c` does.
-impl<S: Scalar<Real = R>, const N: usize, R: Real> Mul for Jet<S, N, R> {
+impl<'m, S: Scalar<Real = R>, const N: usize, R: Real> Mul for Jet<'m, S, N, R> {
     type Output = Self;
     #[inline(always)]
     fn mul(mut self, mut o: Self) -> Self {
@@ -515,7 +559,7 @@ impl<S: Scalar<Real = R>, const N: usize, R: Real> Mul for Jet<S, N, R> {
     }
 }
 
-impl<S: Scalar<Real = R>, const N: usize, R: Real> Neg for Jet<S, N, R> {
+impl<'m, S: Scalar<Real = R>, const N: usize, R: Real> Neg for Jet<'m, S, N, R> {
     type Output = Self;
     #[inline(always)]
     fn neg(mut self) -> Self {
@@ -524,35 +568,35 @@ impl<S: Scalar<Real = R>, const N: usize, R: Real> Neg for Jet<S, N, R> {
     }
 }
 
-impl<S: Scalar<Real = R>, const N: usize, R: Real> AddAssign<R> for Jet<S, N, R> {
+impl<'m, S: Scalar<Real = R>, const N: usize, R: Real> AddAssign<R> for Jet<'m, S, N, R> {
     #[inline(always)]
     fn add_assign(&mut self, x: R) {
         self.v += x;
     }
 }
 
-impl<S: Scalar<Real = R>, const N: usize, R: Real> SubAssign<R> for Jet<S, N, R> {
+impl<'m, S: Scalar<Real = R>, const N: usize, R: Real> SubAssign<R> for Jet<'m, S, N, R> {
     #[inline(always)]
     fn sub_assign(&mut self, x: R) {
         self.v -= x;
     }
 }
 
-impl<S: Scalar<Real = R>, const N: usize, R: Real> MulAssign<R> for Jet<S, N, R> {
+impl<'m, S: Scalar<Real = R>, const N: usize, R: Real> MulAssign<R> for Jet<'m, S, N, R> {
     #[inline(always)]
     fn mul_assign(&mut self, x: R) {
         self.scale_by(S::from_real(x));
     }
 }
 
-impl<S: Scalar<Real = R>, const N: usize, R: Real> DivAssign<R> for Jet<S, N, R> {
+impl<'m, S: Scalar<Real = R>, const N: usize, R: Real> DivAssign<R> for Jet<'m, S, N, R> {
     #[inline(always)]
     fn div_assign(&mut self, x: R) {
         *self /= Self::constant(S::from_real(x));
     }
 }
 
-impl<S: Scalar<Real = R>, const N: usize, R: Real> Zero for Jet<S, N, R> {
+impl<'m, S: Scalar<Real = R>, const N: usize, R: Real> Zero for Jet<'m, S, N, R> {
     fn zero() -> Self {
         Self::constant(S::zero())
     }
@@ -567,13 +611,13 @@ impl<S: Scalar<Real = R>, const N: usize, R: Real> Zero for Jet<S, N, R> {
     }
 }
 
-impl<S: Scalar<Real = R>, const N: usize, R: Real> One for Jet<S, N, R> {
+impl<'m, S: Scalar<Real = R>, const N: usize, R: Real> One for Jet<'m, S, N, R> {
     fn one() -> Self {
         Self::constant(S::one())
     }
 }
 
-impl<S: Scalar<Real = R>, const N: usize, R: Real> Scalar for Jet<S, N, R> {
+impl<'m, S: Scalar<Real = R>, const N: usize, R: Real> Scalar for Jet<'m, S, N, R> {
     type Real = R;
 
     fn from_real(x: R) -> Self {
@@ -587,20 +631,20 @@ impl<S: Scalar<Real = R>, const N: usize, R: Real> Scalar for Jet<S, N, R> {
     }
     #[inline(always)]
     fn sin(mut self) -> Self {
-        let (s, c) = self.v.sin_cos();
+        let (s, c) = self.sin_cos_value();
         self.chain(s, c, -s);
         self
     }
     #[inline(always)]
     fn cos(mut self) -> Self {
-        let (s, c) = self.v.sin_cos();
+        let (s, c) = self.sin_cos_value();
         self.chain(c, -s, -c);
         self
     }
     #[inline(always)]
     fn sin_cos(mut self) -> (Self, Self) {
         // One copy: the cosine takes `self`'s own storage.
-        let (s, c) = self.v.sin_cos();
+        let (s, c) = self.sin_cos_value();
         let mut sin = self;
         sin.chain(s, c, -s);
         self.chain(c, -s, -c);
@@ -666,7 +710,7 @@ mod tests {
     use super::*;
     use crate::Dual;
 
-    type J = Jet<f64, 2>;
+    type J = Jet<'static, f64, 2>;
     type D2 = Dual<Dual<f64, 4>, 4>;
 
     /// Variables of the jet: `q0, q1` moving at `r0, r1`, then `p0, p1`, time moving at 1.
@@ -737,8 +781,9 @@ mod tests {
         }
         let x: [f64; 2 * M] = core::array::from_fn(|i| 0.3 * (i as f64 + 1.0).sin());
         let rate: [f64; M] = core::array::from_fn(|i| x[M + i]);
-        let jq: [Jet<f64, M>; M] = core::array::from_fn(|k| Jet::coordinate(x[k], k, rate[k]));
-        let jp: [Jet<f64, M>; M] = core::array::from_fn(|k| Jet::velocity(x[M + k], k));
+        let jq: [Jet<'static, f64, M>; M] =
+            core::array::from_fn(|k| Jet::coordinate(x[k], k, rate[k]));
+        let jp: [Jet<'static, f64, M>; M] = core::array::from_fn(|k| Jet::velocity(x[M + k], k));
         let j = chain(&jq, &jp);
         let v = |k: usize| Big::variable(Dual::variable(x[k], k), k);
         let r = chain(

@@ -62,6 +62,7 @@ mod scalar;
 mod scalar_trig;
 mod state;
 mod tape;
+mod trig_memo;
 pub mod validate;
 
 pub use cholesky::{solve_spd, Cholesky};
