@@ -15,11 +15,12 @@ const FAC_MAX: f32 = 10.0;
 const BETA: f32 = 0.04;
 /// `log2` of the floor of the previous error kept by the controller (`1e-4`).
 const LOG2_ERROR_FLOOR: f32 = -13.287_712;
-/// Errors at or below this grow the step by [`FAC_MAX`] (for any exponent here,
-/// `0.9 err^-alpha` is above 10 long before; it also keeps subnormals out of [`log2`]).
-const ERROR_NEGLIGIBLE: f32 = 1e-30;
+/// Squared errors at or below this (errors of `1e-15`) grow the step by [`FAC_MAX`] (for any
+/// order here, up to 8, `0.9 err^-alpha` is above 10 long before; it also keeps subnormals out
+/// of [`log2`]).
+const ERROR_SQ_NEGLIGIBLE: f32 = 1e-30;
 
-/// The PI controller:
+/// The PI controller, given the square of the error estimate (see [`PiController::accept`]):
 ///
 /// ```text
 /// accepted (err <= 1):  factor = clamp(0.9 err^-(1/k - 0.75 beta) err_prev^beta, 0.2, 10),
@@ -63,10 +64,12 @@ impl PiController {
         self.rejected_last
     }
 
-    /// The factor for the next step after one accepted with error `err` (`<= 1`).
-    pub(super) fn accept(&mut self, err: f32) -> f32 {
-        let (factor, log2_err) = if err > ERROR_NEGLIGIBLE {
-            let l = log2(err);
+    /// The factor for the next step after one accepted with error `err` (`<= 1`), given
+    /// `err_sq = err^2`: the adaptive pairs form the square (a sum of squares), and its
+    /// logarithm halved is the error's, with no square root between.
+    pub(super) fn accept(&mut self, err_sq: f32) -> f32 {
+        let (factor, log2_err) = if err_sq > ERROR_SQ_NEGLIGIBLE {
+            let l = 0.5 * log2(err_sq);
             let growth = SAFETY * exp2(BETA * self.log2_previous - self.alpha * l);
             (growth.clamp(FAC_MIN, FAC_MAX), l)
         } else {
@@ -82,11 +85,13 @@ impl PiController {
         factor
     }
 
-    /// The factor by which to shrink a step rejected with error `err` (`> 1`, or NaN).
-    pub(super) fn reject(&mut self, err: f32) -> f32 {
+    /// The factor by which to shrink a step rejected with error `err` (`> 1`, or NaN), given
+    /// `err_sq = err^2` (an infinity where the square overflows: the factor is then the least
+    /// anyway).
+    pub(super) fn reject(&mut self, err_sq: f32) -> f32 {
         self.rejected_last = true;
-        if err.is_finite() {
-            (SAFETY * exp2(-self.inv_k * log2(err))).max(FAC_MIN)
+        if err_sq.is_finite() {
+            (SAFETY * exp2(-0.5 * self.inv_k * log2(err_sq))).max(FAC_MIN)
         } else {
             FAC_MIN
         }
@@ -122,10 +127,12 @@ fn exp2(y: f32) -> f32 {
     let n = (if y >= 0.0 { y + 0.5 } else { y - 0.5 }) as i32;
     #[allow(clippy::cast_precision_loss)] // |n| <= 127
     let x = (y - n as f32) * core::f32::consts::LN_2;
-    let p = 1.0
-        + x * (1.0
-            + x * (1.0 / 2.0
-                + x * (1.0 / 6.0 + x * (1.0 / 24.0 + x * (1.0 / 120.0 + x * (1.0 / 720.0))))));
+    // By Estrin's scheme, pairs of terms in x^2 and x^4 (three multiplications deep, where
+    // Horner's rule is six: the controller is on the critical path from one step to the next).
+    let x2 = x * x;
+    let p = (1.0 + x)
+        + x2 * (1.0 / 2.0 + x * (1.0 / 6.0))
+        + x2 * x2 * ((1.0 / 24.0 + x * (1.0 / 120.0)) + x2 * (1.0 / 720.0));
     #[allow(clippy::cast_sign_loss)] // n + 127 in 1..=254
     let scale = f32::from_bits(((n + 127) as u32) << 23);
     p * scale
@@ -171,7 +178,7 @@ mod tests {
         let alpha = 1.0 / k - 0.75 * beta;
         let mut previous = 1e-4f64;
         for err in [0.5f64, 1e-3, 0.9, 1e-6, 0.2] {
-            let f = c.accept(err as f32);
+            let f = c.accept((err * err) as f32);
             let exact =
                 (0.9 * Real::powf(err, -alpha) * Real::powf(previous, beta)).clamp(0.2, 10.0);
             assert!(
@@ -180,12 +187,13 @@ mod tests {
             );
             previous = err.max(1e-4);
         }
-        let shrink = c.reject(3.0);
+        let shrink = c.reject(9.0);
         let exact = (0.9 * Real::powf(3.0f64, -1.0 / k)).max(0.2);
         assert!((f64::from(shrink) - exact).abs() < 1e-5);
         assert!(c.rejected_last());
-        assert!(c.accept(0.01) <= 1.0, "no growth right after a rejection");
+        assert!(c.accept(1e-4) <= 1.0, "no growth right after a rejection");
         assert_eq!(c.reject(f32::NAN), FAC_MIN);
+        assert_eq!(c.reject(f32::INFINITY), FAC_MIN, "a square that overflowed");
         assert_eq!(c.accept(0.0), 1.0, "capped at 1 after the rejection");
         assert_eq!(c.accept(0.0), FAC_MAX);
         c.reset();

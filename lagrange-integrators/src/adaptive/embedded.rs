@@ -410,10 +410,12 @@ where
         })
     }
 
-    /// The error norm of a step of `h` from `y0 = self.state` to `y1`, from the stages; NaN
-    /// when `y1` is not finite.
+    /// The square of the error norm of a step of `h` from `y0 = self.state` to `y1`, from the
+    /// stages; NaN when `y1` is not finite. Squared: the test against 1 and the controller
+    /// (which takes a logarithm) need no square root, whose latency sat on the chain from one
+    /// step's last stage to the next step's first.
     #[inline(always)]
-    fn error_norm(&self, h: T, y1: &State<T, N>) -> T {
+    fn error_norm_sq(&self, h: T, y1: &State<T, N>) -> T {
         let (rtol, atol) = (self.settings.rtol(), self.settings.atol());
         let y0 = &self.state;
         // The weights 1 / (atol + rtol max(|y0|, |y1|)), divided once for both estimates.
@@ -431,14 +433,15 @@ where
         let n = T::from_f64(2.0 * N as f64);
         let err5 = self.weighted_sum_sq(&P::E[..=P::FSAL], &wq, &wv);
         match P::E3 {
-            None => h * (err5 / n).sqrt(),
+            None => h * h * (err5 / n),
             Some(e3) => {
                 let err3 = self.weighted_sum_sq(&e3[..=P::FSAL], &wq, &wv);
                 let mut deno = err5 + real::<T>(0.01) * err3;
                 if deno <= T::zero() {
                     deno = T::one();
                 }
-                h * err5 / (deno * n).sqrt()
+                let e = h * err5;
+                e * e / (deno * n)
             }
         }
     }
@@ -547,11 +550,12 @@ where
             }
             // A blown-up stage, or a new state that is not finite, makes the error NaN:
             // rejected.
-            let err = self.error_norm(h, &y1);
-            if err <= T::one() {
+            let err_sq = self.error_norm_sq(h, &y1);
+            if err_sq <= T::one() {
                 let rejected_last = self.controller.rejected_last();
                 // Grows at most tenfold, and never past the largest finite step.
-                let proposal = (h * T::from_f32(self.controller.accept(err.to_f32()))).min(T::MAX);
+                let factor = self.controller.accept(err_sq.to_f32());
+                let proposal = (h * T::from_f32(factor)).min(T::MAX);
                 // A last step shortened to land on t_end says nothing against the proposal
                 // it was shortened from.
                 self.h = if last && !rejected_last {
@@ -569,7 +573,7 @@ where
                 self.work.steps += 1;
                 return Ok(());
             }
-            h *= T::from_f32(self.controller.reject(err.to_f32()));
+            h *= T::from_f32(self.controller.reject(err_sq.to_f32()));
             stretch = T::one();
             self.stats.rejected += 1;
             self.work.rejected += 1;
