@@ -121,20 +121,26 @@ fn log2(x: f32) -> f32 {
 
 /// `2^y`, to about 2e-7 relative, for `y` in `[-126, 127]` (clamped there): `y = n + f` with
 /// `|f| <= 1/2`, `2^f = e^(f ln 2)` by its Taylor series to the sixth power.
+///
+/// `n` is found by adding and taking away `1.5 2^23`, which rounds `y` to an integer in the
+/// float unit, and read from the sum's low bits: no conversion to and from an integer register
+/// on the chain from one step to the next.
 fn exp2(y: f32) -> f32 {
+    /// `1.5 2^23`: added to `|y| < 2^22`, the sum's ulp is 1, so the sum is `y` rounded.
+    const ROUND: f32 = 12_582_912.0;
     let y = y.clamp(-126.0, 127.0);
-    #[allow(clippy::cast_possible_truncation)] // |y| <= 127
-    let n = (if y >= 0.0 { y + 0.5 } else { y - 0.5 }) as i32;
-    #[allow(clippy::cast_precision_loss)] // |n| <= 127
-    let x = (y - n as f32) * core::f32::consts::LN_2;
+    let shifted = y + ROUND;
+    let x = (y - (shifted - ROUND)) * core::f32::consts::LN_2;
     // By Estrin's scheme, pairs of terms in x^2 and x^4 (three multiplications deep, where
-    // Horner's rule is six: the controller is on the critical path from one step to the next).
+    // Horner's rule is six).
     let x2 = x * x;
     let p = (1.0 + x)
         + x2 * (1.0 / 2.0 + x * (1.0 / 6.0))
         + x2 * x2 * ((1.0 / 24.0 + x * (1.0 / 120.0)) + x2 * (1.0 / 720.0));
-    #[allow(clippy::cast_sign_loss)] // n + 127 in 1..=254
-    let scale = f32::from_bits(((n + 127) as u32) << 23);
+    // The sum's bits less ROUND's are n (in -126..=127, two's complement); 2^n has the
+    // exponent field n + 127.
+    let n = shifted.to_bits().wrapping_sub(ROUND.to_bits());
+    let scale = f32::from_bits(n.wrapping_add(127) << 23);
     p * scale
 }
 
@@ -157,10 +163,19 @@ mod tests {
             x *= 1.37;
         }
         let mut y = -125.9f32;
-        while y < 126.9 {
+        let mut check = |y: f32| {
             let exact = (f64::from(y) * core::f64::consts::LN_2).exp();
             worst.1 = worst.1.max(((f64::from(exp2(y)) - exact) / exact).abs());
+        };
+        while y < 126.9 {
+            check(y);
             y += 0.0173;
+        }
+        // The ends of the range, and halves, where the rounding of `y` to `n` ties.
+        for y in [
+            -126.0, 127.0, -125.5, 126.5, -2.5, -1.5, -0.5, 0.0, 0.5, 1.5, 2.5, 3.5,
+        ] {
+            check(y);
         }
         assert!(
             worst.0 < 2.0,
