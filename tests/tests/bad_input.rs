@@ -220,3 +220,67 @@ fn reference_solutions_refuse_bad_arguments() {
     refuses(jacobi_sn_cn(0.5, 1.0), "k");
     refuses(jacobi_sn_cn(f64::INFINITY, 0.5), "u");
 }
+
+/// A law that is not finite at one time only: a unit spring whose acceleration is `poison`
+/// (NaN or an infinity) at `t = at`, and `-q` elsewhere.
+struct Poisoned {
+    at: f64,
+    poison: f64,
+}
+
+impl Lagrangian<f64, 1> for Poisoned {
+    fn kinetic<S: Scalar<Real = f64>>(&self, _t: S, _q: &SVector<S, 1>, qd: &SVector<S, 1>) -> S {
+        S::from_f64(0.5) * qd[0] * qd[0]
+    }
+    fn potential<S: Scalar<Real = f64>>(&self, _t: S, q: &SVector<S, 1>) -> S {
+        S::from_f64(0.5) * q[0] * q[0]
+    }
+}
+
+impl Mechanism<f64, 1> for Poisoned {
+    fn mass_matrix(&self, _s: &State<f64, 1>) -> lagrange_core::nalgebra::Matrix1<f64> {
+        lagrange_core::nalgebra::Matrix1::new(1.0)
+    }
+    fn rhs(&self, s: &State<f64, 1>) -> SVector<f64, 1> {
+        SVector::<f64, 1>::new(if s.t == self.at { self.poison } else { -s.q[0] })
+    }
+    /// The right-hand side as it is (`M = 1`), with no test of its own: a hand-written law.
+    fn law<F: lagrange_core::GeneralizedForce<f64, 1>>(
+        &self,
+        s: &State<f64, 1>,
+        _extra: &F,
+    ) -> Result<SVector<f64, 1>, Error> {
+        Ok(self.rhs(s))
+    }
+}
+
+/// RK4 takes each stage's law unchecked (the new state is checked instead): a stage whose
+/// accelerations are not finite, whichever of the four, still makes the step fail with
+/// `NonFiniteState`, one step or many, never a state with NaN or an infinity in it.
+#[test]
+fn rk4_refuses_a_stage_that_is_not_finite() -> Result<(), Error> {
+    let start = State::new(0.0, [0.3], [0.1]);
+    // Stage times from t = 0 with h = 1: 0 (stage 1), 0.5 (stages 2 and 3), 1 (stage 4).
+    for at in [0.0, 0.5, 1.0] {
+        for poison in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+            let m = Poisoned { at, poison };
+            assert_eq!(
+                Rk4.step(&m, &start, 1.0),
+                Err(Error::NonFiniteState),
+                "{at} {poison}"
+            );
+            let run = Rk4.integrate(&m, &start, 1.0, 3);
+            assert!(
+                run.is_err_and(|f| f.error == Error::NonFiniteState && f.step == 0),
+                "{at} {poison}"
+            );
+        }
+    }
+    // Where no stage meets the poison, the step is the spring's.
+    let m = Poisoned {
+        at: 0.25,
+        poison: f64::NAN,
+    };
+    assert!(Rk4.step(&m, &start, 1.0)?.is_finite());
+    Ok(())
+}
