@@ -164,6 +164,20 @@ pub(super) fn real<T: Real>(x: f64) -> T {
     T::from_f64(x)
 }
 
+/// `a^2 b` (both non-negative, or NaN), squaring without a square root unless `a^2` overflows
+/// (a step near the largest finite time): then `(a sqrt(b))^2`, so that such a step with a
+/// zero estimate is not taken for an infinite or NaN error.
+#[inline(always)]
+fn scaled_square<T: Real>(a: T, b: T) -> T {
+    let a2 = a * a;
+    if a2.is_finite() {
+        a2 * b
+    } else {
+        let e = a * b.sqrt();
+        e * e
+    }
+}
+
 /// Zero for a finite `x`, NaN for an infinite or NaN one: added to a value, it makes that
 /// value NaN exactly where `x` is not finite, without a branch.
 #[inline(always)]
@@ -433,15 +447,14 @@ where
         let n = T::from_f64(2.0 * N as f64);
         let err5 = self.weighted_sum_sq(&P::E[..=P::FSAL], &wq, &wv);
         match P::E3 {
-            None => h * h * (err5 / n),
+            None => scaled_square(h, err5 / n),
             Some(e3) => {
                 let err3 = self.weighted_sum_sq(&e3[..=P::FSAL], &wq, &wv);
                 let mut deno = err5 + real::<T>(0.01) * err3;
                 if deno <= T::zero() {
                     deno = T::one();
                 }
-                let e = h * err5;
-                e * e / (deno * n)
+                scaled_square(h * err5, (deno * n).recip())
             }
         }
     }
