@@ -1,6 +1,7 @@
 //! Automatic Euler-Lagrange: write `T` and `V` once, generic over a [`Scalar`], and get the
-//! equations of motion by differentiating them: `T` by forward mode (a second-order jet)
-//! below 11 coordinates and by reverse mode over a tape from 11 on, `V` by dual numbers.
+//! equations of motion by differentiating them: below 11 coordinates `T` and `V` by forward
+//! mode over the same second-order jets (which share their sines and cosines); from 11 on `T`
+//! by reverse mode over a tape and `V` by dual numbers.
 
 use crate::jet::Jet;
 use crate::mechanism::finite;
@@ -112,8 +113,8 @@ type Directional<T> = Dual<T, 1>;
 /// ```
 ///
 /// each entry exact to rounding, from automatic derivatives: one evaluation of `T` over a
-/// second-order jet (from 11 coordinates on, a tape: below) and one of `V` over a [`Dual`]
-/// number give both. The jet carries `T`'s
+/// second-order jet and one of `V` over the same jets (from 11 coordinates on, `T` on a tape
+/// and `V` over a [`Dual`] number: below) give both. The jet carries `T`'s
 /// gradients in `q` and `q'`, the upper half of its Hessian in `q'` (that is `M`), and the
 /// derivative of its velocity gradient along `(dq, dt) = (q', 1)` (the mixed and time terms
 /// at once, `O(N)` per operation instead of a second Hessian); parts that are exactly zero (a
@@ -132,7 +133,7 @@ type Directional<T> = Dual<T, 1>;
 /// depends on) and its rate along `(q', 1)`, and each node that is not linear in its parents
 /// adds a rank-one or rank-two term to `M` and its share of the mixed term. The cost is then
 /// about 20 ns a node plus the rank updates, whatever `N`: measured on a 20-link chain, about
-/// 19 times the hand-derived law where the jet takes 150 times. A tape holds up to 1,024
+/// 22 times the hand-derived law where the jet takes 170 times. A tape holds up to 1,024
 /// nodes (about 140 kB of stack at `N = 20`); a `T` that needs more is differentiated by the
 /// jet, as below 11.
 ///
@@ -255,8 +256,10 @@ where
     (SMatrix::from_fn(|i, k| r.hessian(i, k)), f)
 }
 
-/// `dV/dq` over any scalar `S`, from one evaluation of `V` over `Dual<S, N>`: at every `N`,
-/// since `V` is a function of `q` alone and a dual number is only `N + 1` numbers. (A tape
+/// `dV/dq` over any scalar `S`, from one evaluation of `V` over `Dual<S, N>`: from 11
+/// coordinates on and with [`Lagrangian::CONSTANT_MASS`] (below 11 the jets of `T` take `V`
+/// too, [`kinetic_jet`]), since `V` is a function of `q` alone and a dual number is only
+/// `N + 1` numbers. (A tape
 /// measured slower for `V`: its 20 ns or so a node each way against a few ns an operation of
 /// the dual, on the N-body of the bench, 14 and 28 coordinates, 2.7 and 2.2 times.)
 fn potential_gradient<T, S, L, const N: usize>(l: &L, t: S, q: &SVector<S, N>) -> SVector<S, N>
@@ -298,7 +301,8 @@ where
 }
 
 /// `M` and `f = dT/dq - dV/dq - (d2T/dq'dq) q' - d2T/dq'dt` over any scalar `S`, from one
-/// evaluation of `T` ([`kinetic_terms`]) and one of `V` ([`potential_gradient`]). Where
+/// evaluation of `T` and one of `V`: over the same jets below 11 coordinates
+/// ([`kinetic_jet`]), else `T` by [`kinetic_terms`] and `V` by [`potential_gradient`]. Where
 /// [`Lagrangian::CONSTANT_MASS`] holds, `f` skips `T` but for the time term, and `M` is not
 /// computed (zero here: use the factor made once).
 #[inline(always)]
