@@ -221,46 +221,49 @@ fn reference_solutions_refuse_bad_arguments() {
     refuses(jacobi_sn_cn(f64::INFINITY, 0.5), "u");
 }
 
-/// A law that is not finite at one time only: a unit spring whose acceleration is `poison`
-/// (NaN or an infinity) at `t = at`, and `-q` elsewhere.
+/// A law that is not finite at one time only: unit springs whose accelerations are `poison`
+/// (NaN or an infinity, in the last coordinate) at `t = at`, and `-q` elsewhere.
 struct Poisoned {
     at: f64,
     poison: f64,
 }
 
-impl Lagrangian<f64, 1> for Poisoned {
-    fn kinetic<S: Scalar<Real = f64>>(&self, _t: S, _q: &SVector<S, 1>, qd: &SVector<S, 1>) -> S {
-        S::from_f64(0.5) * qd[0] * qd[0]
+impl<const N: usize> Lagrangian<f64, N> for Poisoned {
+    fn kinetic<S: Scalar<Real = f64>>(&self, _t: S, _q: &SVector<S, N>, qd: &SVector<S, N>) -> S {
+        qd.iter().fold(S::zero(), |e, &v| e + v * v * 0.5)
     }
-    fn potential<S: Scalar<Real = f64>>(&self, _t: S, q: &SVector<S, 1>) -> S {
-        S::from_f64(0.5) * q[0] * q[0]
+    fn potential<S: Scalar<Real = f64>>(&self, _t: S, q: &SVector<S, N>) -> S {
+        q.iter().fold(S::zero(), |e, &x| e + x * x * 0.5)
     }
 }
 
-impl Mechanism<f64, 1> for Poisoned {
-    fn mass_matrix(&self, _s: &State<f64, 1>) -> lagrange_core::nalgebra::Matrix1<f64> {
-        lagrange_core::nalgebra::Matrix1::new(1.0)
+impl<const N: usize> Mechanism<f64, N> for Poisoned {
+    fn mass_matrix(&self, _s: &State<f64, N>) -> lagrange_core::nalgebra::SMatrix<f64, N, N> {
+        lagrange_core::nalgebra::SMatrix::identity()
     }
-    fn rhs(&self, s: &State<f64, 1>) -> SVector<f64, 1> {
-        SVector::<f64, 1>::new(if s.t == self.at { self.poison } else { -s.q[0] })
+    fn rhs(&self, s: &State<f64, N>) -> SVector<f64, N> {
+        let mut a = -s.q;
+        if s.t == self.at {
+            a[N - 1] = self.poison;
+        }
+        a
     }
     /// The right-hand side as it is (`M = 1`), with no test of its own: a hand-written law.
-    fn law<F: lagrange_core::GeneralizedForce<f64, 1>>(
+    fn law<F: lagrange_core::GeneralizedForce<f64, N>>(
         &self,
-        s: &State<f64, 1>,
+        s: &State<f64, N>,
         _extra: &F,
-    ) -> Result<SVector<f64, 1>, Error> {
-        Ok(self.rhs(s))
+    ) -> Result<SVector<f64, N>, Error> {
+        Ok(<Self as Mechanism<f64, N>>::rhs(self, s))
     }
 }
 
-/// RK4 takes each stage's law unchecked (the new state is checked instead): a stage whose
-/// accelerations are not finite, whichever of the four, still makes the step fail with
-/// `NonFiniteState`, one step or many, never a state with NaN or an infinity in it.
-#[test]
-fn rk4_refuses_a_stage_that_is_not_finite() -> Result<(), Error> {
-    let start = State::new(0.0, [0.3], [0.1]);
-    // Stage times from t = 0 with h = 1: 0 (stage 1), 0.5 (stages 2 and 3), 1 (stage 4).
+/// RK4 with `N` coordinates, from t = 0 with h = 1: a stage whose accelerations are not finite,
+/// whichever of the four, fails the step with `NonFiniteState`, one step or many, never a state
+/// with NaN or an infinity in it.
+fn rk4_refuses_poison<const N: usize>() -> Result<(), Error> {
+    let start = State::<f64, N>::new(0.0, [0.3; N], [0.1; N]);
+    // Stage times: 0 (stage 1), 0.5 (stages 2 and 3), 1 (stage 4).
     for at in [0.0, 0.5, 1.0] {
         for poison in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
             let m = Poisoned { at, poison };
@@ -276,11 +279,20 @@ fn rk4_refuses_a_stage_that_is_not_finite() -> Result<(), Error> {
             );
         }
     }
-    // Where no stage meets the poison, the step is the spring's.
+    // Where no stage meets the poison, the step is the springs'.
     let m = Poisoned {
         at: 0.25,
         poison: f64::NAN,
     };
     assert!(Rk4.step(&m, &start, 1.0)?.is_finite());
     Ok(())
+}
+
+/// Both of RK4's ways of taking a stage: each stage's accelerations tested (one coordinate)
+/// and only the new state tested (six, above the threshold where the stages take the law
+/// unchecked).
+#[test]
+fn rk4_refuses_a_stage_that_is_not_finite() -> Result<(), Error> {
+    rk4_refuses_poison::<1>()?;
+    rk4_refuses_poison::<6>()
 }

@@ -121,6 +121,8 @@ const AREAS: [Area; 14] = [
             "lanes",
             "--test",
             "work_counts",
+            "--test",
+            "bad_input",
         ],
         unit_tests: false,
         optimised: false,
