@@ -806,3 +806,24 @@ where
             .map_err(|f| f.error)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::scaled_square;
+
+    /// `a^2 b`, and where `a^2` overflows (a step near the largest finite time) the same
+    /// through `(a sqrt b)^2`: finite, not infinity times a small estimate.
+    #[test]
+    fn scaled_square_survives_overflow() {
+        assert_eq!(scaled_square(3.0f64, 2.0), 18.0);
+        // (1e200 sqrt(1e-300))^2 = (1e50)^2 = 1e100, to a few roundings.
+        let big = scaled_square(1e200f64, 1e-300);
+        assert!((big / 1e100 - 1.0).abs() < 1e-14, "{big:e}");
+        let big32 = scaled_square(1e20f32, 1e-30);
+        assert!((big32 / 1e10 - 1.0).abs() < 1e-6, "{big32:e}");
+        // A zero estimate is a zero error however long the step; NaN stays NaN.
+        assert_eq!(scaled_square(1e200f64, 0.0), 0.0);
+        assert!(scaled_square(f64::NAN, 1.0).is_nan());
+        assert!(scaled_square(1e200f64, f64::NAN).is_nan());
+    }
+}
