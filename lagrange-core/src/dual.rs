@@ -54,10 +54,18 @@ impl<S: Scalar<Real = R>, const K: usize, R: Real> Dual<S, K, R> {
     #[must_use]
     pub fn variable(re: S, k: usize) -> Self {
         let mut d = Self::constant(re);
-        if let Some(e) = d.eps.get_mut(k) {
+        d.seed(re, k);
+        d
+    }
+
+    /// Makes `self`, a constant, [`Dual::variable`]`(re, k)` in place (an array of seeds
+    /// filled where it stands: built and moved one by one, each was a call to `memcpy`).
+    #[inline]
+    pub(crate) fn seed(&mut self, re: S, k: usize) {
+        self.re = re;
+        if let Some(e) = self.eps.get_mut(k) {
             *e = S::one();
         }
-        d
     }
 
     /// Chain rule: the value `f` of a function at `re` with derivative `df` there.

@@ -259,9 +259,9 @@ where
 /// `dV/dq` over any scalar `S`, from one evaluation of `V` over `Dual<S, N>`: from 11
 /// coordinates on and with [`Lagrangian::CONSTANT_MASS`] (below 11 the jets of `T` take `V`
 /// too, [`kinetic_jet`]), since `V` is a function of `q` alone and a dual number is only
-/// `N + 1` numbers. (A tape
-/// measured slower for `V`: its 20 ns or so a node each way against a few ns an operation of
-/// the dual, on the N-body of the bench, 14 and 28 coordinates, 2.7 and 2.2 times.)
+/// `N + 1` numbers. (A tape measured slower for `V`: its 20 ns or so a node each way against a
+/// few ns an operation of the dual, on the N-body of the bench, 14 and 28 coordinates, 2.7 and
+/// 2.2 times.)
 fn potential_gradient<T, S, L, const N: usize>(l: &L, t: S, q: &SVector<S, N>) -> SVector<S, N>
 where
     T: Real,
@@ -272,10 +272,7 @@ where
     // `memcpy`, 6% of a 20-link chain's acceleration.
     let mut seeds = [Dual::<S, N>::constant(S::zero()); N];
     for (k, (seed, &x)) in seeds.iter_mut().zip(q.iter()).enumerate() {
-        seed.re = x;
-        if let Some(e) = seed.eps.get_mut(k) {
-            *e = S::one();
-        }
+        seed.seed(x, k);
     }
     let v = l.potential(
         Dual::constant(t),
