@@ -181,28 +181,33 @@ impl<T: Real, const N: usize, L: defmt::Format> defmt::Format for EulerLagrange<
 }
 
 /// `M = d2T/dq'dq'` and `T`'s part of `f`, `dT/dq - (d2T/dq'dq) q' - d2T/dq'dt`, from `T` at
-/// `(t, q, q')`: over a [`Jet`] below [`tape::FROM`] coordinates, over a tape from there on
+/// `(t, q, q')`, with `POTENTIAL` less `dV/dq` too (`V` over the same jets or on the same
+/// tape as `T`): over a [`Jet`] below [`tape::FROM`] coordinates, over a tape from there on
 /// (or where `T` does not fit the largest tape).
 ///
 /// The one place that evaluates `T` for its derivatives, for every use (the law, `M` alone,
-/// `f` alone, the time term).
-fn kinetic_terms<T, S, L, const N: usize>(
+/// `f` alone, the time term). `M` is written to `m` and `f` returned: a matrix of a
+/// tape-sized mechanism returned through the callers was copied at each (a 20-link chain's is
+/// 3.2 kB).
+fn kinetic_terms<T, S, L, const N: usize, const POTENTIAL: bool>(
     l: &L,
     t: S,
-    q: &SVector<S, N>,
-    qd: &SVector<S, N>,
-) -> (SMatrix<S, N, N>, SVector<S, N>)
+    (q, qd): (&SVector<S, N>, &SVector<S, N>),
+    m: &mut SMatrix<S, N, N>,
+) -> SVector<S, N>
 where
     T: Real,
     S: Scalar<Real = T> + 'static,
     L: Lagrangian<T, N>,
 {
     if N >= tape::FROM {
-        if let Some(terms) = tape::terms::kinetic(l, t, q, qd) {
-            return terms;
+        if let Some(f) = tape::terms::kinetic::<T, S, L, N, POTENTIAL>(l, t, (q, qd), m) {
+            return f;
         }
     }
-    kinetic_jet::<T, S, L, N, false>(l, t, q, qd)
+    let (jm, f) = kinetic_jet::<T, S, L, N, POTENTIAL>(l, t, q, qd);
+    *m = jm;
+    f
 }
 
 /// [`kinetic_terms`] over a [`Jet`] (velocities seeded, coordinates seeded and moving at
@@ -256,12 +261,12 @@ where
     (SMatrix::from_fn(|i, k| r.hessian(i, k)), f)
 }
 
-/// `dV/dq` over any scalar `S`, from one evaluation of `V` over `Dual<S, N>`: from 11
-/// coordinates on and with [`Lagrangian::CONSTANT_MASS`] (below 11 the jets of `T` take `V`
-/// too, [`kinetic_jet`]), since `V` is a function of `q` alone and a dual number is only
-/// `N + 1` numbers. (A tape measured slower for `V`: its 20 ns or so a node each way against a
-/// few ns an operation of the dual, on the N-body of the bench, 14 and 28 coordinates, 2.7 and
-/// 2.2 times.)
+/// `dV/dq` over any scalar `S`, from one evaluation of `V` over `Dual<S, N>`: with
+/// [`Lagrangian::CONSTANT_MASS`], where `T` is not differentiated (elsewhere `V` goes with `T`,
+/// over its jets or on its tape), since `V` is a function of `q` alone and a dual number is
+/// only `N + 1` numbers. (A tape of its own measured slower for `V`: its 20 ns or so a node
+/// each way against a few ns an operation of the dual, on the N-body of the bench, 14 and 28
+/// coordinates, 2.7 and 2.2 times. On `T`'s tape it is cheaper: its angles are `T`'s nodes.)
 fn potential_gradient<T, S, L, const N: usize>(l: &L, t: S, q: &SVector<S, N>) -> SVector<S, N>
 where
     T: Real,
@@ -294,21 +299,23 @@ where
     S: Scalar<Real = T> + 'static,
     L: Lagrangian<T, N>,
 {
-    kinetic_terms(l, t, q, qd).0
+    let mut m = SMatrix::from_element(S::zero());
+    kinetic_terms::<T, S, L, N, false>(l, t, (q, qd), &mut m);
+    m
 }
 
-/// `M` and `f = dT/dq - dV/dq - (d2T/dq'dq) q' - d2T/dq'dt` over any scalar `S`, from one
-/// evaluation of `T` and one of `V`: over the same jets below 11 coordinates
-/// ([`kinetic_jet`]), else `T` by [`kinetic_terms`] and `V` by [`potential_gradient`]. Where
-/// [`Lagrangian::CONSTANT_MASS`] holds, `f` skips `T` but for the time term, and `M` is not
-/// computed (zero here: use the factor made once).
+/// `f = dT/dq - dV/dq - (d2T/dq'dq) q' - d2T/dq'dt` over any scalar `S`, and `M` written to
+/// `m`, from one evaluation of `T` and one of `V`, over the same jets or on the same tape
+/// ([`kinetic_terms`]). Where [`Lagrangian::CONSTANT_MASS`] holds, `f` skips `T` but for the
+/// time term (`V` by [`potential_gradient`]), and `m` is left as it is (use the factor made
+/// once).
 #[inline(always)]
 fn terms_in<T, S, L, const N: usize>(
     l: &L,
     t: S,
-    q: &SVector<S, N>,
-    qd: &SVector<S, N>,
-) -> (SMatrix<S, N, N>, SVector<S, N>)
+    (q, qd): (&SVector<S, N>, &SVector<S, N>),
+    m: &mut SMatrix<S, N, N>,
+) -> SVector<S, N>
 where
     T: Real,
     S: Scalar<Real = T> + 'static,
@@ -319,15 +326,11 @@ where
         let mut f = -potential_gradient(l, t, q);
         if L::EXPLICIT_TIME {
             // T's part is then -d2T/dq'dt alone (dT/dq = 0 and d2T/dq'dq = 0).
-            f += kinetic_terms(l, t, q, qd).1;
+            f += kinetic_terms::<T, S, L, N, false>(l, t, (q, qd), m);
         }
-        return (SMatrix::zeros(), f);
+        return f;
     }
-    if N < tape::FROM {
-        return kinetic_jet::<T, S, L, N, true>(l, t, q, qd);
-    }
-    let (m, f) = kinetic_terms(l, t, q, qd);
-    (m, f - potential_gradient(l, t, q))
+    kinetic_terms::<T, S, L, N, true>(l, t, (q, qd), m)
 }
 
 /// `v` as one-direction duals, seeded along component `k` when `seed` is true.
@@ -374,7 +377,8 @@ fn residual_jacobian<T: Real, const N: usize, L: Lagrangian<T, N>>(
             let q = seeded(&s.q, k, !velocity);
             let qd = seeded(&s.qd, k, velocity);
             // With a constant mass matrix, dM/dx = 0.
-            let (m, f) = terms_in(l, t, &q, &qd);
+            let mut m = SMatrix::from_element(Directional::constant(T::zero()));
+            let f = terms_in(l, t, (&q, &qd), &mut m);
             let mut column = -f.map(|x| x.eps[0]);
             if !L::CONSTANT_MASS {
                 column += m.map(|x| x.eps[0]) * a;
@@ -395,7 +399,7 @@ impl<T: Real, const N: usize, L: Lagrangian<T, N>> Mechanism<T, N> for EulerLagr
     }
 
     fn rhs(&self, s: &State<T, N>) -> SVector<T, N> {
-        terms_in(&self.lagrangian, s.t, &s.q, &s.qd).1
+        terms_in(&self.lagrangian, s.t, (&s.q, &s.qd), &mut SMatrix::zeros())
     }
 
     /// With the factor made once where the mass matrix is constant.
@@ -412,7 +416,8 @@ impl<T: Real, const N: usize, L: Lagrangian<T, N>> Mechanism<T, N> for EulerLagr
         s: &State<T, N>,
         extra: &F,
     ) -> Result<SVector<T, N>, Error> {
-        let (m, f) = terms_in(&self.lagrangian, s.t, &s.q, &s.qd);
+        let mut m = SMatrix::zeros();
+        let f = terms_in(&self.lagrangian, s.t, (&s.q, &s.qd), &mut m);
         let b = extra.added_to(s, f + self.lagrangian.non_conservative_force(s));
         match &self.mass {
             Some(factor) => factor.as_ref().map(|c| c.solve(&b)).map_err(|e| *e),

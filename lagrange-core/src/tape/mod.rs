@@ -19,12 +19,14 @@
 
 pub(crate) mod sweep;
 pub(crate) mod terms;
+mod trig;
 
 use crate::scalar::{powi_by_squaring, Real, Scalar};
 use core::cell::{Cell, Ref, RefCell};
 use core::fmt;
 use core::ops::{Add, AddAssign, Div, DivAssign, Mul, MulAssign, Neg, Sub, SubAssign};
 use num_traits::{One, Zero};
+use trig::TrigNodes;
 
 /// From how many coordinates [`EulerLagrange`](crate::EulerLagrange) differentiates `T` over
 /// a tape rather than a [`Jet`](crate::jet::Jet). A jet holds `N^2 + 3 N + 2` numbers and
@@ -62,17 +64,22 @@ pub(crate) struct Tape<'s, S, const CAP: usize> {
     nodes: RefCell<&'s mut heapless::Vec<Node<S>, CAP>>,
     /// Set when a node did not fit: the recording is then incomplete and must not be used.
     full: Cell<bool>,
+    /// The sine and cosine nodes recorded so far, by angle.
+    trig: TrigNodes<S>,
 }
 
 impl<'s, S: Scalar, const CAP: usize> Tape<'s, S, CAP> {
     /// An empty tape in `storage`.
-    pub(crate) fn new(storage: &'s mut heapless::Vec<Node<S>, CAP>) -> Self {
+    /// An empty tape in `storage`; with `remember`, an angle's sine or cosine taken again is
+    /// the node recorded first (only for plain numbers: see [`TrigNodes`]).
+    pub(crate) fn new(storage: &'s mut heapless::Vec<Node<S>, CAP>, remember: bool) -> Self {
         // Node indices are `u16`, `NONE` kept out of them.
         const { assert!(CAP < NONE as usize) };
         storage.clear();
         Self {
             nodes: RefCell::new(storage),
             full: Cell::new(false),
+            trig: TrigNodes::new(remember),
         }
     }
 
@@ -228,6 +235,49 @@ impl<S: Scalar, const CAP: usize> Taped<'_, '_, S, CAP> {
             at,
             scale: S::one(),
         }
+    }
+
+    /// The sine (`SIN`) and the cosine (`COS`) of `self`: the nodes recorded for the same
+    /// angle before where there are (see [`TrigNodes`]), else new ones (a function not asked
+    /// for is the constant zero).
+    #[inline]
+    fn sin_cos_nodes<const SIN: bool, const COS: bool>(self) -> (Self, Self) {
+        let Some(tape) = self.tape else {
+            let (s, c) = self.v.sin_cos();
+            return (Self::constant(s), Self::constant(c));
+        };
+        let mut found = tape.trig.find(self.at, self.scale, self.v);
+        let (s, c) = found.values;
+        let recorded = |v: S, at: u16| Self {
+            v,
+            tape: Some(tape),
+            at,
+            scale: S::one(),
+        };
+        let (mut sin, mut cos) = (Self::constant(S::zero()), Self::constant(S::zero()));
+        let mut new = false;
+        if SIN {
+            sin = if found.nodes.0 == NONE {
+                new = true;
+                self.unary(s, c, -s)
+            } else {
+                recorded(s, found.nodes.0)
+            };
+            found.nodes.0 = sin.at;
+        }
+        if COS {
+            cos = if found.nodes.1 == NONE {
+                new = true;
+                self.unary(c, -s, -c)
+            } else {
+                recorded(c, found.nodes.1)
+            };
+            found.nodes.1 = cos.at;
+        }
+        if new {
+            tape.trig.keep(self.at, self.scale, self.v, found);
+        }
+        (sin, cos)
     }
 
     /// A linear function of `self` with slope `c` and value `v`: no node.
@@ -395,16 +445,13 @@ impl<S: Scalar<Real = R>, R: Real, const CAP: usize> Scalar for Taped<'_, '_, S,
         self.v.value()
     }
     fn sin(self) -> Self {
-        let (s, c) = self.v.sin_cos();
-        self.unary(s, c, -s)
+        self.sin_cos_nodes::<true, false>().0
     }
     fn cos(self) -> Self {
-        let (s, c) = self.v.sin_cos();
-        self.unary(c, -s, -c)
+        self.sin_cos_nodes::<false, true>().1
     }
     fn sin_cos(self) -> (Self, Self) {
-        let (s, c) = self.v.sin_cos();
-        (self.unary(s, c, -s), self.unary(c, -s, -c))
+        self.sin_cos_nodes::<true, true>()
     }
     fn tan(self) -> Self {
         let t = self.v.tan();

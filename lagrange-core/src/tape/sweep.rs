@@ -77,11 +77,11 @@ impl Span {
     }
 }
 
-/// `pa ga + pb gb` written to the free part of `pool` (zeros) from `*used` on, or `None`
-/// where the pool is full.
-fn combine<S: Scalar>(
-    pool: &mut [S],
-    used: &mut usize,
+/// `pa ga + pb gb` appended to `pool`, or `None` where the pool is full. (The pool grows
+/// by each gradient's length: clearing all of it ahead, 8 kB for the smaller tape, took more
+/// time than writing the zeros of the gradients made.)
+fn combine<S: Scalar, const POOL: usize>(
+    pool: &mut heapless::Vec<S, POOL>,
     (pa, ga): (S, Span),
     (pb, gb): (S, Span),
 ) -> Option<Span> {
@@ -91,10 +91,9 @@ fn combine<S: Scalar>(
         (true, false) => (gb.lo, gb.hi),
         (false, false) => (ga.lo.min(gb.lo), ga.hi.max(gb.hi)),
     };
-    let at = *used;
-    let end = at + usize::from(hi - lo);
-    let (old, rest) = pool.split_at_mut_checked(at)?;
-    let new = rest.get_mut(..end - at)?;
+    let at = pool.len();
+    pool.resize(at + usize::from(hi - lo), S::zero()).ok()?;
+    let (old, new) = pool.split_at_mut_checked(at)?;
     for (g, c) in [(ga, pa), (gb, pb)] {
         let from = usize::from(g.lo.saturating_sub(lo));
         let to = new.get_mut(from..).unwrap_or_default();
@@ -102,7 +101,6 @@ fn combine<S: Scalar>(
             *x += c * *y;
         }
     }
-    *used = end;
     Some(Span {
         at: u32::try_from(at).ok()?,
         lo,
@@ -202,9 +200,9 @@ fn reverse<S: Scalar, const CAP: usize>(
     (adj, needed)
 }
 
-/// `M` and `dT/dq - d/de dT/dq'` of the `T` recorded in `nodes`, its value a multiple
-/// `out.1` of the node `out.0`; `None` where the pool (`POOL` numbers of gradients) is too
-/// small.
+/// `dT/dq - d/de dT/dq'` of the `T` recorded in `nodes`, its value a multiple `out.1` of
+/// the node `out.0`, and `M` added to `m` (zero on entry; whole: both triangles); `None`
+/// where the pool (`POOL` numbers of gradients) is too small.
 #[inline(never)]
 pub(crate) fn second_order<
     S: Scalar + 'static,
@@ -215,7 +213,8 @@ pub(crate) fn second_order<
     nodes: &[Node<S>],
     out: (u16, S),
     inputs: &Inputs<'_, S, N>,
-) -> Option<(SMatrix<S, N, N>, SVector<S, N>)> {
+    m: &mut SMatrix<S, N, N>,
+) -> Option<SVector<S, N>> {
     let z = S::zero();
     let (adj, needed) = reverse::<S, CAP>(nodes, out);
 
@@ -223,9 +222,9 @@ pub(crate) fn second_order<
     // the curved nodes' terms.
     let mut tangent = [z; CAP];
     let mut span = [Span::ZERO; CAP];
-    let mut pool = [z; POOL];
-    let mut used = 0;
-    let mut h = [[z; N]; N];
+    let mut pool = heapless::Vec::<S, POOL>::new();
+    // Row `i` of `h` is column `i` of `m`: the same numbers, `M` being symmetric.
+    let h = &mut m.data.0;
     let mut dp = [z; N];
     let (time, q0, qd0) = (
         usize::from(inputs.time),
@@ -245,7 +244,7 @@ pub(crate) fn second_order<
         let ga = span.get(usize::from(node.a)).copied().unwrap_or(Span::ZERO);
         let gb = span.get(usize::from(node.b)).copied().unwrap_or(Span::ZERO);
         if curved {
-            curved_terms(&mut h, &mut dp, &pool, w, node, (ga, ta), (gb, tb));
+            curved_terms(h, &mut dp, &pool, w, node, (ga, ta), (gb, tb));
         }
         if !need {
             continue;
@@ -256,10 +255,9 @@ pub(crate) fn second_order<
         } else if (q0..q0 + N).contains(&v) {
             (inputs.rates.get(v - q0).copied().unwrap_or(z), Span::ZERO)
         } else if (qd0..qd0 + N).contains(&v) {
-            *pool.get_mut(used)? = S::one();
+            let at = u32::try_from(pool.len()).ok()?;
+            pool.push(S::one()).ok()?;
             let k = u16::try_from(v - qd0).ok()?;
-            let at = u32::try_from(used).ok()?;
-            used += 1;
             (
                 z,
                 Span {
@@ -269,7 +267,7 @@ pub(crate) fn second_order<
                 },
             )
         } else {
-            let g = combine(&mut pool, &mut used, (node.pa, ga), (node.pb, gb))?;
+            let g = combine(&mut pool, (node.pa, ga), (node.pb, gb))?;
             let mut t = z;
             if node.a != NONE {
                 t += node.pa * ta;
@@ -284,8 +282,7 @@ pub(crate) fn second_order<
     }
 
     let gq = SVector::from_fn(|i, _| adj.get(q0 + i).copied().unwrap_or(z));
-    let m = SMatrix::from_fn(|i, k| h[i][k]);
-    Some((m, gq - SVector::from(dp)))
+    Some(gq - SVector::from(dp))
 }
 
 /// A curved node's share of `M` (upper triangle `h`) and of the mixed term `dp`, its adjoint

@@ -11,41 +11,49 @@
 use super::sweep::{self, Inputs};
 use super::{Node, Tape, Taped, NONE};
 use crate::{Lagrangian, Real, Scalar};
+use core::any::TypeId;
 use nalgebra::{ArrayStorage, SMatrix, SVector};
 
 /// `M = d2T/dq'2` and `T`'s part of `f`, `dT/dq - (d2T/dq'dq) q' - d2T/dq'dt`, from `T` at
-/// `(t, q, q')` (time an input where [`Lagrangian::EXPLICIT_TIME`]); `None` where `T` does
-/// not fit the largest tape.
-pub(crate) fn kinetic<T, S, L, const N: usize>(
+/// `(t, q, q')` (time an input where [`Lagrangian::EXPLICIT_TIME`]); with `POTENTIAL`, `f`
+/// less `dV/dq` too, from `V` recorded on the same tape after `T` (its angles are `T`'s nodes,
+/// see [`TrigNodes`](super::trig::TrigNodes), and one reverse pass of `T - V` gives both
+/// gradients); `M` is added to `m` (zero on entry); `None` where they do not fit the largest
+/// tape.
+pub(crate) fn kinetic<T, S, L, const N: usize, const POTENTIAL: bool>(
     l: &L,
     t: S,
-    q: &SVector<S, N>,
-    qd: &SVector<S, N>,
-) -> Option<(SMatrix<S, N, N>, SVector<S, N>)>
+    (q, qd): (&SVector<S, N>, &SVector<S, N>),
+    m: &mut SMatrix<S, N, N>,
+) -> Option<SVector<S, N>>
 where
     T: Real,
     S: Scalar<Real = T> + 'static,
     L: Lagrangian<T, N>,
 {
-    kinetic_on::<T, S, L, N, 384, 1024>(l, t, q, qd)
-        .or_else(|| kinetic_on::<T, S, L, N, 1024, 8192>(l, t, q, qd))
+    kinetic_on::<T, S, L, N, POTENTIAL, 384, 1024>(l, t, (q, qd), m).or_else(|| {
+        // The smaller tape may have left part of M before its pool ran out.
+        m.fill(S::zero());
+        kinetic_on::<T, S, L, N, POTENTIAL, 1024, 8192>(l, t, (q, qd), m)
+    })
 }
 
 /// [`kinetic`] on a tape of `CAP` nodes with `POOL` numbers for the sweep's gradients.
 #[inline(never)]
-fn kinetic_on<T, S, L, const N: usize, const CAP: usize, const POOL: usize>(
+fn kinetic_on<T, S, L, const N: usize, const POTENTIAL: bool, const CAP: usize, const POOL: usize>(
     l: &L,
     t: S,
-    q: &SVector<S, N>,
-    qd: &SVector<S, N>,
-) -> Option<(SMatrix<S, N, N>, SVector<S, N>)>
+    (q, qd): (&SVector<S, N>, &SVector<S, N>),
+    m: &mut SMatrix<S, N, N>,
+) -> Option<SVector<S, N>>
 where
     T: Real,
     S: Scalar<Real = T> + 'static,
     L: Lagrangian<T, N>,
 {
     let mut storage = heapless::Vec::<Node<S>, CAP>::new();
-    let tape = Tape::new(&mut storage);
+    // Angles remembered for plain numbers only (see `TrigNodes`); the test folds away.
+    let tape = Tape::new(&mut storage, TypeId::of::<S>() == TypeId::of::<T>());
     let (out, inputs) = {
         // Inputs first, in this order: time (where it enters T), q, q'.
         let time = if L::EXPLICIT_TIME {
@@ -61,15 +69,15 @@ where
             qd: tqd.first().map_or(NONE, |x| x.node().0),
             rates: qd,
         };
-        let r = l.kinetic(
-            time,
-            &SVector::from_array_storage(ArrayStorage([tq])),
-            &SVector::from_array_storage(ArrayStorage([tqd])),
-        );
+        let tq = SVector::from_array_storage(ArrayStorage([tq]));
+        let mut r = l.kinetic(time, &tq, &SVector::from_array_storage(ArrayStorage([tqd])));
+        if POTENTIAL {
+            r -= l.potential(time, &tq);
+        }
         (r.node(), inputs)
     };
     let nodes = tape.nodes()?;
-    sweep::second_order::<S, N, CAP, POOL>(&nodes, out, &inputs)
+    sweep::second_order::<S, N, CAP, POOL>(&nodes, out, &inputs, m)
 }
 
 /// The tape against the jet, which differentiates the same `T` by forward mode: every
@@ -82,6 +90,34 @@ mod tests {
 
     /// Coordinates: as many as a mechanism that takes the tape has.
     const N: usize = 12;
+
+    /// [`kinetic_on`] with `V`, `M` returned.
+    fn on_tape<S, L, const K: usize, const POTENTIAL: bool, const CAP: usize, const POOL: usize>(
+        l: &L,
+        t: S,
+        q: &SVector<S, K>,
+        qd: &SVector<S, K>,
+    ) -> Option<(SMatrix<S, K, K>, SVector<S, K>)>
+    where
+        S: Scalar<Real = f64> + 'static,
+        L: Lagrangian<f64, K>,
+    {
+        let mut m = SMatrix::from_element(S::zero());
+        let f = kinetic_on::<f64, S, L, K, POTENTIAL, CAP, POOL>(l, t, (q, qd), &mut m)?;
+        Some((m, f))
+    }
+
+    /// [`kinetic`] (the tapes tried) with `V`, `M` returned.
+    fn on_tapes<L: Lagrangian<f64, N>>(
+        l: &L,
+        t: f64,
+        q: &SVector<f64, N>,
+        qd: &SVector<f64, N>,
+    ) -> Option<(SMatrix<f64, N, N>, SVector<f64, N>)> {
+        let mut m = SMatrix::zeros();
+        let f = kinetic::<f64, f64, L, N, true>(l, t, (q, qd), &mut m)?;
+        Some((m, f))
+    }
 
     /// A kinetic energy that uses every operation of [`Scalar`], with constants on either
     /// side, and time where `TIMED` (and a potential, which the tape does not take).
@@ -168,17 +204,17 @@ mod tests {
         (a - b).amax() / b.amax().max(1.0)
     }
 
-    /// Both agree to rounding: measured worst 3.5e-16 (M) and 5.4e-16 (f) over 200 states;
-    /// bound 1e-13, far under what a wrong partial of any one operation makes (each of those
-    /// planted moved M or f by more than 1e-4).
-    fn agree<const TIMED: bool>() -> Result<(), &'static str> {
+    /// Both agree to rounding, with and without `V`: measured worst 3.5e-16 (M) and 5.4e-16
+    /// (f) over 200 states; bound 1e-13, far under what a wrong partial of any one operation
+    /// makes (each of those planted moved M or f by more than 1e-4).
+    fn agree<const TIMED: bool, const POTENTIAL: bool>() -> Result<(), &'static str> {
         let l = Everything::<TIMED>;
         let mut worst = [0.0f64; 2];
         for seed in 0..200 {
             let (t, q, qd) = state(seed);
-            let (mt, ft) = kinetic_on::<f64, f64, _, N, 1024, 8192>(&l, t, &q, &qd)
+            let (mt, ft) = on_tape::<f64, _, N, POTENTIAL, 1024, 8192>(&l, t, &q, &qd)
                 .ok_or("T does not fit the tape")?;
-            let (mj, fj) = kinetic_jet::<_, _, _, _, false>(&l, t, &q, &qd);
+            let (mj, fj) = kinetic_jet::<_, _, _, _, POTENTIAL>(&l, t, &q, &qd);
             worst[0] = worst[0].max(relative(&mt, &mj));
             worst[1] = worst[1].max(relative(&ft, &fj));
         }
@@ -188,7 +224,8 @@ mod tests {
 
     #[test]
     fn the_tape_agrees_with_the_jet() -> Result<(), &'static str> {
-        agree::<false>()
+        agree::<false, false>()?;
+        agree::<false, true>()
     }
 
     /// The tapes the automatic path tries, smaller first, give the same.
@@ -197,8 +234,8 @@ mod tests {
         let l = Everything::<true>;
         for seed in 0..20 {
             let (t, q, qd) = state(seed);
-            let large = kinetic_on::<f64, f64, _, N, 1024, 8192>(&l, t, &q, &qd);
-            let tried = kinetic(&l, t, &q, &qd);
+            let large = on_tape::<f64, _, N, true, 1024, 8192>(&l, t, &q, &qd);
+            let tried = on_tapes(&l, t, &q, &qd);
             assert_eq!(tried, large);
             tried.ok_or("T does not fit")?;
         }
@@ -235,8 +272,8 @@ mod tests {
         }
     }
 
-    /// The smaller tape holds a chain of 20 links (recorded once per call, not twice), and a
-    /// chain of 40 needs the larger.
+    /// The smaller tape holds a chain of 20 links with its `V` (recorded once per call, not
+    /// twice), and a chain of 40 needs the larger.
     #[test]
     fn the_smaller_tape_holds_a_chain_of_twenty() {
         let (q, qd) = (
@@ -244,24 +281,25 @@ mod tests {
             SVector::from_element(0.5),
         );
         let c = Chain::<20>;
-        assert!(kinetic_on::<f64, f64, _, 20, 384, 1024>(&c, 0.0, &q, &qd).is_some());
+        assert!(on_tape::<f64, _, 20, true, 384, 1024>(&c, 0.0, &q, &qd).is_some());
         let (q, qd) = (
             SVector::from_fn(|i, _| 0.1 * i as f64),
             SVector::from_element(0.5),
         );
         let c = Chain::<40>;
-        assert!(kinetic_on::<f64, f64, _, 40, 384, 1024>(&c, 0.0, &q, &qd).is_none());
-        assert!(kinetic_on::<f64, f64, _, 40, 1024, 8192>(&c, 0.0, &q, &qd).is_some());
+        assert!(on_tape::<f64, _, 40, true, 384, 1024>(&c, 0.0, &q, &qd).is_none());
+        assert!(on_tape::<f64, _, 40, true, 1024, 8192>(&c, 0.0, &q, &qd).is_some());
     }
 
     #[test]
     fn the_tape_agrees_with_the_jet_with_time() -> Result<(), &'static str> {
-        agree::<true>()
+        agree::<true, false>()?;
+        agree::<true, true>()
     }
 
     /// Over one-direction dual numbers (the exact law Jacobian's third derivatives, seeded
-    /// along a coordinate or a velocity), both the values and the derivatives agree:
-    /// measured worst 6.3e-16 over 100 states; bound 1e-13, as above.
+    /// along a coordinate or a velocity), both the values and the derivatives agree, with `V`
+    /// in every other state: measured worst 6.3e-16 over 100 states; bound 1e-13, as above.
     #[test]
     fn the_tape_agrees_with_the_jet_over_dual_numbers() -> Result<(), &'static str> {
         // Unoptimised, the jet's temporaries over dual numbers (about 3 KB each, every one
@@ -294,9 +332,18 @@ mod tests {
             let velocity = seed % 2 == 1;
             let (dq, dqd) = (seeded(&q, !velocity), seeded(&qd, velocity));
             let dt = Dual::constant(t);
-            let (mt, ft) = kinetic_on::<f64, _, _, N, 1024, 8192>(&l, dt, &dq, &dqd)
-                .ok_or("T does not fit the tape")?;
-            let (mj, fj) = kinetic_jet::<_, _, _, _, false>(&l, dt, &dq, &dqd);
+            let (taped, (mj, fj)) = if seed % 4 < 2 {
+                (
+                    on_tape::<_, _, N, false, 1024, 8192>(&l, dt, &dq, &dqd),
+                    kinetic_jet::<_, _, _, _, false>(&l, dt, &dq, &dqd),
+                )
+            } else {
+                (
+                    on_tape::<_, _, N, true, 1024, 8192>(&l, dt, &dq, &dqd),
+                    kinetic_jet::<_, _, _, _, true>(&l, dt, &dq, &dqd),
+                )
+            };
+            let (mt, ft) = taped.ok_or("T does not fit the tape")?;
             let parts = |m: &SMatrix<Dual<f64, 1>, N, N>, f: &SVector<Dual<f64, 1>, N>| {
                 (
                     m.map(|x| x.re),
@@ -321,7 +368,7 @@ mod tests {
     #[test]
     fn a_recorded_number_reads_as_its_value() {
         let mut storage = heapless::Vec::<Node<f64>, 16>::new();
-        let tape = Tape::new(&mut storage);
+        let tape = Tape::new(&mut storage, true);
         let x = tape.input(1.5);
         let y = x * 2.0 - 1.0;
         assert_eq!(Scalar::value(y), 2.0);
@@ -344,8 +391,8 @@ mod tests {
     fn a_tape_too_small_refuses() {
         let l = Everything::<false>;
         let (t, q, qd) = state(1);
-        assert!(kinetic_on::<f64, f64, _, N, 64, 8192>(&l, t, &q, &qd).is_none());
-        assert!(kinetic_on::<f64, f64, _, N, 1024, 16>(&l, t, &q, &qd).is_none());
-        assert!(kinetic(&l, t, &q, &qd).is_some());
+        assert!(on_tape::<f64, _, N, true, 64, 8192>(&l, t, &q, &qd).is_none());
+        assert!(on_tape::<f64, _, N, true, 1024, 16>(&l, t, &q, &qd).is_none());
+        assert!(on_tapes(&l, t, &q, &qd).is_some());
     }
 }
