@@ -1,7 +1,7 @@
 //! Automatic Euler-Lagrange: write `T` and `V` once, generic over a [`Scalar`], and get the
 //! equations of motion by differentiating them: below 11 coordinates `T` and `V` by forward
 //! mode over the same second-order jets (which share their sines and cosines); from 11 on `T`
-//! by reverse mode over a tape and `V` by dual numbers.
+//! and `V` by reverse mode over one tape (on which `V`'s sines and cosines are `T`'s nodes).
 
 use crate::jet::Jet;
 use crate::mechanism::finite;
@@ -113,8 +113,8 @@ type Directional<T> = Dual<T, 1>;
 /// ```
 ///
 /// each entry exact to rounding, from automatic derivatives: one evaluation of `T` over a
-/// second-order jet and one of `V` over the same jets (from 11 coordinates on, `T` on a tape
-/// and `V` over a [`Dual`] number: below) give both. The jet carries `T`'s
+/// second-order jet and one of `V` over the same jets (from 11 coordinates on, both on one
+/// tape: below) give both. The jet carries `T`'s
 /// gradients in `q` and `q'`, the upper half of its Hessian in `q'` (that is `M`), and the
 /// derivative of its velocity gradient along `(dq, dt) = (q', 1)` (the mixed and time terms
 /// at once, `O(N)` per operation instead of a second Hessian); parts that are exactly zero (a
@@ -127,13 +127,14 @@ type Directional<T> = Dual<T, 1>;
 /// `N^2 + 3 N + 2` numbers, which for a long chain (kilobytes at `N = 20`) makes copying them
 /// a large part of the cost.
 ///
-/// So from 11 coordinates on, `T` is instead recorded on a tape on the stack (each operation
-/// a node with its parents and partial derivatives) and swept: one reverse pass gives
-/// `dT/dq`, one forward pass each node's gradient in `q'` (only over the coordinates it
-/// depends on) and its rate along `(q', 1)`, and each node that is not linear in its parents
-/// adds a rank-one or rank-two term to `M` and its share of the mixed term. The cost is then
-/// about 20 ns a node plus the rank updates, whatever `N`: measured on a 20-link chain, about
-/// 22 times the hand-derived law where the jet takes 170 times. A tape holds up to 1,024
+/// So from 11 coordinates on, `T` and then `V` are instead recorded on a tape on the stack
+/// (each operation a node with its parents and partial derivatives; a sine or cosine of an
+/// angle already taken is the node made for it) and swept: one reverse pass of `T - V` gives
+/// `dT/dq - dV/dq`, one forward pass each node's gradient in `q'` (only over the coordinates
+/// it depends on) and its rate along `(q', 1)`, and each node that is not linear in its
+/// parents adds a rank-one or rank-two term to `M` and its share of the mixed term. The cost
+/// is then about 20 ns a node plus the rank updates, whatever `N`: measured on a 20-link
+/// chain, about 20 times the hand-derived law where the jet takes 170 times. A tape holds up to 1,024
 /// nodes (about 140 kB of stack at `N = 20`); a `T` that needs more is differentiated by the
 /// jet, as below 11.
 ///
