@@ -373,8 +373,8 @@ const AREAS: [Area; 14] = [
         optimised: false,
     },
     Area {
-        // The automatic path's tape (reverse mode for long mechanisms) and the memo of sines
-        // and cosines its jets share: tested where they live (the tape against the jet) by
+        // The automatic path's tape (reverse mode for long mechanisms, with its sine and
+        // cosine nodes by angle) and the memo of sines and cosines its jets share: tested where they live (the tape against the jet) by
         // `lagrange-core`'s unit tests; a build of one crate per mutant.
         name: "tape",
         package: "lagrange-core",
@@ -383,6 +383,7 @@ const AREAS: [Area; 14] = [
             "lagrange-core/src/tape/mod.rs",
             "lagrange-core/src/tape/sweep.rs",
             "lagrange-core/src/tape/terms.rs",
+            "lagrange-core/src/tape/trig.rs",
             "lagrange-core/src/trig_memo.rs",
         ],
         only: None,
