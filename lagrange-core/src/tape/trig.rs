@@ -144,6 +144,21 @@ mod tests {
         }
     }
 
+    /// Angles of different nodes are kept side by side: a chain's angles are its first
+    /// nodes, and each stays remembered while the others are taken.
+    #[test]
+    fn angles_of_different_nodes_are_all_kept() {
+        let mut storage = heapless::Vec::<Node<f64>, 64>::new();
+        let tape = Tape::new(&mut storage, true);
+        let xs: [_; 8] = core::array::from_fn(|k| tape.input(0.1 + 0.2 * k as f64));
+        let first: [_; 8] = core::array::from_fn(|k| xs[k].sin_cos());
+        for (x, (s, c)) in xs.iter().zip(&first) {
+            let (s2, c2) = x.sin_cos();
+            assert!(s2.at == s.at && c2.at == c.at);
+        }
+        assert_eq!(tape.nodes().map(|n| n.len()), Some(8 + 16));
+    }
+
     /// A hit is a look-up: a wrong value planted in the slot is what comes back.
     #[test]
     fn a_hit_is_a_look_up() {
