@@ -134,9 +134,9 @@ type Directional<T> = Dual<T, 1>;
 /// it depends on) and its rate along `(q', 1)`, and each node that is not linear in its
 /// parents adds a rank-one or rank-two term to `M` and its share of the mixed term. The cost
 /// is then about 20 ns a node plus the rank updates, whatever `N`: measured on a 20-link
-/// chain, about 20 times the hand-derived law where the jet takes 170 times. A tape holds up to 1,024
-/// nodes (about 140 kB of stack at `N = 20`); a `T` that needs more is differentiated by the
-/// jet, as below 11.
+/// chain, about 20 times the hand-derived law where the jet takes 170 times. A tape holds up
+/// to 1,024 nodes (about 140 kB of stack at `N = 20`); a `T` that needs more is
+/// differentiated by the jet, as below 11.
 ///
 /// Its [`Mechanism::law_jacobian`] is exact too: differentiating `M q'' = f + Q + extra` gives
 /// `M dq''/dx = d(f + Q + extra)/dx - (dM/dx) q''`, with `dM/dx` and `df/dx` from `M` and `f`

@@ -248,33 +248,35 @@ impl<S: Scalar, const CAP: usize> Taped<'_, '_, S, CAP> {
         };
         let mut found = tape.trig.find(self.at, self.scale, self.v);
         let (s, c) = found.values;
-        let recorded = |v: S, at: u16| Self {
-            v,
-            tape: Some(tape),
-            at,
-            scale: S::one(),
+        let recorded = found.nodes;
+        // The node recorded for the function where there is one, else a new node (value `v`,
+        // derivatives `d`, `dd`), which is then the one recorded.
+        let take = |node: &mut u16, (v, d, dd): (S, S, S)| {
+            let r = if *node == NONE {
+                self.unary(v, d, dd)
+            } else {
+                Self {
+                    v,
+                    tape: Some(tape),
+                    at: *node,
+                    scale: S::one(),
+                }
+            };
+            *node = r.at;
+            r
         };
-        let (mut sin, mut cos) = (Self::constant(S::zero()), Self::constant(S::zero()));
-        let mut new = false;
-        if SIN {
-            sin = if found.nodes.0 == NONE {
-                new = true;
-                self.unary(s, c, -s)
-            } else {
-                recorded(s, found.nodes.0)
-            };
-            found.nodes.0 = sin.at;
-        }
-        if COS {
-            cos = if found.nodes.1 == NONE {
-                new = true;
-                self.unary(c, -s, -c)
-            } else {
-                recorded(c, found.nodes.1)
-            };
-            found.nodes.1 = cos.at;
-        }
-        if new {
+        let zero = Self::constant(S::zero());
+        let sin = if SIN {
+            take(&mut found.nodes.0, (s, c, -s))
+        } else {
+            zero
+        };
+        let cos = if COS {
+            take(&mut found.nodes.1, (c, -s, -c))
+        } else {
+            zero
+        };
+        if found.nodes != recorded {
             tape.trig.keep(self.at, self.scale, self.v, found);
         }
         (sin, cos)
