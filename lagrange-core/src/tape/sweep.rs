@@ -137,6 +137,54 @@ fn add_square<S: Scalar, const N: usize>(h: &mut [[S; N]; N], pool: &[S], c: S, 
     }
 }
 
+/// `h += c a a^T + d b b^T` for gradients `a`, `b` of one range, in one pass over the block.
+fn add_two_squares<S: Scalar, const N: usize>(
+    h: &mut [[S; N]; N],
+    pool: &[S],
+    (c, a): (S, Span),
+    (d, b): (S, Span),
+) {
+    let (pa, pb) = (a.part(pool), b.part(pool));
+    let rows = h.get_mut(a.range()).unwrap_or_default();
+    for ((row, ai), bi) in rows.iter_mut().zip(pa).zip(pb) {
+        let (cai, dbi) = (c * *ai, d * *bi);
+        let block = row.get_mut(a.range()).unwrap_or_default();
+        for ((e, aj), bj) in block.iter_mut().zip(pa).zip(pb) {
+            *e += cai * *aj + dbi * *bj;
+        }
+    }
+}
+
+/// `M`'s rank-one squares, held back one at a time so that two of one range (a chain's
+/// `vx^2 + vy^2`) go in one pass over their block: the updates of `M` were row overhead as
+/// much as arithmetic.
+struct Squares<'h, S, const N: usize> {
+    h: &'h mut [[S; N]; N],
+    held: Option<(S, Span)>,
+}
+
+impl<S: Scalar, const N: usize> Squares<'_, S, N> {
+    /// `h += c a a^T`, now or with the next square.
+    fn add(&mut self, pool: &[S], c: S, a: Span) {
+        if let Some((d, b)) = self.held {
+            if b.range() == a.range() {
+                self.held = None;
+                add_two_squares(self.h, pool, (d, b), (c, a));
+                return;
+            }
+        }
+        self.flush(pool);
+        self.held = Some((c, a));
+    }
+
+    /// Adds the square held, if any.
+    fn flush(&mut self, pool: &[S]) {
+        if let Some((c, a)) = self.held.take() {
+            add_square(self.h, pool, c, a);
+        }
+    }
+}
+
 /// `h += c (a b^T + b a^T)`, in the rows of the ranges: whole rows of the fixed length `N`
 /// (the two ranges differ, and a loop of known length vectorises).
 fn add_outer<S: Scalar, const N: usize>(h: &mut [[S; N]; N], pool: &[S], c: S, a: Span, b: Span) {
@@ -224,7 +272,10 @@ pub(crate) fn second_order<
     let mut span = [Span::ZERO; CAP];
     let mut pool = heapless::Vec::<S, POOL>::new();
     // Row `i` of `h` is column `i` of `m`: the same numbers, `M` being symmetric.
-    let h = &mut m.data.0;
+    let mut h = Squares {
+        h: &mut m.data.0,
+        held: None,
+    };
     let mut dp = [z; N];
     let (time, q0, qd0) = (
         usize::from(inputs.time),
@@ -244,7 +295,7 @@ pub(crate) fn second_order<
         let ga = span.get(usize::from(node.a)).copied().unwrap_or(Span::ZERO);
         let gb = span.get(usize::from(node.b)).copied().unwrap_or(Span::ZERO);
         if curved {
-            curved_terms(h, &mut dp, &pool, w, node, (ga, ta), (gb, tb));
+            curved_terms(&mut h, &mut dp, &pool, w, node, (ga, ta), (gb, tb));
         }
         if !need {
             continue;
@@ -281,6 +332,7 @@ pub(crate) fn second_order<
         *span.get_mut(v)? = g;
     }
 
+    h.flush(&pool);
     let gq = SVector::from_fn(|i, _| adj.get(q0 + i).copied().unwrap_or(z));
     Some(gq - SVector::from(dp))
 }
@@ -289,7 +341,7 @@ pub(crate) fn second_order<
 /// `w`, each parent with its velocity gradient (none where it does not move with `q'`) and
 /// its tangent.
 fn curved_terms<S: Scalar, const N: usize>(
-    h: &mut [[S; N]; N],
+    h: &mut Squares<'_, S, N>,
     dp: &mut [S; N],
     pool: &[S],
     w: S,
@@ -300,7 +352,7 @@ fn curved_terms<S: Scalar, const N: usize>(
     let (caa, cab, cbb) = (w * node.haa, w * node.hab, w * node.hbb);
     if !ga.is_zero() {
         if !caa.is_zero() {
-            add_square(h, pool, caa, ga);
+            h.add(pool, caa, ga);
             ga.add_to(pool, dp, caa * ta);
         }
         if !cab.is_zero() {
@@ -309,7 +361,7 @@ fn curved_terms<S: Scalar, const N: usize>(
     }
     if !gb.is_zero() {
         if !cbb.is_zero() {
-            add_square(h, pool, cbb, gb);
+            h.add(pool, cbb, gb);
             gb.add_to(pool, dp, cbb * tb);
         }
         if !cab.is_zero() {
@@ -319,9 +371,9 @@ fn curved_terms<S: Scalar, const N: usize>(
     if !ga.is_zero() && !gb.is_zero() && !cab.is_zero() {
         if node.a == node.b {
             // x x: a square, 2 c g g^T.
-            add_square(h, pool, cab + cab, ga);
+            h.add(pool, cab + cab, ga);
         } else {
-            add_outer(h, pool, cab, ga, gb);
+            add_outer(h.h, pool, cab, ga, gb);
         }
     }
 }
