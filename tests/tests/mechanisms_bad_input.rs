@@ -106,6 +106,20 @@ fn non_negative_parameters_are_named<T: Real>() -> Result<(), Error> {
     Ok(())
 }
 
+/// The elastic pendulum's law takes `k / m`: a pair whose ratio overflows is refused, naming
+/// the parameter that pushes it furthest (f32: 1e30 / 1e-10; f64: 1e300 / 1e-10 and
+/// 1e10 / 1e-300).
+#[test]
+fn elastic_pendulum_refuses_a_spring_rate_that_overflows() {
+    refuses(ElasticPendulum::new(1e-10f32, 1e30, 1.0, 9.81), "stiffness");
+    refuses(
+        ElasticPendulum::new(1e-10f64, 1e300, 1.0, 9.81),
+        "stiffness",
+    );
+    refuses(ElasticPendulum::new(1e-300f64, 1e10, 1.0, 0.0), "mass");
+    assert!(ElasticPendulum::new(1e-10f64, 1e290, 1.0, 9.81).is_ok());
+}
+
 /// A mass whose inverse overflows is refused (f32: 1e-45 is a positive subnormal).
 #[test]
 fn chain_refuses_a_mass_it_cannot_invert() {
