@@ -203,6 +203,21 @@ fn singular_states_are_reported<T: Real>() -> Result<(), Error> {
         &kepler,
         &State::new(T::zero(), [T::from_f64(near), T::zero()], [one, one]),
     );
+    // The elastic pendulum's th'' overflows there too at r' = 1 / r (2 / r^2: f64 2e320,
+    // f32 2e40), and at r = 1 both accelerations overflow at rates of 1e200 (f32 1e20):
+    // finite states, refused all the same.
+    let fast = T::from_f64(1.0 / near);
+    singular(
+        &elastic,
+        &State::new(T::zero(), [T::from_f64(near), T::zero()], [fast, one]),
+    );
+    let faster = T::from_f64(if T::EPSILON.to_f64() > 1e-10 {
+        1e20
+    } else {
+        1e200
+    });
+    let both = elastic.acceleration(&State::new(T::zero(), [one, T::zero()], [faster, faster]));
+    assert!(matches!(both, Err(Error::Singularity { .. })), "{both:?}");
     let spherical = SphericalPendulum::new(one, one, g)?;
     for th in [0.0, -0.0, tiny] {
         singular(
