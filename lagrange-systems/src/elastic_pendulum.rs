@@ -1,6 +1,6 @@
 //! [`ElasticPendulum`]: a point mass on a linear spring swinging from a fixed pivot.
 
-use crate::small_solve::{positive_radius, solve_diagonal2};
+use crate::small_solve::{positive_radius, radial_accelerations, solve_diagonal2};
 use lagrange_core::nalgebra::{Matrix2, SVector, Vector2};
 use lagrange_core::{
     free_law_force, validate, Error, GeneralizedForce, Lagrangian, Mechanism, Real, Scalar, State,
@@ -150,21 +150,7 @@ impl<T: Real> Mechanism<T, 2> for ElasticPendulum<T> {
             let e = extra.force(s);
             qdd += Vector2::new(e[0] / self.mass, e[1] / (self.mass * r * r));
         }
-        // Coordinates or rates that are not finite give accelerations that are not, so a test
-        // of the result, of the time (which the law does not use) and of `r > 0` with `M`'s
-        // `m r^2` not underflowing to zero (the split form's singular `M`, so that both forms
-        // refuse the same states) passes every good state, and the error is told apart only
-        // on failure: a test of the whole state first was a fifth of the step.
-        let good = qdd
-            .iter()
-            .fold(s.t.is_finite(), |all, x| all & x.is_finite());
-        if good && r > T::zero() && self.mass * r * r > T::zero() {
-            return Ok(qdd);
-        }
-        positive_radius(s, SPRING_COLLAPSED)?;
-        Err(Error::Singularity {
-            what: SPRING_COLLAPSED,
-        })
+        radial_accelerations(s, qdd, self.mass * r * r, SPRING_COLLAPSED)
     }
 
     fn law_force<F: GeneralizedForce<T, 2>>(

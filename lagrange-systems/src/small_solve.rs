@@ -74,6 +74,31 @@ pub(crate) fn positive_radius<T: Real>(s: &State<T, 2>, what: &'static str) -> R
     }
 }
 
+/// `qdd`, the accelerations of a mechanism in a radius `r = s.q[0]` (the elastic pendulum,
+/// Kepler) at `s`, when they are finite, the time is, `r > 0`, and `M`'s angular entry
+/// `m_r2 = m r^2` has not underflowed to zero (the split form's singular `M`: both forms refuse
+/// the same states); else [`Error::NonFiniteState`] for a state that is not finite and
+/// [`Error::Singularity`] `what` otherwise. Coordinates or rates that are not finite give
+/// accelerations that are not, so this one test of the result passes every good state and the
+/// error is told apart only on failure: a test of the whole state first was a fifth of an RK4
+/// step of the elastic pendulum.
+#[inline(always)]
+pub(crate) fn radial_accelerations<T: Real>(
+    s: &State<T, 2>,
+    qdd: Vector2<T>,
+    m_r2: T,
+    what: &'static str,
+) -> Result<Vector2<T>, Error> {
+    let good = qdd
+        .iter()
+        .fold(s.t.is_finite(), |all, x| all & x.is_finite());
+    if good && s.q[0] > T::zero() && m_r2 > T::zero() {
+        return Ok(qdd);
+    }
+    positive_radius(s, what)?;
+    Err(Error::Singularity { what })
+}
+
 /// `x` when every entry is finite, else `error`.
 #[inline]
 pub(crate) fn finite<T: Real, const N: usize>(
