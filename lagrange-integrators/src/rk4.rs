@@ -1,6 +1,8 @@
 //! The classical fourth-order Runge-Kutta method.
 
-use crate::integrator::{check_run_step, check_step, finish, step_loop, Cost, Failure};
+use crate::integrator::{
+    check_run_step, check_step, finish, step_loop, unobserved_loop, Cost, Failure,
+};
 use crate::{Integrator, Method};
 use lagrange_core::nalgebra::SVector;
 use lagrange_core::{Error, Lanes, Mechanism, NoForce, Real, State};
@@ -59,6 +61,16 @@ impl<T: Real, const N: usize, M: Mechanism<T, N>> Integrator<T, N, M> for Rk4 {
     /// As the default, with `dt` and the start checked once (each step's end is checked, so
     /// the next step's start is known finite) and the stages inlined into the loop: a call per
     /// step cost a quarter of a pendulum's RK4 step.
+    fn integrate(
+        &mut self,
+        m: &M,
+        state: &State<T, N>,
+        dt: T,
+        steps: u64,
+    ) -> Result<State<T, N>, Failure<T, N>> {
+        unobserved_loop(state, dt, steps, |s| stages(m, s, dt))
+    }
+
     fn integrate_with<F: FnMut(&State<T, N>)>(
         &mut self,
         m: &M,

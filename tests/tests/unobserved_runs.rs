@@ -1,0 +1,125 @@
+//! A run that nothing observes (`Integrator::integrate`) may test its states for finiteness
+//! once in a few steps rather than at every step (RK4 does, one state in 8), and take the
+//! steps since the last tested state again, each tested, when a test or a step fails. Its
+//! outcome must be that of the same run observed at every step (`integrate_with`, whose
+//! states are each tested before the observer sees them): the same last state to the bit, or
+//! the same error at the same step with the same last good state.
+
+use lagrange_core::nalgebra::{SMatrix, SVector};
+use lagrange_core::{Error, GeneralizedForce, Lagrangian, Mechanism, Real, Scalar, State};
+use lagrange_integrators::{Integrator, Rk4};
+use lagrange_tests::for_f32_and_f64;
+
+/// `q_i'' = k q_i^2` for each coordinate: unit masses in the potential `-k q^3 / 3`, which
+/// run away to infinity in a finite time. Past `limit` on the first coordinate (where given),
+/// the law refuses the state instead, as a mechanism at a singular configuration does.
+struct Runaway<T, const N: usize> {
+    k: T,
+    limit: Option<T>,
+}
+
+impl<T: Real, const N: usize> Lagrangian<T, N> for Runaway<T, N> {
+    fn kinetic<S: Scalar<Real = T>>(&self, _t: S, _q: &SVector<S, N>, qd: &SVector<S, N>) -> S {
+        qd.iter().fold(S::zero(), |t, v| t + *v * *v * T::HALF)
+    }
+    fn potential<S: Scalar<Real = T>>(&self, _t: S, q: &SVector<S, N>) -> S {
+        let third = T::one() / T::from_f64(3.0);
+        q.iter()
+            .fold(S::zero(), |v, x| v - *x * *x * *x * (self.k * third))
+    }
+}
+
+impl<T: Real, const N: usize> Mechanism<T, N> for Runaway<T, N> {
+    fn mass_matrix(&self, _s: &State<T, N>) -> SMatrix<T, N, N> {
+        SMatrix::identity()
+    }
+    fn rhs(&self, s: &State<T, N>) -> SVector<T, N> {
+        s.q.map(|x| self.k * x * x)
+    }
+    /// The accelerations as they come: infinite once `q^2` overflows (RK4 reads the law
+    /// itself from 5 coordinates, and the run's own tests must catch the overflow).
+    fn law<F: GeneralizedForce<T, N>>(
+        &self,
+        s: &State<T, N>,
+        _extra: &F,
+    ) -> Result<SVector<T, N>, Error> {
+        match self.limit {
+            Some(limit) if s.q[0] > limit => Err(Error::Singularity {
+                what: "past the limit",
+            }),
+            _ => Ok(self.rhs(s)),
+        }
+    }
+}
+
+/// How the runs of one mechanism ended: the failed steps seen, by error.
+#[derive(Default)]
+struct Seen {
+    non_finite: Vec<u64>,
+    refused: Vec<u64>,
+    finished: usize,
+}
+
+/// `integrate` against `integrate_with` for runs of many lengths and step sizes, from `q0`.
+fn compare<T: Real, const N: usize>(mechanism: &Runaway<T, N>, seen: &mut Seen) {
+    let q0: [T; N] = core::array::from_fn(|i| T::from_f64(1.0 + 0.25 * i as f64));
+    let start = State::new(T::from_f64(0.5), q0, [T::zero(); N]);
+    for dt in [0.013, 0.021, 0.034, 0.055, 0.089, 0.144] {
+        let dt = T::from_f64(dt);
+        for steps in [0, 1, 7, 8, 9, 15, 16, 17, 23, 40, 63, 200] {
+            let unobserved = Rk4.integrate(mechanism, &start, dt, steps);
+            let mut states = 0u64;
+            let observed = Rk4.integrate_with(mechanism, &start, dt, steps, |s| {
+                assert!(s.is_finite(), "an observer saw {s:?}");
+                states += 1;
+            });
+            // Debug prints each number so that it reads back to the same bits.
+            assert_eq!(
+                format!("{unobserved:?}"),
+                format!("{observed:?}"),
+                "dt {dt:?}, {steps} steps"
+            );
+            match observed {
+                Ok(s) => {
+                    assert!(s.is_finite());
+                    assert_eq!(states, steps);
+                    seen.finished += 1;
+                }
+                Err(f) => {
+                    assert!(f.last.is_finite());
+                    assert_eq!(states, f.step);
+                    match f.error {
+                        Error::NonFiniteState => seen.non_finite.push(f.step),
+                        Error::Singularity { .. } => seen.refused.push(f.step),
+                        e => unreachable!("a runaway fails only so, not with {e:?}"),
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// Checks that the runs failed within the untested steps (not only at a tested one, the
+/// eighth), so that the steps taken again were exercised.
+fn mid_chunk(steps: &[u64]) -> bool {
+    steps.iter().any(|k| k % 8 != 7) && steps.iter().any(|k| *k >= 8)
+}
+
+/// Runs that overflow and runs the law refuses, through the stages' own test of the
+/// accelerations (2 coordinates) and through the law alone (6).
+fn unobserved_runs_end_as_observed_runs<T: Real>() -> Result<(), Error> {
+    let mut overflow = Seen::default();
+    let k = T::one();
+    compare(&Runaway::<T, 2> { k, limit: None }, &mut overflow);
+    compare(&Runaway::<T, 6> { k, limit: None }, &mut overflow);
+    let mut refused = Seen::default();
+    let limit = Some(T::from_f64(30.0));
+    compare(&Runaway::<T, 2> { k: T::one(), limit }, &mut refused);
+    compare(&Runaway::<T, 6> { k: T::one(), limit }, &mut refused);
+    assert!(mid_chunk(&overflow.non_finite), "{:?}", overflow.non_finite);
+    assert!(mid_chunk(&refused.refused), "{:?}", refused.refused);
+    assert!(overflow.finished > 0 && refused.finished > 0);
+    Ok(())
+}
+
+for_f32_and_f64!(unobserved_runs_end_as_observed_runs);
