@@ -1,6 +1,6 @@
 //! Fixed-size Cholesky solve of `M x = b` for a symmetric positive definite mass matrix.
 
-use crate::{Error, Real};
+use crate::{all_finite, Error, Real};
 use nalgebra::{SMatrix, SVector};
 
 /// Solves `m x = b` for symmetric positive definite `m` by Cholesky factorisation, on the
@@ -30,7 +30,7 @@ pub fn solve_spd<T: Real, const N: usize>(
     b: &SVector<T, N>,
 ) -> Result<SVector<T, N>, Error> {
     let x = Cholesky::factor(m)?.solve(b);
-    if x.iter().all(|v| v.is_finite()) {
+    if all_finite(x.as_slice()) {
         Ok(x)
     } else {
         Err(Error::NonFiniteState)

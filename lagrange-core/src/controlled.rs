@@ -1,7 +1,7 @@
 //! [`Controlled`]: a mechanism with an input that its owner sets between steps.
 
 use crate::forces::{Forced, Input};
-use crate::{Error, Real};
+use crate::{all_finite, Error, Real};
 use nalgebra::SVector;
 
 /// A mechanism driven by an input that the caller sets between steps and that is held
@@ -53,7 +53,7 @@ impl<T: Real, const N: usize, M> Controlled<T> for Forced<M, Input<T, N>> {
     }
 
     fn set_input(&mut self, input: SVector<T, N>) -> Result<(), Error> {
-        if input.iter().all(|x| x.is_finite()) {
+        if all_finite(input.as_slice()) {
             self.force_mut().value = input;
             Ok(())
         } else {

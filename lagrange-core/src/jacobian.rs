@@ -1,7 +1,7 @@
 //! [`Jacobian`]: derivatives with respect to `q` and `q'`, and the central-difference default
 //! ([`central_difference_jacobian`]) that exact dual-number Jacobians override.
 
-use crate::{Real, State};
+use crate::{all_finite, Real, State};
 use nalgebra::{SMatrix, SVector};
 
 /// The derivatives of a vector function `g(t, q, q')` of a state: `dg/dq` and `dg/dq'`, column
@@ -27,10 +27,7 @@ impl<T: Real, const N: usize> Jacobian<T, N> {
     /// True when every entry of both blocks is finite.
     #[must_use]
     pub fn is_finite(&self) -> bool {
-        self.wrt_q
-            .iter()
-            .chain(self.wrt_qd.iter())
-            .all(|x| x.is_finite())
+        all_finite(self.wrt_q.as_slice()) & all_finite(self.wrt_qd.as_slice())
     }
 }
 

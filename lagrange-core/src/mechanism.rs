@@ -4,8 +4,8 @@
 use crate::constraints::{Constrained, Constraints, Held};
 use crate::forces::{Forced, NoForce};
 use crate::{
-    central_difference_jacobian, solve_spd, Error, GeneralizedForce, Jacobian, Lagrangian, Lanes,
-    Real, State,
+    all_finite, central_difference_jacobian, solve_spd, Error, GeneralizedForce, Jacobian,
+    Lagrangian, Lanes, Real, State,
 };
 use nalgebra::{SMatrix, SVector};
 
@@ -255,12 +255,12 @@ pub trait Mechanism<T: Real, const N: usize>: Lagrangian<T, N> {
 
 /// `v` when every component is finite, else [`Error::NonFiniteState`].
 ///
-/// Every component is tested, without stopping at the first that fails: the tests then
-/// vectorise, and there is one branch, not one per component (the profile of a DOP853 step of
-/// a 40-coordinate system showed the test as a scalar loop with a branch per component).
+/// Every component is tested ([`all_finite`]), with one branch for all (the profile of a
+/// DOP853 step of a 40-coordinate system showed the test as a scalar loop with a branch per
+/// component).
 #[inline(always)]
 pub(crate) fn finite<T: Real, const N: usize>(v: SVector<T, N>) -> Result<SVector<T, N>, Error> {
-    if v.iter().fold(true, |all, x| all & x.is_finite()) {
+    if all_finite(v.as_slice()) {
         Ok(v)
     } else {
         Err(Error::NonFiniteState)

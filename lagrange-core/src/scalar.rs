@@ -140,6 +140,25 @@ pub trait Real:
     fn sin_cos_lanes<const L: usize>(x: [Self; L]) -> ([Self; L], [Self; L]);
 }
 
+/// True when every value is finite (neither NaN nor infinite).
+///
+/// Every value is tested, without stopping at the first that fails, over a slice: the tests
+/// then vectorise, with one branch for all. (Over nalgebra's own iterators, `v.iter()`, they
+/// do not: the test of a 40-coordinate chain's accelerations in `f32` took 70 ns that way, a
+/// sixth of an RK4 step.) Give it a vector's `as_slice()`.
+///
+/// ```
+/// use lagrange_core::all_finite;
+/// assert!(all_finite(&[1.0f32, -2.0, 0.0]));
+/// assert!(!all_finite(&[1.0f64, f64::NAN]));
+/// assert!(!all_finite(&[f32::INFINITY]));
+/// ```
+#[inline(always)]
+#[must_use]
+pub fn all_finite<T: Real>(values: &[T]) -> bool {
+    values.iter().fold(true, |all, x| all & x.is_finite())
+}
+
 /// `sin_cos` of each value, one at a time.
 #[inline]
 pub(crate) fn sin_cos_each<S: Scalar, const L: usize>(x: [S; L]) -> ([S; L], [S; L]) {

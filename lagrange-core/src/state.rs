@@ -1,6 +1,6 @@
 //! [`State`]: time, generalized coordinates and generalized velocities.
 
-use crate::{Error, Real};
+use crate::{all_finite, Error, Real};
 use nalgebra::SVector;
 
 /// The state of a mechanism with `N` degrees of freedom at time `t`.
@@ -36,12 +36,11 @@ impl<T: Real, const N: usize> State<T, N> {
     /// True when `t`, every coordinate and every velocity are finite.
     #[must_use]
     ///
-    /// Every component is tested, without stopping at the first that fails: the tests then
-    /// vectorise, with one branch instead of one per component, in every step's check.
+    /// Every component is tested ([`all_finite`](crate::all_finite)), with one branch for all,
+    /// in every step's check.
     #[inline]
     pub fn is_finite(&self) -> bool {
-        let all = |v: &SVector<T, N>| v.iter().fold(true, |all, x| all & x.is_finite());
-        self.t.is_finite() & all(&self.q) & all(&self.qd)
+        self.t.is_finite() & all_finite(self.q.as_slice()) & all_finite(self.qd.as_slice())
     }
 
     /// `Ok(())` when finite, else [`Error::NonFiniteState`].

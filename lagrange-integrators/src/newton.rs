@@ -3,7 +3,7 @@
 //! Jacobian refreshed when convergence slows, and a fixed-point start where that converges.
 
 use lagrange_core::nalgebra::{SMatrix, SVector};
-use lagrange_core::{Error, Real};
+use lagrange_core::{all_finite, Error, Real};
 
 /// How an implicit method iterates to solve its step equations.
 ///
@@ -180,8 +180,8 @@ fn exceeds<T: Real>(x: T, limit: T) -> bool {
 }
 
 /// True when every entry is finite.
-fn all_finite<T: Real, const N: usize, const S: usize>(x: &Blocks<T, N, S>) -> bool {
-    x.iter().flat_map(|v| v.iter()).all(|v| v.is_finite())
+fn all_blocks_finite<T: Real, const N: usize, const S: usize>(x: &Blocks<T, N, S>) -> bool {
+    x.iter().all(|v| all_finite(v.as_slice()))
 }
 
 /// An LU factorisation `P A = L U` with partial pivoting.
@@ -200,13 +200,7 @@ impl<T: Real, const N: usize, const S: usize> Lu<T, N, S> {
     /// when a pivot column is zero.
     pub fn factor(mut a: BlockMatrix<T, N, S>) -> Result<Self, Error> {
         let n = N * S;
-        if !a
-            .0
-            .iter()
-            .flatten()
-            .flat_map(|b| b.iter())
-            .all(|x| x.is_finite())
-        {
+        if !a.0.iter().flatten().all(|b| all_finite(b.as_slice())) {
             return Err(Error::NonFiniteState);
         }
         let mut pivots = [[0; N]; S];
@@ -328,7 +322,7 @@ where
     let mut previous: Option<T> = None;
     for iteration in 1..=settings.max_iterations {
         let r = problem.residual(x)?;
-        if !all_finite(&r) {
+        if !all_blocks_finite(&r) {
             return Err(Error::NonFiniteState);
         }
         let dx = if fixed_point {
@@ -350,7 +344,7 @@ where
         for (xi, di) in x.iter_mut().zip(dx.iter()) {
             *xi -= di;
         }
-        if !all_finite(x) {
+        if !all_blocks_finite(x) {
             return Err(Error::NonFiniteState);
         }
         let size = weighted_size(&dx, &problem.weights(x));

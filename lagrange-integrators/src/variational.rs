@@ -9,8 +9,8 @@ use crate::newton::{self, BlockMatrix, Blocks, NewtonProblem, NewtonSettings, St
 use crate::{Clock, Integrator, Method, SymmetricBase};
 use lagrange_core::nalgebra::{SMatrix, SVector};
 use lagrange_core::{
-    central_difference_jacobian, Dual, Error, Jacobian, Lagrangian, Mechanism, NoForce, Real,
-    Scalar, State,
+    all_finite, central_difference_jacobian, Dual, Error, Jacobian, Lagrangian, Mechanism, NoForce,
+    Real, Scalar, State,
 };
 
 /// A state in position-momentum form: time, coordinates and the discrete momenta `p`
@@ -29,9 +29,7 @@ impl<T: Real, const N: usize> PhaseState<T, N> {
     /// True when `t`, every coordinate and every momentum are finite.
     #[must_use]
     pub fn is_finite(&self) -> bool {
-        self.t.is_finite()
-            && self.q.iter().all(|x| x.is_finite())
-            && self.p.iter().all(|x| x.is_finite())
+        self.t.is_finite() & all_finite(self.q.as_slice()) & all_finite(self.p.as_slice())
     }
 }
 

@@ -4,7 +4,7 @@
 use lagrange_core::constraints::{Constraints, HolonomicConstraints};
 use lagrange_core::nalgebra::{Matrix2x3, SMatrix, SVector, Vector2, Vector3};
 use lagrange_core::{
-    validate, Error, GeneralizedForce, Lagrangian, Mechanism, Real, Scalar, State,
+    all_finite, validate, Error, GeneralizedForce, Lagrangian, Mechanism, Real, Scalar, State,
 };
 
 /// Which of the two ways to close the loop at a given crank angle: the coupler-rocker joint
@@ -258,7 +258,7 @@ impl<T: Real> FourBarLinkage<T> {
             (i1 * b[1] - kc * b[0]) / det,
             b[2] / i3,
         );
-        if x.iter().all(|v| v.is_finite()) {
+        if all_finite(x.as_slice()) {
             Ok(x)
         } else {
             Err(Error::NonFiniteState)

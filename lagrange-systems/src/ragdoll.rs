@@ -5,7 +5,8 @@ use core::cmp::Ordering;
 
 use lagrange_core::nalgebra::{SMatrix, SVector};
 use lagrange_core::{
-    free_law_force, validate, Error, GeneralizedForce, Lagrangian, Mechanism, Real, Scalar, State,
+    all_finite, free_law_force, validate, Error, GeneralizedForce, Lagrangian, Mechanism, Real,
+    Scalar, State,
 };
 
 /// Generalized coordinates of a [`Ragdoll`]: the torso's position and angle, then nine joints.
@@ -617,7 +618,7 @@ impl<T: Real> Ragdoll<T> {
         qdd[0] = a0[1] - qd[2] * qd[1];
         qdd[1] = a0[2] + qd[2] * qd[0];
         qdd[2] = a0[0];
-        if qdd.iter().all(|x| x.is_finite()) {
+        if all_finite(qdd.as_slice()) {
             Ok(qdd)
         } else {
             Err(Error::NonFiniteState)

@@ -3,7 +3,7 @@
 
 use lagrange_core::constraints::{Constraints, PfaffianConstraints};
 use lagrange_core::nalgebra::{Matrix2x4, SMatrix, SVector, Vector2, Vector4};
-use lagrange_core::{validate, Error, Lagrangian, Mechanism, Real, Scalar, State};
+use lagrange_core::{all_finite, validate, Error, Lagrangian, Mechanism, Real, Scalar, State};
 
 /// A uniform thin disk of mass `m` and radius `R` held upright (no tilt) and rolling without
 /// slipping on a horizontal plane: free to turn about the vertical and to roll, but its
@@ -122,7 +122,7 @@ impl<T: Real> Mechanism<T, 4> for RollingDisk<T> {
     }
     fn solve_mass(&self, _s: &State<T, 4>, b: &Vector4<T>) -> Result<Vector4<T>, Error> {
         let x = b.component_div(&self.inertias());
-        if x.iter().all(|v| v.is_finite()) {
+        if all_finite(x.as_slice()) {
             Ok(x)
         } else {
             Err(Error::NonFiniteState)

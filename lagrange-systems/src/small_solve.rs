@@ -2,7 +2,7 @@
 //! diagonal solve that reports the configuration where a diagonal entry vanishes.
 
 use lagrange_core::nalgebra::{Matrix2, SVector, Vector2};
-use lagrange_core::{Error, Real, State};
+use lagrange_core::{all_finite, Error, Real, State};
 
 /// Solves the symmetric positive definite 2x2 system `m x = b` by its closed-form inverse.
 ///
@@ -89,9 +89,7 @@ pub(crate) fn radial_accelerations<T: Real>(
     m_r2: T,
     what: &'static str,
 ) -> Result<Vector2<T>, Error> {
-    let good = qdd
-        .iter()
-        .fold(s.t.is_finite(), |all, x| all & x.is_finite());
+    let good = s.t.is_finite() & all_finite(qdd.as_slice());
     if good && s.q[0] > T::zero() && m_r2 > T::zero() {
         return Ok(qdd);
     }
@@ -106,7 +104,7 @@ pub(crate) fn finite<T: Real, const N: usize>(
     error: Error,
 ) -> Result<SVector<T, N>, Error> {
     // Every entry tested, without a branch per entry (as `Mechanism::acceleration`'s test).
-    if x.iter().fold(true, |all, v| all & v.is_finite()) {
+    if all_finite(x.as_slice()) {
         Ok(x)
     } else {
         Err(error)

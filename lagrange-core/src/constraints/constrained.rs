@@ -4,8 +4,8 @@
 use super::{Constraints, Schur};
 use crate::mechanism::{finite, finite_jacobian};
 use crate::{
-    validate, Error, GeneralizedForce, Jacobian, Lagrangian, Mechanism, NoForce, Real, Scalar,
-    State,
+    all_finite, validate, Error, GeneralizedForce, Jacobian, Lagrangian, Mechanism, NoForce, Real,
+    Scalar, State,
 };
 use nalgebra::{SMatrix, SVector};
 
@@ -209,11 +209,7 @@ pub(crate) fn solve_kkt<T: Real, const N: usize, const C: usize>(
 ) -> Result<ConstrainedAcceleration<T, N, C>, Error> {
     let multipliers = schur.multipliers(&(target - schur.jacobian() * free_acceleration));
     let acceleration = free_acceleration + schur.response(&multipliers);
-    if acceleration
-        .iter()
-        .chain(multipliers.iter())
-        .all(|x| x.is_finite())
-    {
+    if all_finite(acceleration.as_slice()) & all_finite(multipliers.as_slice()) {
         Ok(ConstrainedAcceleration {
             acceleration,
             multipliers,

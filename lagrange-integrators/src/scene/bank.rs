@@ -5,7 +5,7 @@ use super::{NeverSleeps, Sleep, Sleeps};
 use crate::Integrator;
 use heapless::Vec;
 use lagrange_core::nalgebra::SVector;
-use lagrange_core::{divergences, Controlled, Error, Lanes, Mechanism, Real, State};
+use lagrange_core::{all_finite, divergences, Controlled, Error, Lanes, Mechanism, Real, State};
 
 /// A handle to an instance of a [`Bank`], given by [`Bank::add`]. It stays valid until the
 /// instance is removed; after that it names nothing ([`Error::NoSuchInstance`]), even when
@@ -500,7 +500,7 @@ where
     /// the new velocities are not finite. Nothing changes on an error.
     pub fn apply_impulse(&mut self, id: Id, impulse: &SVector<T, N>) -> Result<(), Error> {
         let place = self.place(id)?;
-        if !impulse.iter().all(|x| x.is_finite()) {
+        if !all_finite(impulse.as_slice()) {
             return Err(Error::InvalidParameter {
                 name: "impulse",
                 reason: "must be finite",
@@ -508,7 +508,7 @@ where
         }
         let slot = self.at_mut(place)?;
         let qd = slot.current.qd + slot.mechanism.velocity_jump(&slot.current, impulse)?;
-        if !qd.iter().all(|x| x.is_finite()) {
+        if !all_finite(qd.as_slice()) {
             return Err(Error::NonFiniteState);
         }
         slot.current.qd = qd;
