@@ -105,9 +105,10 @@ impl<T: Real, const B: usize, const N: usize> Mechanism<T, N> for NBody<T, B, N>
         s: &State<T, N>,
         extra: &F,
     ) -> Result<SVector<T, N>, Error> {
-        let mut a = [T::zero(); N];
-        gravity(&self.m, &s.q.into(), &mut a);
-        let a = SVector::from(a);
+        // In place: the coordinates read and the accelerations written as the vectors' own
+        // arrays, not copies of them.
+        let mut a = SVector::zeros();
+        gravity(&self.m, &s.q.data.0[0], &mut a.data.0[0]);
         if F::IS_ZERO {
             Ok(a)
         } else {
