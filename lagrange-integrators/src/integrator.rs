@@ -349,6 +349,8 @@ pub(crate) fn unobserved_loop<T: Real, const N: usize>(
                 failed = true;
                 break;
             };
+            // The step's own time, which `finish` tests before the clock's replaces it.
+            failed |= !next.t.is_finite();
             clock.tick(dt);
             next.t = clock.time();
             s = next;
