@@ -145,7 +145,9 @@ pub trait Real:
 /// Every value is tested, without stopping at the first that fails, over a slice: the tests
 /// then vectorise, with one branch for all. (Over nalgebra's own iterators, `v.iter()`, they
 /// do not: the test of a 40-coordinate chain's accelerations in `f32` took 70 ns that way, a
-/// sixth of an RK4 step.) Give it a vector's `as_slice()`.
+/// sixth of an RK4 step.) Give it a vector's `as_slice()`. Over [`Lanes`](crate::Lanes), where
+/// each test of a value whose lanes disagree counts a divergence, not stopping at the first
+/// failure may count more of them: the answer is the same.
 ///
 /// ```
 /// use lagrange_core::all_finite;
