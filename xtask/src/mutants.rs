@@ -122,6 +122,8 @@ const AREAS: [Area; 14] = [
             "--test",
             "work_counts",
             "--test",
+            "unobserved_runs",
+            "--test",
             "bad_input",
         ],
         unit_tests: false,
