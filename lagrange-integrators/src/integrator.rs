@@ -269,8 +269,12 @@ pub(crate) fn step_loop<T: Real, const N: usize>(
     tested_steps(state, &mut clock, (0, steps), dt, advance, observe)
 }
 
-/// The [`Failure`] of step `step` from `last`.
-fn fail<T: Real, const N: usize>(error: Error, step: u64, last: &State<T, N>) -> Failure<T, N> {
+/// The [`Failure`] of step `step` from `last`: every run's way of reporting one.
+pub(crate) fn fail<T: Real, const N: usize>(
+    error: Error,
+    step: u64,
+    last: &State<T, N>,
+) -> Failure<T, N> {
     Failure {
         error,
         step,

@@ -2,7 +2,7 @@
 //! Lagrangian, with discrete forces (Lagrange-d'Alembert), in position-momentum form.
 
 use crate::integrator::{
-    check_run, check_run_step, check_signed, check_signed_run, check_step, continues, Cost,
+    check_run, check_run_step, check_signed, check_signed_run, check_step, continues, fail, Cost,
     Failure, Work,
 };
 use crate::newton::{self, BlockMatrix, Blocks, NewtonProblem, NewtonSettings, Start};
@@ -505,11 +505,6 @@ impl<T: Real, const N: usize, M: Mechanism<T, N>> Integrator<T, N, M>
         dt: T,
         steps: u64,
     ) -> Result<State<T, N>, Failure<T, N>> {
-        let fail = |error, step, last: &State<T, N>| Failure {
-            error,
-            step,
-            last: *last,
-        };
         let dt = check_run(state, dt, steps).map_err(|e| fail(e, 0, state))?;
         if steps == 0 {
             return Ok(*state);

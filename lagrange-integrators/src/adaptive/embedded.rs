@@ -3,7 +3,7 @@
 
 use super::controller::PiController;
 use super::AdaptiveSettings;
-use crate::integrator::{check_step, continues, Cost, Failure, Work};
+use crate::integrator::{check_step, continues, fail, Cost, Failure, Work};
 use crate::{Integrator, Method};
 use core::marker::PhantomData;
 use lagrange_core::nalgebra::SVector;
@@ -723,11 +723,6 @@ where
         t_end: T,
         exact_end: bool,
     ) -> Result<State<T, N>, Failure<T, N>> {
-        let fail = |error, step, last: &State<T, N>| Failure {
-            error,
-            step,
-            last: *last,
-        };
         let t_end = check_end(state, t_end).map_err(|e| fail(e, 0, state))?;
         self.begin(mechanism, state)
             .map_err(|e| fail(e, 0, state))?;

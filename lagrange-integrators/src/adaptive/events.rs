@@ -2,6 +2,7 @@
 //! accepted points) and event location by root finding on it.
 
 use super::embedded::{check_end, combine, real, EmbeddedPair, EmbeddedRungeKutta};
+use crate::integrator::fail;
 use crate::Failure;
 use lagrange_core::nalgebra::SVector;
 use lagrange_core::{Error, Mechanism, Real, State};
@@ -195,11 +196,6 @@ where
         M: Mechanism<T, N>,
         G: FnMut(&State<T, N>) -> T,
     {
-        let fail = |error, step, last: &State<T, N>| Failure {
-            error,
-            step,
-            last: *last,
-        };
         let t_end = check_end(state, t_end).map_err(|e| fail(e, 0, state))?;
         self.begin(mechanism, state)
             .map_err(|e| fail(e, 0, state))?;
