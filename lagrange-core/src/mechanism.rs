@@ -130,6 +130,28 @@ pub trait Mechanism<T: Real, const N: usize>: Lagrangian<T, N> {
         finite(self.mass_matrix(state) * qdd - self.rhs(state))
     }
 
+    /// Whether the law reads the velocities `q'`: `true` unless the type says otherwise (the
+    /// safe answer). A Runge-Kutta-Nyström pair (`lagrange-integrators`'
+    /// `DormandPrinceNystrom64`, say) steps only laws `q'' = f(t, q)`, and refuses a mechanism
+    /// that answers `true`.
+    /// Answer `false` only when [`Mechanism::law`] with no extra force gives the same
+    /// accelerations whatever `q'` is (no damping, no Coriolis or centrifugal terms, no
+    /// velocity-dependent force).
+    ///
+    /// ```
+    /// use lagrange_core::prelude::*;
+    /// # struct Spring;
+    /// # impl Lagrangian<f64, 1> for Spring {
+    /// #     fn kinetic<S: Scalar<Real = f64>>(&self, _: S, _: &SVector<S, 1>, qd: &SVector<S, 1>) -> S { qd[0] * qd[0] * 0.5 }
+    /// #     fn potential<S: Scalar<Real = f64>>(&self, _: S, q: &SVector<S, 1>) -> S { q[0] * q[0] * 0.5 }
+    /// # }
+    /// // The automatic law cannot know: it says it reads them.
+    /// assert!(EulerLagrange::new(Spring).reads_velocities());
+    /// ```
+    fn reads_velocities(&self) -> bool {
+        true
+    }
+
     /// The generalized accelerations `q''` (the law with no extra force).
     ///
     /// # Errors

@@ -5,7 +5,8 @@
 
 pub use crate::scene::{Bank, NeverSleeps, Scene, Sleeps};
 pub use crate::{
-    AdaptiveSettings, DormandPrince54, DormandPrince853, FixedTimestep, GaussLegendre2, Integrator,
-    Method, Projected, Rk4, StormerVerlet, VariationalMidpoint, Yoshida4,
+    AdaptiveSettings, DormandPrince54, DormandPrince853, DormandPrinceNystrom1210,
+    DormandPrinceNystrom64, FixedTimestep, GaussLegendre2, Integrator, Method, Projected, Rk4,
+    StormerVerlet, VariationalMidpoint, Yoshida4,
 };
 pub use lagrange_core::prelude::*;

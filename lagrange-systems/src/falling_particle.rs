@@ -85,6 +85,10 @@ impl<T: Real> Mechanism<T, 1> for FallingParticle<T> {
     ) -> Result<SVector<T, 1>, Error> {
         free_law_force(self, s, extra)
     }
+    /// Never: the acceleration is `-g`.
+    fn reads_velocities(&self) -> bool {
+        false
+    }
 }
 
 impl<T: Real> Lagrangian<T, 1> for FallingParticle<T> {

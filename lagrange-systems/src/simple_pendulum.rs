@@ -152,6 +152,10 @@ impl<T: Real> Mechanism<T, 1> for SimplePendulum<T> {
     ) -> Result<SVector<T, 1>, Error> {
         free_law_force(self, s, extra)
     }
+    /// Only through the damping: an undamped pendulum's law is `q'' = -(g/L) sin q`.
+    fn reads_velocities(&self) -> bool {
+        self.damping != T::zero()
+    }
 }
 
 impl<T: Real> Lagrangian<T, 1> for SimplePendulum<T> {

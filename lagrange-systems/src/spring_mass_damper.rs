@@ -97,6 +97,10 @@ impl<T: Real> Mechanism<T, 1> for SpringMassDamper<T> {
     ) -> Result<SVector<T, 1>, Error> {
         free_law_force(self, s, extra)
     }
+    /// Only through the damping.
+    fn reads_velocities(&self) -> bool {
+        self.damping != T::zero()
+    }
 }
 
 impl<T: Real> Lagrangian<T, 1> for SpringMassDamper<T> {

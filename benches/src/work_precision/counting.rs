@@ -82,4 +82,7 @@ impl<T: Real, const N: usize, M: Mechanism<T, N>> Mechanism<T, N> for Counting<'
     ) -> Result<SVector<T, N>, Error> {
         self.inner.law_force(s, extra)
     }
+    fn reads_velocities(&self) -> bool {
+        self.inner.reads_velocities()
+    }
 }

@@ -361,6 +361,9 @@ impl<M: Mechanism<f64, N>, const N: usize> Mechanism<f64, N> for Recording<'_, M
     ) -> Result<(SVector<f64, N>, Jacobian<f64, N>), Error> {
         self.inner.law_jacobian(s, extra)
     }
+    fn reads_velocities(&self) -> bool {
+        self.inner.reads_velocities()
+    }
 }
 
 /// A Lagrangian with its claim of a constant mass matrix withdrawn: the automatic path's

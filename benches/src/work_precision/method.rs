@@ -10,7 +10,7 @@ use lagrange_core::{Error, Mechanism, Real, State};
 use lagrange_integrators::{
     AdaptiveSettings, BackwardEuler, Clock, Dop853Pair, Dopri5Pair, EmbeddedPair,
     EmbeddedRungeKutta, ExplicitEuler, Failure, GaussLegendre2, ImplicitMidpoint, Integrator,
-    RadauIIA2, Rk4, SemiImplicitEuler, StormerVerlet, VariationalMidpoint, VelocityVerlet,
+    Nystrom1210Pair, Nystrom64Pair, RadauIIA2, Rk4, SemiImplicitEuler, StormerVerlet, VariationalMidpoint, VelocityVerlet,
     Yoshida4,
 };
 use std::marker::PhantomData;
@@ -160,6 +160,8 @@ pub fn for_each(v: &mut impl MethodVisitor) {
     v.visit(&Adaptive::<16, 4, Dop853Pair>::new(
         Tableau::DormandPrince853,
     ));
+    v.visit(&Adaptive::<6, 2, Nystrom64Pair>::unpaired());
+    v.visit(&Adaptive::<18, 2, Nystrom1210Pair>::unpaired());
     v.visit(&HandRk4);
     v.visit(&OdeSolvers(Peer::Dopri5));
     v.visit(&OdeSolvers(Peer::Dop853));
@@ -344,7 +346,7 @@ impl<F: FixedStep> Method for Library<F> {
 
 /// An adaptive embedded Runge-Kutta pair of the library (`S` stages, `R` dense-output rows).
 pub struct Adaptive<const S: usize, const R: usize, P> {
-    tableau: Tableau,
+    tableau: Option<Tableau>,
     pair: PhantomData<P>,
 }
 
@@ -352,7 +354,15 @@ impl<const S: usize, const R: usize, P> Adaptive<S, R, P> {
     /// The pair `P`, whose coefficients are `tableau`'s.
     pub fn new(tableau: Tableau) -> Self {
         Self {
-            tableau,
+            tableau: Some(tableau),
+            pair: PhantomData,
+        }
+    }
+
+    /// The pair `P`, which no peer has.
+    pub fn unpaired() -> Self {
+        Self {
+            tableau: None,
             pair: PhantomData,
         }
     }
@@ -372,7 +382,7 @@ impl<const S: usize, const R: usize, Pair: EmbeddedPair<S, R>> Method for Adapti
         Kind::Adaptive
     }
     fn tableau(&self) -> Option<Tableau> {
-        Some(self.tableau)
+        self.tableau
     }
     fn solve<T, P, M, const N: usize, const N2: usize>(
         &self,
@@ -391,6 +401,10 @@ impl<const S: usize, const R: usize, Pair: EmbeddedPair<S, R>> Method for Adapti
         let Param::Tolerance(tol) = param else {
             return None;
         };
+        // A Nyström pair does not apply to a law that reads the velocities.
+        if Pair::NYSTROM.is_some() && mechanism.reads_velocities() {
+            return None;
+        }
         let solve = || -> Result<Outcome<T, N>, String> {
             let tol = T::real(tol);
             let settings = AdaptiveSettings::new(tol, tol)

@@ -39,6 +39,49 @@ pub trait EmbeddedPair<const S: usize, const R: usize> {
     const E3: Option<[f64; S]>;
     /// The dense-output rows beyond the cubic Hermite part: `d_r = h sum_j DENSE[r][j] k_j`.
     const DENSE: [[f64; S]; R];
+    /// The position half of a Runge-Kutta-Nyström pair ([`Nystrom`]); `None`, the default,
+    /// for a pair of the first-order system `y' = (q', q'')`.
+    const NYSTROM: Option<Nystrom<S>> = None;
+}
+
+/// The position half of a Runge-Kutta-Nyström pair, which steps laws `q'' = f(t, q)` that do
+/// not read `q'` ([`Mechanism::reads_velocities`] `false`) with fewer stages than a pair of
+/// the first-order system needs for the same order.
+///
+/// ```text
+/// stage i:  q_i = q0 + h (c_i q0' + h sum_j ABAR[i][j] kv_j),   q_i' = q0'
+/// stage FSAL: (t0 + h, q1, q1'),   q1 = its row of ABAR,   q1' = q0' + h sum_j A[FSAL][j] kv_j
+/// error:    e_q = h^2 sum_j E[j] kv_j,   e_q' = h sum_j EmbeddedPair::E[j] kv_j
+/// ```
+///
+/// `A`'s row `FSAL` holds the velocity weights `b'` and may use the stage `FSAL` itself
+/// (evaluated at `q1`, before `q1'` is formed); its other rows are zero: a stage's velocity is
+/// `q0'`, which the law does not read. The dense output is the quintic Hermite interpolant of
+/// `q` through `(q, q', q'')` at both ends, and its derivative for `q'` (orders 5 and 4, no
+/// evaluation), in two rows (`R = 2`; `DENSE` is unused).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Nystrom<const S: usize> {
+    /// The position coefficients `abar_ij`, lower triangular (row `FSAL` is `b`).
+    pub abar: [[f64; S]; S],
+    /// The weights of the position error estimate.
+    pub e: [f64; S],
+}
+
+/// The square matrix whose row `i` starts with `rows[i]` (at most `i + 1` entries; zeros
+/// after): a lower-triangular tableau written row by row, without its zeros.
+#[must_use]
+pub const fn lower_triangular<const S: usize>(rows: [&[f64]; S]) -> [[f64; S]; S] {
+    let mut m = [[0.0; S]; S];
+    let mut i = 0;
+    while i < S {
+        let mut j = 0;
+        while j < rows[i].len() {
+            m[i][j] = rows[i][j];
+            j += 1;
+        }
+        i += 1;
+    }
+    m
 }
 
 /// Work counts since the integrator was made or restarted.
@@ -233,12 +276,29 @@ fn step_into<T: Real, const N: usize>(
     }
 }
 
+/// `out = q0 + (q0' c + (sum_j w_j kv_j) h) h`: a Nyström stage's position ([`Nystrom`]).
+#[inline(always)]
+fn nystrom_position<T: Real, const N: usize>(
+    out: &mut SVector<T, N>,
+    y0: &State<T, N>,
+    w: &[f64],
+    c: f64,
+    kv: &[SVector<T, N>],
+    h: T,
+) {
+    let c = real::<T>(c);
+    for (i, o) in out.as_mut_slice().iter_mut().enumerate() {
+        let v = y0.qd.as_slice()[i];
+        *o = y0.q.as_slice()[i] + (v * c + stage_sum(w, kv, i) * h) * h;
+    }
+}
+
 /// Evaluates stages `1..=P::FSAL` of a step, each with a constant index (so that
 /// [`combine`] sees constant rows): one line per possible stage, those past `FSAL` skipped at
 /// compile time. Leaves the state of stage `FSAL`, `(t0 + h, y1)`, in `$last`.
 macro_rules! run_stages {
     ($rk:ident, $m:ident, $y0:ident, $h:ident, $last:ident; $($i:literal)*) => {
-        const { assert!(P::FSAL <= 12, "run_stages! covers pairs of up to 12 step stages") };
+        const { assert!(P::FSAL <= 17, "run_stages! covers pairs of up to 17 step stages") };
         $(
             if $i <= P::FSAL {
                 $rk.stage::<M, $i>($m, &$y0, $h, &mut $last)?;
@@ -319,6 +379,12 @@ where
         m: &M,
         state: &State<T, N>,
     ) -> Result<(), Error> {
+        if P::NYSTROM.is_some() && m.reads_velocities() {
+            return Err(Error::InvalidParameter {
+                name: "mechanism",
+                reason: "reads the velocities: a Nyström pair steps only laws q'' = f(t, q)",
+            });
+        }
         state.check_finite()?;
         if self.output.is_some_and(|out| continues(&out, state)) {
             return Ok(());
@@ -445,11 +511,11 @@ where
         // The time too, on the factor `|h|`, which is known before the estimate.
         let h = h.abs() + nan_unless_finite(y1.t);
         let n = T::from_f64(2.0 * N as f64);
-        let err5 = self.weighted_sum_sq(&P::E[..=P::FSAL], &wq, &wv);
+        let err5 = self.weighted_sum_sq(&P::E[..=P::FSAL], h, &wq, &wv);
         match P::E3 {
             None => scaled_square(h, err5 / n),
             Some(e3) => {
-                let err3 = self.weighted_sum_sq(&e3[..=P::FSAL], &wq, &wv);
+                let err3 = self.weighted_sum_sq(&e3[..=P::FSAL], h, &wq, &wv);
                 let mut deno = err5 + real::<T>(0.01) * err3;
                 if deno <= T::zero() {
                     deno = T::one();
@@ -459,10 +525,15 @@ where
         }
     }
 
-    /// `|W_q e_q|^2 + |W_v e_v|^2` for the estimate `e = sum_j w_j k_j`.
+    /// `|W_q e_q|^2 + |W_v e_v|^2` for the estimate `e = sum_j w_j k_j` (of a Nyström pair:
+    /// `e_q = h sum_j E[j] kv_j`, see [`Nystrom`]), to be scaled by `h^2`.
     #[inline(always)]
-    fn weighted_sum_sq(&self, w: &[f64], wq: &SVector<T, N>, wv: &SVector<T, N>) -> T {
-        let eq = combine(w, &self.stages.kq).component_mul(wq);
+    fn weighted_sum_sq(&self, w: &[f64], h: T, wq: &SVector<T, N>, wv: &SVector<T, N>) -> T {
+        let eq = match P::NYSTROM {
+            None => combine(w, &self.stages.kq),
+            Some(ny) => combine(&ny.e[..w.len()], &self.stages.kv) * h,
+        }
+        .component_mul(wq);
         let ev = combine(w, &self.stages.kv).component_mul(wv);
         eq.dot(&eq) + ev.dot(&ev)
     }
@@ -479,6 +550,14 @@ where
     ) -> Result<(), Error> {
         let (row, c) = (&P::A[I][..I], P::C[I]);
         s.t = y0.t + h * real::<T>(c);
+        if let Some(ny) = P::NYSTROM {
+            nystrom_position(&mut s.q, y0, &ny.abar[I][..I], c, &self.stages.kv, h);
+            s.qd = y0.qd;
+            self.stages.kv[I] = self.eval(m, s)?;
+            step_into(&mut s.qd, &y0.qd, &P::A[I][..=I], &self.stages.kv, h);
+            self.stages.kq[I] = s.qd;
+            return Ok(());
+        }
         step_into(&mut s.q, &y0.q, row, &self.stages.kq, h);
         // The stage's q' is its derivative of q too: written to both in the same loop, not
         // copied after.
@@ -505,6 +584,12 @@ where
         // A is strictly lower triangular: stage i combines the stages before it.
         let (row, c) = (&P::A[i][..i], P::C[i]);
         s.t = y0.t + h * real::<T>(c);
+        if let Some(ny) = P::NYSTROM {
+            // The stage's own evaluation is known here (a stage after the step's).
+            nystrom_position(&mut s.q, y0, &ny.abar[i][..i], c, &self.stages.kv, h);
+            step_into(&mut s.qd, &y0.qd, &P::A[i][..=i], &self.stages.kv, h);
+            return;
+        }
         step_into(&mut s.q, &y0.q, row, &self.stages.kq, h);
         step_into(&mut s.qd, &y0.qd, row, &self.stages.kv, h);
     }
@@ -557,7 +642,7 @@ where
                 h = (y0.t + h) - y0.t;
             }
             let mut y1 = y0;
-            run_stages!(self, m, y0, h, y1; 1 2 3 4 5 6 7 8 9 10 11 12);
+            run_stages!(self, m, y0, h, y1; 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17);
             if last {
                 y1.t = t_end;
             }
@@ -794,10 +879,13 @@ where
 {
     /// Lands on `state.t + dt` through the continuous extension, the internal steps as long
     /// as the tolerance allows (they run ahead of the landing; the next call from this one's
-    /// result continues from them).
+    /// result continues from them). A pair whose dense output is more than one order below
+    /// its own (the Nyström pairs: quintic Hermite under orders 6 and 12) lands by a last
+    /// step shortened to `state.t + dt` instead, so that a frame is as accurate as a step.
     fn step(&mut self, m: &M, state: &State<T, N>, dt: T) -> Result<State<T, N>, Error> {
         let dt = check_step(state, dt)?;
-        self.call(|rk| rk.run_to(m, state, state.t + dt, false))
+        let exact_end = P::DENSE_ORDER + 1 < P::ORDER;
+        self.call(|rk| rk.run_to(m, state, state.t + dt, exact_end))
             .map_err(|f| f.error)
     }
 }

@@ -123,6 +123,10 @@ impl<T: Real, const B: usize, const N: usize> Mechanism<T, N> for NBody<T, B, N>
     ) -> Result<SVector<T, N>, Error> {
         free_law_force(self, s, extra)
     }
+    /// Never: gravity reads the positions only.
+    fn reads_velocities(&self) -> bool {
+        false
+    }
 }
 
 /// The Pleiades' masses (star `i` weighs `i`).
