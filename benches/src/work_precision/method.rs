@@ -10,8 +10,8 @@ use lagrange_core::{Error, Mechanism, Real, State};
 use lagrange_integrators::{
     AdaptiveSettings, BackwardEuler, Clock, Dop853Pair, Dopri5Pair, EmbeddedPair,
     EmbeddedRungeKutta, ExplicitEuler, Failure, GaussLegendre2, ImplicitMidpoint, Integrator,
-    Nystrom1210Pair, Nystrom64Pair, RadauIIA2, Rk4, SemiImplicitEuler, StormerVerlet, VariationalMidpoint, VelocityVerlet,
-    Yoshida4,
+    Nystrom1210Pair, Nystrom64Pair, RadauIIA2, Rk4, SemiImplicitEuler, StormerVerlet,
+    VariationalMidpoint, VelocityVerlet, Yoshida4,
 };
 use std::marker::PhantomData;
 

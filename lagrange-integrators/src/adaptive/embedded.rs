@@ -101,7 +101,9 @@ pub(super) type Hermite<T, const N: usize> = [SVector<T, N>; 3];
 
 /// An adaptive explicit Runge-Kutta integrator on the pair `P`: use the aliases
 /// [`DormandPrince54`](crate::DormandPrince54) and
-/// [`DormandPrince853`](crate::DormandPrince853).
+/// [`DormandPrince853`](crate::DormandPrince853), and for laws that do not read the
+/// velocities the Runge-Kutta-Nyström [`DormandPrinceNystrom64`](crate::DormandPrinceNystrom64)
+/// and [`DormandPrinceNystrom1210`](crate::DormandPrinceNystrom1210).
 ///
 /// It advances by steps whose size a PI controller chooses from the embedded error estimate:
 ///
@@ -117,7 +119,9 @@ pub(super) type Hermite<T, const N: usize> = [SVector<T, N>; 3];
 ///
 /// - [`Integrator::step`] lands exactly on `state.t + dt` through the continuous extension
 ///   (dense output), so a frame loop ([`FixedTimestep`](crate::FixedTimestep), a scene) can
-///   drive it with its own steps taken at the size the error control allows, not the frame's;
+///   drive it with its own steps taken at the size the error control allows, not the frame's
+///   (a pair whose dense output is more than an order below its steps, the Nyström pairs',
+///   lands by a last step shortened to the frame's end instead);
 /// - [`EmbeddedRungeKutta::integrate_to`] steps to an end time, its last step shortened to
 ///   land there;
 /// - [`EmbeddedRungeKutta::next_step`] takes one step of the controller's choosing, and
