@@ -471,13 +471,65 @@ fn overhead_summary(s: &mut String, o: &Overhead) {
     }
 }
 
-/// The ratios of issue 17's goals in one place: the engine's own cost per evaluation against
-/// `ode_solvers`' for each N, and the RK4 step against the hand-written loop for each problem.
-fn goals_summary(s: &mut String, ratios: &[Rk4Ratio], o: &Overhead) {
-    if ratios.is_empty() && o.rows.is_empty() {
+/// Issue 17's targets at equal final error: how many times faster the library's fastest
+/// method is than `ode_solvers`' fastest, per problem, at both f64 levels.
+const EQUAL_ERROR_TARGETS: [(&str, f64); 5] = [
+    ("P1", 3.0),
+    ("P2", 3.0),
+    ("P3-N5", 2.0),
+    ("P3-N20", 2.0),
+    ("P4", 2.0),
+];
+
+/// The equal-error targets: per problem and level, the factor, the library method that gives
+/// it, and whether the target is met.
+fn equal_error_goals(s: &mut String, rows: &[Row]) {
+    let _ = write!(
+        s,
+        "**The fastest at equal error**: the library's fastest method against `ode_solvers`' \
+         fastest, f64, at each final error (`ode_solvers`' time over the library's; details \
+         under \"The library against `ode_solvers`\").\n\n\
+         | problem | target | at {:.0e} | met | at {:.0e} | met |\n|---|---:|---|---|---|---|\n",
+        F64_LEVELS[0], F64_LEVELS[1]
+    );
+    for (id, target) in EQUAL_ERROR_TARGETS {
+        if !rows.iter().any(|r| r.problem == id && r.origin == Origin::OdeSolvers) {
+            continue;
+        }
+        let mut line = format!("| {id} | {target:.0}x |");
+        for level in F64_LEVELS {
+            let lib = best_of(rows, id, Origin::Library, level);
+            let peer = best_of(rows, id, Origin::OdeSolvers, level);
+            let time = |side: Option<(&str, Reach)>| side.and_then(|(_, r)| r.time());
+            let (cell, met) = match (lib, time(lib), time(peer)) {
+                (Some((m, _)), Some(a), Some(b)) => {
+                    let factor = b / a;
+                    let met = if factor >= target { "yes" } else { "**no**" };
+                    (format!("{factor:.2}x ({m})"), met)
+                }
+                (_, Some(_), None) => ("`ode_solvers` does not reach it".into(), "yes"),
+                (_, None, Some(_)) => ("the library does not reach it".into(), "**no**"),
+                _ => ("neither reaches it".into(), "-"),
+            };
+            let _ = write!(line, " {cell} | {met} |");
+        }
+        s.push_str(&line);
+        s.push('\n');
+    }
+}
+
+/// The ratios of issue 17's goals in one place: the library against `ode_solvers` at equal
+/// error, the engine's own cost per evaluation against `ode_solvers`' for each N, and the RK4
+/// step against the hand-written loop for each problem.
+fn goals_summary(s: &mut String, rows: &[Row], ratios: &[Rk4Ratio], o: &Overhead) {
+    if ratios.is_empty() && o.rows.is_empty() && rows.is_empty() {
         return;
     }
     s.push_str("\n## Summary: the goals of issue 17 (speed)\n\n");
+    if rows.iter().any(|r| r.origin == Origin::OdeSolvers) {
+        equal_error_goals(s, rows);
+        s.push('\n');
+    }
     if !o.rows.is_empty() {
         s.push_str(
             "**Overhead that does not grow with N**: the library's own cost per evaluation \
@@ -589,7 +641,7 @@ fn markdown(
         context.budget.seconds
     );
 
-    goals_summary(&mut s, ratios, overhead);
+    goals_summary(&mut s, rows, ratios, overhead);
     s.push_str("\n## Problems and references\n\n");
     s.push_str("| id | problem | T (s) | mechanism simulated | reference | its error | E(0) |\n|---|---|---:|---|---|---:|---:|\n");
     for r in &sweeps.references {
