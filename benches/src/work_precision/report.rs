@@ -493,7 +493,10 @@ fn equal_error_goals(s: &mut String, rows: &[Row]) {
         F64_LEVELS[0], F64_LEVELS[1]
     );
     for (id, target) in EQUAL_ERROR_TARGETS {
-        if !rows.iter().any(|r| r.problem == id && r.origin == Origin::OdeSolvers) {
+        if !rows
+            .iter()
+            .any(|r| r.problem == id && r.origin == Origin::OdeSolvers)
+        {
             continue;
         }
         let mut line = format!("| {id} | {target:.0}x |");

@@ -682,6 +682,23 @@ where
         }
     }
 
+    /// The state one step of the method from the start of the last accepted step to `t`
+    /// inside it (for events located on steps, [`Self::stop_at_event`]): its stages overwrite
+    /// the last step's from the second on; the first, the derivative at the start, is kept.
+    pub(super) fn step_state<M: Mechanism<T, N>>(
+        &mut self,
+        m: &M,
+        t: T,
+    ) -> Result<State<T, N>, Error> {
+        let y0 = self.previous;
+        let h = t - y0.t;
+        let mut y1 = y0;
+        run_stages!(self, m, y0, h, y1; 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17);
+        y1.t = t;
+        y1.check_finite()?;
+        Ok(y1)
+    }
+
     /// Runs one public call `f`, with its work counted ([`Method::last_step`]); a call that
     /// fails leaves the integrator as it found it (the run, the controller, the step size,
     /// the dense output), so that the caller can go on from its last good state as if the

@@ -191,7 +191,9 @@ where
     /// Steps from `state` towards `t_end` until `guard(state)` changes sign, locates the time
     /// of the change on the dense output (the Illinois variant of regula falsi, to
     /// [`AdaptiveSettings::event_tolerance`](super::AdaptiveSettings::event_tolerance) or to
-    /// rounding), and stops there; a call from the state it returns continues the run.
+    /// rounding; for a pair whose dense output is more than an order below its steps, the
+    /// Nyström pairs, again on steps of the pair from there), and stops there; a call from the
+    /// state it returns continues the run.
     ///
     /// The guard is a function `g(t, q, q')` of the state. A sign change is a step from a
     /// non-zero value to zero or to the opposite sign; the located time is the first one known
@@ -267,6 +269,11 @@ where
 
     /// The event inside the last step, where the guard went from `start = (t, g)` to `g1`
     /// at the step's end: the state there becomes the run's current one.
+    ///
+    /// The time is located on the dense output. Where that is more than an order below the
+    /// steps (the Nyström pairs), it is located again on steps of the method itself from the
+    /// step's start, the dense output's time tried first: the state returned is then as
+    /// accurate as a step's, and the guard there is that state's.
     fn stop_at_event<M, G>(
         &mut self,
         m: &M,
@@ -280,30 +287,58 @@ where
     {
         self.protect();
         if g1 != T::zero() {
-            let t = self.locate(m, guard, start, g1)?;
-            self.state = self.evaluate_dense(t);
+            self.prepare_dense(m)?;
+            let end = (self.state.t, g1);
+            let mut dense = |rk: &mut Self, t: T| checked_guard(guard(&rk.evaluate_dense(t)));
+            let t = self.locate((start, end), None, &mut dense)?;
+            self.state = if P::DENSE_ORDER + 1 < P::ORDER {
+                // The guard's rate along the interpolant, for a Newton step from its time.
+                let delta = (end.0 - start.0) * real::<T>(1e-3);
+                let (lo, hi) = ((t - delta).max(start.0), (t + delta).min(end.0));
+                let slope = (dense(self, hi)? - dense(self, lo)?) / (hi - lo);
+                // The last two states stepped to: the located time is usually one of them.
+                let mut recent: [Option<State<T, N>>; 2] = [None; 2];
+                let stepped = |rk: &mut Self, t: T| {
+                    let s = rk.step_state(m, t)?;
+                    recent = [Some(s), recent[0]];
+                    checked_guard(guard(&s))
+                };
+                let t = self.locate((start, end), Some((t, slope)), stepped)?;
+                match recent.into_iter().flatten().find(|s| s.t == t) {
+                    Some(s) => s,
+                    None => self.step_state(m, t)?,
+                }
+            } else {
+                self.evaluate_dense(t)
+            };
             self.state.check_finite()?;
-            self.dense_end = t;
+            self.dense_end = self.state.t;
             self.derivative = None;
         }
         self.output = Some(self.state);
         Ok(Stop::Event(self.state))
     }
 
-    /// The time of the sign change of `guard` within the last step, between `(a, g(a))` and
-    /// the step's end where it is `g1`.
-    fn locate<M, G>(&mut self, m: &M, guard: &mut G, from: (T, T), g1: T) -> Result<T, Error>
-    where
-        M: Mechanism<T, N>,
-        G: FnMut(&State<T, N>) -> T,
-    {
-        self.prepare_dense(m)?;
-        let (mut a, mut ga) = from;
-        let (mut b, mut gb) = (self.state.t, g1);
+    /// The time of the sign change of the guard between `(a, g(a))` and `(b, g(b))`, by the
+    /// Illinois variant of regula falsi on `g_at(t)`: the first time found past the change
+    /// (`g` zero or of `g(b)`'s sign), to the event tolerance or to rounding.
+    ///
+    /// With a `guess` `(t, slope)`, `t` is tried first, then a Newton step from it on `slope`
+    /// taken twice over, so that the root is bracketed about as tightly as the guess was
+    /// close: from a good guess, a few trials instead of a regula falsi from the step's ends.
+    fn locate(
+        &mut self,
+        ((mut a, mut ga), (mut b, mut gb)): ((T, T), (T, T)),
+        mut guess: Option<(T, T)>,
+        mut g_at: impl FnMut(&mut Self, T) -> Result<T, Error>,
+    ) -> Result<T, Error> {
+        let mut newton: Option<(T, T, T)> = None;
         let tolerance = self
             .settings
             .event_tolerance()
             .max(real::<T>(4.0) * T::EPSILON * b.abs());
+        // Trials keep a few ulps off either end (below the default tolerance's 4).
+        let margin = real::<T>(2.0) * T::EPSILON * b.abs();
         // Which end moved last: the Illinois method halves the other end's value when the
         // same end moves twice, so both ends converge.
         let mut moved_b = None;
@@ -311,17 +346,26 @@ where
             if b - a <= tolerance {
                 break;
             }
-            let mut c = b - gb * (b - a) / (gb - ga);
-            if !(c > a && c < b) {
+            let (mut c, slope) = match (guess.take(), newton.take()) {
+                (Some((t, slope)), _) => (t, Some(slope)),
+                (None, Some((t, g, slope))) => (t - real::<T>(2.0) * g / slope, None),
+                (None, None) => (b - gb * (b - a) / (gb - ga), None),
+            };
+            if !c.is_finite() {
                 c = a + (b - a) * T::HALF;
-                if !(c > a && c < b) {
-                    break;
-                }
             }
-            let gc = checked_guard(guard(&self.evaluate_dense(c)))?;
+            // Inside, and a few ulps off either end: a root within rounding of one end (where
+            // regula falsi lands once that end's value is tiny) is then bracketed by the next
+            // trial, not approached by halvings from the other end.
+            c = c.max(a + margin).min(b - margin);
+            if !(c > a && c < b) {
+                break;
+            }
+            let gc = g_at(self, c)?;
             if gc == T::zero() {
                 return Ok(c);
             }
+            newton = slope.map(|s| (c, gc, s));
             if (gc < T::zero()) == (gb < T::zero()) {
                 b = c;
                 gb = gc;

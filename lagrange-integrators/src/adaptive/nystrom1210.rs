@@ -302,18 +302,19 @@ impl EmbeddedPair<18, 2> for Nystrom1210Pair {
 /// for mechanisms whose law does not read the velocities ([`Mechanism::reads_velocities`]
 /// `false`); it refuses any other mechanism with [`Error::InvalidParameter`] `mechanism`.
 ///
-/// Order 12, explicit, adaptive; 17 acceleration evaluations per accepted step, plus 17 per
-/// rejected attempt. Dense output of order 4 at no extra evaluation (the quintic Hermite
-/// interpolant: far below the steps' order, so sample it for plots, and locate events with a
-/// tight [`AdaptiveSettings::event_tolerance`] knowing the state there is of that order);
-/// [`Integrator::step`] lands by a last step shortened to the frame's end. Not symplectic.
+/// Order 12 (the slope of the global error against a fixed step measures 12.6 on the
+/// pendulum released at 2 rad), explicit, adaptive; 17 acceleration evaluations per accepted
+/// step, plus 17 per rejected attempt. Dense output of order 4 at no extra evaluation (the
+/// quintic Hermite interpolant: far below the steps' order, for plots); an event is located
+/// on it and then again on steps of the pair (a few steps' evaluations), so that its time and
+/// state are as accurate as a step; [`Integrator::step`] lands by a last step shortened to
+/// the frame's end. Not symplectic.
 /// The long-step choice at tolerances of about `1e-9` down to `1e-15` in `f64`: its steps are
 /// several times Dormand-Prince 8(5,3)'s for the same error.
 ///
 /// [`Mechanism::reads_velocities`]: lagrange_core::Mechanism::reads_velocities
 /// [`Error::InvalidParameter`]: lagrange_core::Error::InvalidParameter
 /// [`Integrator::step`]: crate::Integrator::step
-/// [`AdaptiveSettings::event_tolerance`]: crate::AdaptiveSettings::event_tolerance
 ///
 /// ```
 /// use lagrange_integrators::prelude::*;
