@@ -19,7 +19,7 @@
 //! | [`DormandPrince54`] | 5 (4) | explicit, adaptive (PI control, dense output order 4, events) | no | 6 per accepted step | general purpose, tolerances `1e-3` to `1e-8` |
 //! | [`DormandPrince853`] | 8 (5, 3) | explicit, adaptive (PI control, dense output order 7, events) | no | 12 per accepted step (+3 where dense output is sampled) | high accuracy, tolerances `1e-7` to `1e-14` |
 //! | [`DormandPrinceNystrom64`] | 6 (4) | explicit Runge-Kutta-Nyström, adaptive (PI control, dense output order 4, events); laws that do not read `q'` only | no | 5 per accepted step | such laws (undamped pendulums, gravity, springs) at tolerances `1e-4` to `1e-9` |
-//! | [`DormandPrinceNystrom1210`] | 12 (10) | explicit Runge-Kutta-Nyström, adaptive (PI control, dense output order 4, events); laws that do not read `q'` only | no | 17 per accepted step | such laws at tolerances `1e-9` to `1e-15` |
+//! | [`DormandPrinceNystrom1210`] | 12 (10) | explicit Runge-Kutta-Nyström, adaptive (PI control, dense output order 4, events); laws that do not read `q'` only | no | 17 per accepted step | such laws at tolerances `1e-9` to `1e-14` |
 //!
 //! "Constant `M`, forces of `q`" is the separable case, where `(q, q')` is a linear image of
 //! `(q, p)` and these methods are symplectic: bounded energy error, no drift. Where the mass

@@ -7,7 +7,7 @@ use lagrange_core::nalgebra::{SMatrix, SVector};
 use lagrange_core::{Error, EulerLagrange, Lagrangian, Mechanism, Real, Scalar, State};
 use lagrange_integrators::{
     AdaptiveSettings, DormandPrince853, DormandPrinceNystrom1210, DormandPrinceNystrom64,
-    EmbeddedPair, EmbeddedRungeKutta, Integrator, Nystrom1210Pair, Nystrom64Pair, Stop,
+    EmbeddedPair, EmbeddedRungeKutta, Integrator, Method, Nystrom1210Pair, Nystrom64Pair, Stop,
 };
 use lagrange_systems::exact::{kepler_orbit, pendulum_from_rest};
 use lagrange_systems::{Kepler, SimplePendulum};
@@ -31,20 +31,28 @@ fn quadrature(w: &[f64], c: &[f64], k: i32, expected: f64) -> Result<(), String>
 }
 
 /// The conditions a Nyström pair of order `p` with an embedded pair of order `p_hat`
-/// meets: every position row sums to `c_i^2 / 2`; `b'` (the velocity row) integrates `c^k`
-/// exactly for `k < p`, `b` (the position row of the last stage) `c^k / ((k+1)(k+2))` for
-/// `k < p - 1`, and the embedded weights `b' - e'` and `b - e` the same up to `p_hat`; `A`'s
-/// rows other than the last are zero (the engine's contract).
-fn check_tableau<const S: usize, const R: usize, P: EmbeddedPair<S, R>>() -> Result<(), String> {
+/// meets: each position row `i` integrates `c^k` as `c_i^(k+2) / ((k+1)(k+2))` for `k <
+/// stage_orders[i]` (at least the row sum `c_i^2 / 2`; the counts are those the published
+/// rationals meet to 1e-25, so that an interior coefficient off in its last digits fails);
+/// `b'` (the velocity row) integrates `c^k` exactly for `k < p`, `b` (the position row of
+/// the last stage) `c^k / ((k+1)(k+2))` for `k < p - 1`, and the embedded weights `b' - e'`
+/// and `b - e` the same up to `p_hat`; `A`'s rows other than the last are zero (the engine's
+/// contract).
+fn check_tableau<const S: usize, const R: usize, P: EmbeddedPair<S, R>>(
+    stage_orders: [i32; S],
+) -> Result<(), String> {
     let ny = P::NYSTROM.ok_or("not a Nyström pair")?;
     let (p, p_hat) = (P::ORDER as i32, P::ERROR_EXPONENT as i32 - 1);
     let f = P::FSAL;
     assert_eq!(f, S - 1);
     assert_eq!(P::C[f], 1.0);
     for i in 0..S {
-        let ones = [1.0; S];
-        quadrature(&ny.abar[i], &ones, 0, P::C[i] * P::C[i] / 2.0)
-            .map_err(|e| format!("{} row {i}: {e}", P::NAME))?;
+        for k in 0..stage_orders[i].max(1) {
+            let kf = f64::from(k);
+            let expected = P::C[i].powi(k + 2) / ((kf + 1.0) * (kf + 2.0));
+            quadrature(&ny.abar[i], &P::C, k, expected)
+                .map_err(|e| format!("{} row {i}: {e}", P::NAME))?;
+        }
         assert!(
             ny.abar[i][i..].iter().all(|&a| a == 0.0),
             "row {i} not lower"
@@ -86,11 +94,86 @@ fn check_tableau<const S: usize, const R: usize, P: EmbeddedPair<S, R>>() -> Res
 
 #[test]
 fn tableaus_meet_their_quadrature_conditions() -> Result<(), String> {
-    check_tableau::<6, 2, Nystrom64Pair>()?;
-    check_tableau::<18, 2, Nystrom1210Pair>()
+    check_tableau::<6, 2, Nystrom64Pair>([13, 1, 1, 1, 1, 5])?;
+    check_tableau::<18, 2, Nystrom1210Pair>([
+        13, 1, 3, 3, 4, 5, 5, 5, 5, 5, 5, 5, 5, 5, 5, 5, 5, 11,
+    ])
 }
 
-/// The global error at `t_end` of steps of exactly `h` (the step bounds pinned, the
+/// The 6(4) pair's coefficients are its published rationals to the nearest `f64` (one
+/// division of two exact integers is correctly rounded); the error weights `b - b^` and
+/// `b' - b'^` within 2 ulps of the larger of the two (two roundings and a subtraction).
+#[test]
+fn the_6_4_pair_is_its_published_rationals() -> Result<(), String> {
+    let ny = Nystrom64Pair::NYSTROM.ok_or("not a Nyström pair")?;
+    let r = |p: f64, q: f64| p / q;
+    let abar: [&[f64]; 6] = [
+        &[],
+        &[r(1.0, 200.0)],
+        &[r(-1.0, 2200.0), r(1.0, 22.0)],
+        &[r(637.0, 6600.0), r(-7.0, 110.0), r(7.0, 33.0)],
+        &[
+            r(225437.0, 1968750.0),
+            r(-30073.0, 281250.0),
+            r(65569.0, 281250.0),
+            r(-9367.0, 984375.0),
+        ],
+        &[
+            r(151.0, 2142.0),
+            r(5.0, 116.0),
+            r(385.0, 1368.0),
+            r(55.0, 168.0),
+            r(-6250.0, 28101.0),
+        ],
+    ];
+    let bp = [
+        r(151.0, 2142.0),
+        r(25.0, 522.0),
+        r(275.0, 684.0),
+        r(275.0, 252.0),
+        r(-78125.0, 112404.0),
+        r(1.0, 12.0),
+    ];
+    let b_hat = [
+        r(1349.0, 157500.0),
+        r(7873.0, 50000.0),
+        r(192199.0, 900000.0),
+        r(521683.0, 2100000.0),
+        r(-16.0, 125.0),
+        0.0,
+    ];
+    let bp_hat = [
+        r(1349.0, 157500.0),
+        r(7873.0, 45000.0),
+        r(27457.0, 90000.0),
+        r(521683.0, 630000.0),
+        r(-2.0, 5.0),
+        r(1.0, 12.0),
+    ];
+    let c = [0.0, 0.1, 0.3, 0.7, r(17.0, 25.0), 1.0];
+    for (i, row) in abar.iter().enumerate() {
+        if ny.abar[i][..row.len()] != **row || ny.abar[i][row.len()..].iter().any(|&a| a != 0.0) {
+            return Err(format!("abar row {i}: {:?}", ny.abar[i]));
+        }
+    }
+    if Nystrom64Pair::A[5] != bp || Nystrom64Pair::C != c {
+        return Err("b' or c".into());
+    }
+    let within = |e: f64, w: f64, w_hat: f64| {
+        (e - (w - w_hat)).abs() <= 2.0 * f64::EPSILON * w.abs().max(w_hat.abs())
+    };
+    for j in 0..6 {
+        if !within(ny.e[j], abar[5].get(j).copied().unwrap_or(0.0), b_hat[j]) {
+            return Err(format!("e_q {j}: {}", ny.e[j]));
+        }
+        if !within(Nystrom64Pair::E[j], bp[j], bp_hat[j]) {
+            return Err(format!("e_v {j}: {}", Nystrom64Pair::E[j]));
+        }
+    }
+    Ok(())
+}
+
+/// The global error at `t_end` of steps of `h` (the last shortened to land; the step bounds pinned, the
 /// tolerance loose) from the pendulum released at `th0`.
 fn fixed_step_error<const S: usize, const R: usize, P: EmbeddedPair<S, R>>(
     th0: f64,
@@ -232,9 +315,9 @@ fn dense_output_has_its_stated_order() -> Result<(), Error> {
     dense_output_local_order::<18, 2, Nystrom1210Pair>(&[0.2, 0.1, 0.05, 0.025])
 }
 
-/// A law that reads the velocities is refused by every entry point, with the integrator left
-/// as it was: the next call, on a pendulum without damping, gives what a fresh integrator
-/// gives, bit for bit.
+/// A law that reads the velocities is refused by every entry point, before any evaluation,
+/// with the integrator left as it was: the next call, on a pendulum without damping, gives
+/// what a fresh integrator gives, bit for bit.
 #[test]
 fn laws_that_read_the_velocities_are_refused() -> Result<(), Error> {
     let settings = AdaptiveSettings::new(1e-8, 1e-10)?;
@@ -257,21 +340,27 @@ fn laws_that_read_the_velocities_are_refused() -> Result<(), Error> {
     };
     let mut rkn = DormandPrinceNystrom64::<f64, 1>::new(settings);
     let first = rkn.integrate_to(&undamped, &s0, 1.0)?;
+    // Each refused before any evaluation.
     refused(rkn.integrate_to(&damped, &first, 2.0).map_err(|f| f.error));
+    assert_eq!(rkn.last_step().evaluations, 0);
     refused(rkn.next_step(&damped, &first, 2.0));
+    assert_eq!(rkn.last_step().evaluations, 0);
     refused(rkn.step(&damped, &first, 0.1));
+    assert_eq!(rkn.last_step().evaluations, 0);
     refused(rkn.step(&spring, &first, 0.1));
+    assert_eq!(rkn.last_step().evaluations, 0);
     refused(
         rkn.integrate_until_event(&damped, &first, 2.0, |s: &State<f64, 1>| s.q[0])
             .map(|stop| *stop.state())
             .map_err(|f| f.error),
     );
+    assert_eq!(rkn.last_step().evaluations, 0);
     let mut polar = DormandPrinceNystrom1210::<f64, 2>::new(settings);
     let r = polar.integrate_to(&orbit, &State::new(0.0, [1.0, 0.0], [0.0, 1.0]), 1.0);
     assert!(
         matches!(r, Err(f) if matches!(f.error, Error::InvalidParameter { name: "mechanism", .. }))
     );
-    // Refused before any work: the run goes on as if the calls had not been made.
+    // The run goes on as if the calls had not been made.
     let mut fresh = DormandPrinceNystrom64::<f64, 1>::new(settings);
     let middle = fresh.integrate_to(&undamped, &s0, 1.0)?;
     let expected = fresh.integrate_to(&undamped, &middle, 2.0)?;
@@ -398,7 +487,7 @@ fn a_users_orbit_in_cartesian_coordinates() -> Result<(), Error> {
 }
 
 /// The pendulum released from rest crosses `th = 0` at a quarter period: at rtol 1e-12,
-/// located within 1e-14 s by both pairs (measured 1.1e-16 and 3.3e-16), the state there
+/// located within 1e-14 s by both pairs (measured 1.1e-16 and 2.2e-16), the state there
 /// within 1e-13 of the exact one. 12(10)'s steps are long beside its order-4 interpolant (on
 /// it alone the crossing was 1.5e-10 s off, the velocity 1.2e-8): the event is located again
 /// on its own steps, from the interpolant's time and a Newton step on its slope (measured 68
@@ -434,5 +523,15 @@ fn events_are_located_to_the_steps_accuracy() -> Result<(), Error> {
         );
         assert!(s.q[0] <= 0.0);
     }
+    // The dense output ends on the event's state: the step was cut there (a nanosecond
+    // before it, within 1e-13 of the exact pendulum; on the uncut step's interpolant the
+    // velocity was 1.2e-8 off).
+    let s = *stop12.state();
+    assert_eq!(rkn12.dense_interval().map(|(_, end)| end), Some(s.t));
+    let before = rkn12.dense_output(s.t - 1e-9)?;
+    let (th, thd) = pendulum_from_rest(th0, G.sqrt(), s.t - 1e-9)?;
+    let off = state_error(&before, &[th, thd]);
+    println!("12(10): the dense output 1 ns before the event {off:.1e} off");
+    assert!(off < 1e-13, "{off:e}");
     Ok(())
 }

@@ -24,7 +24,9 @@ pub trait EmbeddedPair<const S: usize, const R: usize> {
     const ORDER: u32;
     /// `k` of the controller: the error estimate scales like `h^k`.
     const ERROR_EXPONENT: u32;
-    /// Order of the dense output.
+    /// Order of the dense output. More than one below [`EmbeddedPair::ORDER`] (the Nyström
+    /// pairs), it is not trusted where a step is: [`Integrator::step`] lands on a frame's end by
+    /// a step shortened to it, and an event is located again on steps of the pair.
     const DENSE_ORDER: u32;
     /// The nodes `c_i`.
     const C: [f64; S];
@@ -67,13 +69,20 @@ pub struct Nystrom<const S: usize> {
     pub e: [f64; S],
 }
 
-/// The square matrix whose row `i` starts with `rows[i]` (at most `i + 1` entries; zeros
-/// after): a lower-triangular tableau written row by row, without its zeros.
+/// The square matrix whose row `i` starts with `rows[i]` (zeros after): a strictly lower
+/// triangular tableau written row by row, without its zeros.
+///
+/// # Panics
+/// When a row `i` has more than `i` entries (in a constant, a compile error).
 #[must_use]
 pub const fn lower_triangular<const S: usize>(rows: [&[f64]; S]) -> [[f64; S]; S] {
     let mut m = [[0.0; S]; S];
     let mut i = 0;
     while i < S {
+        assert!(
+            rows[i].len() <= i,
+            "a row of a strictly lower triangular tableau"
+        );
         let mut j = 0;
         while j < rows[i].len() {
             m[i][j] = rows[i][j];

@@ -75,9 +75,10 @@ fn nystrom_rows<T: Real, const N: usize>(
     let Some(([_, d2, d3], [e1, e2, e3])) = hermite else {
         return;
     };
-    let half_h2 = h * h * real::<T>(0.5);
-    *q4 = kv[0] * half_h2 + d2 - d3;
-    *q5 = kv[fsal] * half_h2 + d2 + d3 * real::<T>(2.0) - *q4;
+    // (h / 2) h, not h^2 / 2: a step long enough for h^2 to overflow is finite here.
+    let half_h = h * real::<T>(0.5);
+    *q4 = kv[0] * half_h * h + d2 - d3;
+    *q5 = kv[fsal] * half_h * h + d2 + d3 * real::<T>(2.0) - *q4;
     let cubic_mean = y0.qd + e1 * real::<T>(0.5) + e2 / real::<T>(6.0) + e3 / real::<T>(12.0);
     *v4 = ((y1.q - y0.q) / h - cubic_mean) * real::<T>(30.0);
     *v5 = SVector::zeros();
@@ -166,7 +167,8 @@ where
 
     /// The state at time `t` inside the last step taken by
     /// [`EmbeddedRungeKutta::next_step`] (from its start to its end), by the method's
-    /// continuous extension (order 4 for Dormand-Prince 5(4), 7 for DOP853).
+    /// continuous extension (order 4 for Dormand-Prince 5(4), 7 for DOP853, 4 for the
+    /// Nyström pairs).
     ///
     /// # Errors
     /// [`Error::InvalidParameter`] `t` when outside [`EmbeddedRungeKutta::dense_interval`]
@@ -296,18 +298,7 @@ where
                 let delta = (end.0 - start.0) * real::<T>(1e-3);
                 let (lo, hi) = ((t - delta).max(start.0), (t + delta).min(end.0));
                 let slope = (dense(self, hi)? - dense(self, lo)?) / (hi - lo);
-                // The last two states stepped to: the located time is usually one of them.
-                let mut recent: [Option<State<T, N>>; 2] = [None; 2];
-                let stepped = |rk: &mut Self, t: T| {
-                    let s = rk.step_state(m, t)?;
-                    recent = [Some(s), recent[0]];
-                    checked_guard(guard(&s))
-                };
-                let t = self.locate((start, end), Some((t, slope)), stepped)?;
-                match recent.into_iter().flatten().find(|s| s.t == t) {
-                    Some(s) => s,
-                    None => self.step_state(m, t)?,
-                }
+                self.locate_by_steps(m, guard, (start, end), (t, slope))?
             } else {
                 self.evaluate_dense(t)
             };
@@ -317,6 +308,42 @@ where
         }
         self.output = Some(self.state);
         Ok(Stop::Event(self.state))
+    }
+
+    /// The event located again on steps of the pair from the start of the last step, from
+    /// the `guess` `(t, slope)` the dense output gave: the state there, the last step cut
+    /// to it (its stages and dense output those of the step to it, so that the dense output
+    /// ends on the state returned).
+    fn locate_by_steps<M, G>(
+        &mut self,
+        m: &M,
+        guard: &mut G,
+        bracket: ((T, T), (T, T)),
+        guess: (T, T),
+    ) -> Result<State<T, N>, Error>
+    where
+        M: Mechanism<T, N>,
+        G: FnMut(&State<T, N>) -> T,
+    {
+        let mut last = None;
+        let stepped = |rk: &mut Self, t: T| {
+            let s = rk.step_state(m, t)?;
+            last = Some(s);
+            checked_guard(guard(&s))
+        };
+        let t = self.locate(bracket, Some(guess), stepped)?;
+        if t == self.state.t {
+            // The step's own end: its dense output stands (prepared from its own stages).
+            return Ok(self.state);
+        }
+        let s = match last {
+            Some(s) if s.t == t => s,
+            _ => self.step_state(m, t)?,
+        };
+        self.h_last = t - self.previous.t;
+        self.stages.hermite = None;
+        self.prepare_dense(m)?;
+        Ok(s)
     }
 
     /// The time of the sign change of the guard between `(a, g(a))` and `(b, g(b))`, by the
@@ -333,12 +360,11 @@ where
         mut g_at: impl FnMut(&mut Self, T) -> Result<T, Error>,
     ) -> Result<T, Error> {
         let mut newton: Option<(T, T, T)> = None;
-        let tolerance = self
-            .settings
-            .event_tolerance()
-            .max(real::<T>(4.0) * T::EPSILON * b.abs());
-        // Trials keep a few ulps off either end (below the default tolerance's 4).
-        let margin = real::<T>(2.0) * T::EPSILON * b.abs();
+        // The times' scale: a few of its ulps are the default tolerance, and the trials keep
+        // two off either end.
+        let scale = T::EPSILON * a.abs().max(b.abs());
+        let tolerance = self.settings.event_tolerance().max(real::<T>(4.0) * scale);
+        let margin = real::<T>(2.0) * scale;
         // Which end moved last: the Illinois method halves the other end's value when the
         // same end moves twice, so both ends converge.
         let mut moved_b = None;
@@ -351,15 +377,19 @@ where
                 (None, Some((t, g, slope))) => (t - real::<T>(2.0) * g / slope, None),
                 (None, None) => (b - gb * (b - a) / (gb - ga), None),
             };
+            // Inside, and a few ulps off either end: a root within rounding of one end (where
+            // regula falsi lands once that end's value is tiny) is then bracketed by the next
+            // trial, not approached by halvings from the other end. Else (a step of NaN, or
+            // a bracket too narrow for the margins) the midpoint.
             if !c.is_finite() {
                 c = a + (b - a) * T::HALF;
             }
-            // Inside, and a few ulps off either end: a root within rounding of one end (where
-            // regula falsi lands once that end's value is tiny) is then bracketed by the next
-            // trial, not approached by halvings from the other end.
             c = c.max(a + margin).min(b - margin);
             if !(c > a && c < b) {
-                break;
+                c = a + (b - a) * T::HALF;
+                if !(c > a && c < b) {
+                    break;
+                }
             }
             let gc = g_at(self, c)?;
             if gc == T::zero() {

@@ -309,7 +309,7 @@ impl EmbeddedPair<18, 2> for Nystrom1210Pair {
 /// on it and then again on steps of the pair (a few steps' evaluations), so that its time and
 /// state are as accurate as a step; [`Integrator::step`] lands by a last step shortened to
 /// the frame's end. Not symplectic.
-/// The long-step choice at tolerances of about `1e-9` down to `1e-15` in `f64`: its steps are
+/// The long-step choice at tolerances of about `1e-9` down to `1e-14` in `f64`: its steps are
 /// several times Dormand-Prince 8(5,3)'s for the same error.
 ///
 /// [`Mechanism::reads_velocities`]: lagrange_core::Mechanism::reads_velocities
