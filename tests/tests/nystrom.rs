@@ -46,8 +46,8 @@ fn check_tableau<const S: usize, const R: usize, P: EmbeddedPair<S, R>>(
     let f = P::FSAL;
     assert_eq!(f, S - 1);
     assert_eq!(P::C[f], 1.0);
-    for i in 0..S {
-        for k in 0..stage_orders[i].max(1) {
+    for (i, &conditions) in stage_orders.iter().enumerate() {
+        for k in 0..conditions.max(1) {
             let kf = f64::from(k);
             let expected = P::C[i].powi(k + 2) / ((kf + 1.0) * (kf + 2.0));
             quadrature(&ny.abar[i], &P::C, k, expected)
