@@ -2,6 +2,7 @@
 //! stages, error estimate, PI step-size control, and the stepping loops.
 
 use super::controller::PiController;
+use super::nystrom::{position, Nystrom};
 use super::AdaptiveSettings;
 use crate::integrator::{check_step, continues, fail, Cost, Failure, Work};
 use crate::{Integrator, Method};
@@ -44,53 +45,6 @@ pub trait EmbeddedPair<const S: usize, const R: usize> {
     /// The position half of a Runge-Kutta-Nyström pair ([`Nystrom`]); `None`, the default,
     /// for a pair of the first-order system `y' = (q', q'')`.
     const NYSTROM: Option<Nystrom<S>> = None;
-}
-
-/// The position half of a Runge-Kutta-Nyström pair, which steps laws `q'' = f(t, q)` that do
-/// not read `q'` ([`Mechanism::reads_velocities`] `false`) with fewer stages than a pair of
-/// the first-order system needs for the same order.
-///
-/// ```text
-/// stage i:  q_i = q0 + h (c_i q0' + h sum_j ABAR[i][j] kv_j),   q_i' = q0'
-/// stage FSAL: (t0 + h, q1, q1'),   q1 = its row of ABAR,   q1' = q0' + h sum_j A[FSAL][j] kv_j
-/// error:    e_q = h^2 sum_j E[j] kv_j,   e_q' = h sum_j EmbeddedPair::E[j] kv_j
-/// ```
-///
-/// `A`'s row `FSAL` holds the velocity weights `b'` and may use the stage `FSAL` itself
-/// (evaluated at `q1`, before `q1'` is formed); its other rows are zero: a stage's velocity is
-/// `q0'`, which the law does not read. The dense output is the quintic Hermite interpolant of
-/// `q` through `(q, q', q'')` at both ends, and its derivative for `q'` (orders 5 and 4, no
-/// evaluation), in two rows (`R = 2`; `DENSE` is unused).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Nystrom<const S: usize> {
-    /// The position coefficients `abar_ij`, lower triangular (row `FSAL` is `b`).
-    pub abar: [[f64; S]; S],
-    /// The weights of the position error estimate.
-    pub e: [f64; S],
-}
-
-/// The square matrix whose row `i` starts with `rows[i]` (zeros after): a strictly lower
-/// triangular tableau written row by row, without its zeros.
-///
-/// # Panics
-/// When a row `i` has more than `i` entries (in a constant, a compile error).
-#[must_use]
-pub const fn lower_triangular<const S: usize>(rows: [&[f64]; S]) -> [[f64; S]; S] {
-    let mut m = [[0.0; S]; S];
-    let mut i = 0;
-    while i < S {
-        assert!(
-            rows[i].len() <= i,
-            "a row of a strictly lower triangular tableau"
-        );
-        let mut j = 0;
-        while j < rows[i].len() {
-            m[i][j] = rows[i][j];
-            j += 1;
-        }
-        i += 1;
-    }
-    m
 }
 
 /// Work counts since the integrator was made or restarted.
@@ -250,7 +204,7 @@ fn nan_unless_finite<T: Real>(x: T) -> T {
 /// weights fold away, as in a hand-written stage; the callers' loops over the components then
 /// vectorise, each sum staying in a register and each stage read once.
 #[inline(always)]
-fn stage_sum<T: Real, const N: usize>(w: &[f64], k: &[SVector<T, N>], i: usize) -> T {
+pub(super) fn stage_sum<T: Real, const N: usize>(w: &[f64], k: &[SVector<T, N>], i: usize) -> T {
     let mut acc = T::zero();
     for (wj, kj) in w.iter().zip(k) {
         if *wj != 0.0 {
@@ -286,23 +240,6 @@ fn step_into<T: Real, const N: usize>(
 ) {
     for (i, (o, yi)) in out.as_mut_slice().iter_mut().zip(y.as_slice()).enumerate() {
         *o = *yi + stage_sum(w, k, i) * h;
-    }
-}
-
-/// `out = q0 + (q0' c + (sum_j w_j kv_j) h) h`: a Nyström stage's position ([`Nystrom`]).
-#[inline(always)]
-fn nystrom_position<T: Real, const N: usize>(
-    out: &mut SVector<T, N>,
-    y0: &State<T, N>,
-    w: &[f64],
-    c: f64,
-    kv: &[SVector<T, N>],
-    h: T,
-) {
-    let c = real::<T>(c);
-    for (i, o) in out.as_mut_slice().iter_mut().enumerate() {
-        let v = y0.qd.as_slice()[i];
-        *o = y0.q.as_slice()[i] + (v * c + stage_sum(w, kv, i) * h) * h;
     }
 }
 
@@ -564,7 +501,7 @@ where
         let (row, c) = (&P::A[I][..I], P::C[I]);
         s.t = y0.t + h * real::<T>(c);
         if let Some(ny) = P::NYSTROM {
-            nystrom_position(&mut s.q, y0, &ny.abar[I][..I], c, &self.stages.kv, h);
+            position(&mut s.q, y0, &ny.abar[I][..I], c, &self.stages.kv, h);
             s.qd = y0.qd;
             self.stages.kv[I] = self.eval(m, s)?;
             step_into(&mut s.qd, &y0.qd, &P::A[I][..=I], &self.stages.kv, h);
@@ -599,7 +536,7 @@ where
         s.t = y0.t + h * real::<T>(c);
         if let Some(ny) = P::NYSTROM {
             // The stage's own evaluation is known here (a stage after the step's).
-            nystrom_position(&mut s.q, y0, &ny.abar[i][..i], c, &self.stages.kv, h);
+            position(&mut s.q, y0, &ny.abar[i][..i], c, &self.stages.kv, h);
             step_into(&mut s.qd, &y0.qd, &P::A[i][..=i], &self.stages.kv, h);
             return;
         }

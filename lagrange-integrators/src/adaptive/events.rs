@@ -1,7 +1,8 @@
 //! Dense output of the adaptive integrators (the continuous extension between the last two
 //! accepted points) and event location by root finding on it.
 
-use super::embedded::{check_end, combine, real, EmbeddedPair, EmbeddedRungeKutta, Hermite};
+use super::embedded::{check_end, combine, real, EmbeddedPair, EmbeddedRungeKutta};
+use super::nystrom::dense_rows;
 use crate::integrator::fail;
 use crate::Failure;
 use lagrange_core::nalgebra::SVector;
@@ -56,34 +57,6 @@ fn crossed<T: Real>(g0: T, g1: T) -> bool {
     g0 != T::zero() && (g1 == T::zero() || (g0 < T::zero()) != (g1 < T::zero()))
 }
 
-/// The two rows of a Nyström pair's dense output beyond the cubic Hermite parts
-/// ([`Nystrom`](super::Nystrom)), written to `[q4, q5, v4, v5]`:
-///
-/// - for `q`, the quintic Hermite interpolant: `d4` and `d5` add `s^2 (1-s)^2 (d4 + s d5)`,
-///   which leaves the values and slopes at both ends alone and sets the second derivatives
-///   to `h^2 q0''` and `h^2 q1''`;
-/// - for `q'`, its derivative: the quartic through `q0', q0'', q1', q1''` whose mean over the
-///   step is `(q1 - q0) / h`, the cubic plus `s^2 (1-s)^2 e4` (whose mean is `e4 / 30`).
-fn nystrom_rows<T: Real, const N: usize>(
-    [q4, q5, v4, v5]: [&mut SVector<T, N>; 4],
-    hermite: &Option<(Hermite<T, N>, Hermite<T, N>)>,
-    kv: &[SVector<T, N>],
-    (y0, y1): (&State<T, N>, &State<T, N>),
-    h: T,
-    fsal: usize,
-) {
-    let Some(([_, d2, d3], [e1, e2, e3])) = hermite else {
-        return;
-    };
-    // (h / 2) h, not h^2 / 2: a step long enough for h^2 to overflow is finite here.
-    let half_h = h * real::<T>(0.5);
-    *q4 = kv[0] * half_h * h + d2 - d3;
-    *q5 = kv[fsal] * half_h * h + d2 + d3 * real::<T>(2.0) - *q4;
-    let cubic_mean = y0.qd + e1 * real::<T>(0.5) + e2 / real::<T>(6.0) + e3 / real::<T>(12.0);
-    *v4 = ((y1.q - y0.q) / h - cubic_mean) * real::<T>(30.0);
-    *v5 = SVector::zeros();
-}
-
 impl<T, const N: usize, const S: usize, const R: usize, P> EmbeddedRungeKutta<T, N, S, R, P>
 where
     T: Real,
@@ -115,7 +88,7 @@ where
         ));
         if P::NYSTROM.is_some() {
             if let ([q4, q5], [v4, v5]) = (&mut k.rows_q[..], &mut k.rows_v[..]) {
-                nystrom_rows([q4, q5, v4, v5], &k.hermite, &k.kv, (&y0, &y1), h, f);
+                dense_rows([q4, q5, v4, v5], &k.hermite, &k.kv, (&y0, &y1), h, f);
             }
             return Ok(());
         }

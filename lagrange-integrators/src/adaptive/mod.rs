@@ -5,14 +5,16 @@ mod dop853;
 mod dopri5;
 mod embedded;
 mod events;
+mod nystrom;
 mod nystrom1210;
 mod nystrom64;
 mod settings;
 
 pub use dop853::{Dop853Pair, DormandPrince853};
 pub use dopri5::{Dopri5Pair, DormandPrince54};
-pub use embedded::{lower_triangular, EmbeddedPair, EmbeddedRungeKutta, Nystrom, Statistics};
+pub use embedded::{EmbeddedPair, EmbeddedRungeKutta, Statistics};
 pub use events::Stop;
+pub use nystrom::{lower_triangular, Nystrom};
 pub use nystrom1210::{DormandPrinceNystrom1210, Nystrom1210Pair};
 pub use nystrom64::{DormandPrinceNystrom64, Nystrom64Pair};
 pub use settings::AdaptiveSettings;

@@ -1,7 +1,8 @@
 //! Dormand, El-Mikkawy and Prince's Runge-Kutta-Nyström 12(10): a Nyström pair for laws
 //! `q'' = f(t, q)` at tight tolerances.
 
-use super::embedded::{lower_triangular, EmbeddedPair, EmbeddedRungeKutta, Nystrom};
+use super::embedded::{EmbeddedPair, EmbeddedRungeKutta};
+use super::nystrom::{lower_triangular, Nystrom};
 
 /// The Runge-Kutta-Nyström 12(10) pair of Dormand, El-Mikkawy and Prince ("High-order
 /// embedded Runge-Kutta-Nyström formulae", IMA J. Numer. Anal. 7, 1987), for laws that do

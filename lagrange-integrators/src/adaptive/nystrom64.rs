@@ -1,7 +1,8 @@
 //! Dormand, El-Mikkawy and Prince's Runge-Kutta-Nyström 6(4): a Nyström pair for laws
 //! `q'' = f(t, q)` at moderate tolerances.
 
-use super::embedded::{lower_triangular, EmbeddedPair, EmbeddedRungeKutta, Nystrom};
+use super::embedded::{EmbeddedPair, EmbeddedRungeKutta};
+use super::nystrom::{lower_triangular, Nystrom};
 
 /// The Runge-Kutta-Nyström 6(4) pair of Dormand, El-Mikkawy and Prince ("Families of
 /// Runge-Kutta-Nyström formulae", IMA J. Numer. Anal. 7, 1987, the improved 6(4) "FM"
