@@ -350,20 +350,15 @@ where
                 (None, Some((t, g, slope))) => (t - real::<T>(2.0) * g / slope, None),
                 (None, None) => (b - gb * (b - a) / (gb - ga), None),
             };
-            // Inside, and a few ulps off either end: a root within rounding of one end (where
-            // regula falsi lands once that end's value is tiny) is then bracketed by the next
-            // trial, not approached by halvings from the other end. Else (a step of NaN, or
-            // a bracket too narrow for the margins) the midpoint.
+            // A step of NaN or infinity (equal values at both ends, a zero slope): the midpoint.
             if !c.is_finite() {
                 c = a + (b - a) * T::HALF;
             }
+            // Two ulps of the scale off either end, so strictly inside (the bracket is wider
+            // than four): a root within rounding of one end, where regula falsi lands once
+            // that end's value is tiny, is bracketed by the next trial, not approached by
+            // halvings from the other end.
             c = c.max(a + margin).min(b - margin);
-            if !(c > a && c < b) {
-                c = a + (b - a) * T::HALF;
-                if !(c > a && c < b) {
-                    break;
-                }
-            }
             let gc = g_at(self, c)?;
             if gc == T::zero() {
                 return Ok(c);
