@@ -168,6 +168,7 @@ const AREAS: [Area; 14] = [
             "lagrange-integrators/src/adaptive/embedded.rs",
             "lagrange-integrators/src/adaptive/dopri5.rs",
             "lagrange-integrators/src/adaptive/dop853.rs",
+            "lagrange-integrators/src/adaptive/sums.rs",
             "lagrange-integrators/src/adaptive/nystrom.rs",
             "lagrange-integrators/src/adaptive/nystrom64.rs",
             "lagrange-integrators/src/adaptive/nystrom1210.rs",

@@ -1,8 +1,9 @@
 //! Dense output of the adaptive integrators (the continuous extension between the last two
 //! accepted points) and event location by root finding on it.
 
-use super::embedded::{check_end, combine, real, EmbeddedPair, EmbeddedRungeKutta};
+use super::embedded::{check_end, EmbeddedPair, EmbeddedRungeKutta};
 use super::nystrom::dense_rows;
+use super::sums::{combine, real};
 use crate::integrator::fail;
 use crate::Failure;
 use lagrange_core::nalgebra::SVector;

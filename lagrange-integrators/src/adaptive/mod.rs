@@ -9,6 +9,7 @@ mod nystrom;
 mod nystrom1210;
 mod nystrom64;
 mod settings;
+mod sums;
 
 pub use dop853::{Dop853Pair, DormandPrince853};
 pub use dopri5::{Dopri5Pair, DormandPrince54};

@@ -1,7 +1,7 @@
 //! The position half of the Runge-Kutta-Nyström pairs ([`Nystrom`]): their tableau's extra
 //! rows, a stage's position, and the rows of their dense output.
 
-use super::embedded::{real, stage_sum, Hermite};
+use super::sums::{real, stage_sum, Hermite};
 use lagrange_core::nalgebra::SVector;
 use lagrange_core::{Real, State};
 
