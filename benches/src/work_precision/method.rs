@@ -11,7 +11,7 @@ use lagrange_integrators::{
     AdaptiveSettings, BackwardEuler, Clock, Dop853Pair, Dopri5Pair, EmbeddedPair,
     EmbeddedRungeKutta, ExplicitEuler, Failure, GaussLegendre2, ImplicitMidpoint, Integrator,
     Nystrom1210Pair, Nystrom64Pair, RadauIIA2, Rk4, SemiImplicitEuler, StormerVerlet,
-    VariationalMidpoint, VelocityVerlet, Yoshida4,
+    VariationalMidpoint, VelocityVerlet, Verner98Pair, Yoshida4,
 };
 use std::marker::PhantomData;
 
@@ -160,6 +160,7 @@ pub fn for_each(v: &mut impl MethodVisitor) {
     v.visit(&Adaptive::<16, 4, Dop853Pair>::new(
         Tableau::DormandPrince853,
     ));
+    v.visit(&Adaptive::<17, 2, Verner98Pair>::unpaired());
     v.visit(&Adaptive::<6, 2, Nystrom64Pair>::unpaired());
     v.visit(&Adaptive::<18, 2, Nystrom1210Pair>::unpaired());
     v.visit(&HandRk4);

@@ -46,6 +46,11 @@ pub trait EmbeddedPair<const S: usize, const R: usize> {
     /// The position half of a Runge-Kutta-Nyström pair ([`Nystrom`]); `None`, the default,
     /// for a pair of the first-order system `y' = (q', q'')`.
     const NYSTROM: Option<Nystrom<S>> = None;
+    /// Whether the dense output is the quintic Hermite interpolant through `q`, `q'` and
+    /// `q''` at the step's two ends (for `q'`, its derivative), at no evaluation: order 4, for
+    /// a pair without a continuous extension of its own. It takes two rows (`R = 2`), whose
+    /// [`EmbeddedPair::DENSE`] entries are not read. The default: the Nyström pairs.
+    const HERMITE_DENSE: bool = Self::NYSTROM.is_some();
 }
 
 /// Work counts since the integrator was made or restarted.

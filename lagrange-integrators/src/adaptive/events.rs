@@ -2,7 +2,7 @@
 //! accepted points) and event location by root finding on it.
 
 use super::embedded::{check_end, EmbeddedPair, EmbeddedRungeKutta};
-use super::nystrom::dense_rows;
+use super::hermite::quintic_rows;
 use super::sums::{combine, real};
 use crate::integrator::fail;
 use crate::Failure;
@@ -87,9 +87,9 @@ where
             hermite(y1.q - y0.q, k.kq[0], k.kq[f]),
             hermite(y1.qd - y0.qd, k.kv[0], k.kv[f]),
         ));
-        if P::NYSTROM.is_some() {
+        if P::HERMITE_DENSE {
             if let ([q4, q5], [v4, v5]) = (&mut k.rows_q[..], &mut k.rows_v[..]) {
-                dense_rows([q4, q5, v4, v5], &k.hermite, &k.kv, (&y0, &y1), h, f);
+                quintic_rows([q4, q5, v4, v5], &k.hermite, &k.kv, (&y0, &y1), h, f);
             }
             return Ok(());
         }

@@ -5,11 +5,13 @@ mod dop853;
 mod dopri5;
 mod embedded;
 mod events;
+mod hermite;
 mod nystrom;
 mod nystrom1210;
 mod nystrom64;
 mod settings;
 mod sums;
+mod verner98;
 
 pub use dop853::{Dop853Pair, DormandPrince853};
 pub use dopri5::{Dopri5Pair, DormandPrince54};
@@ -19,3 +21,4 @@ pub use nystrom::{lower_triangular, Nystrom};
 pub use nystrom1210::{DormandPrinceNystrom1210, Nystrom1210Pair};
 pub use nystrom64::{DormandPrinceNystrom64, Nystrom64Pair};
 pub use settings::AdaptiveSettings;
+pub use verner98::{Verner98, Verner98Pair};

@@ -1,16 +1,18 @@
-//! The Runge-Kutta-Nyström pairs: their tableaus meet the quadrature conditions of their
-//! orders, their steps converge at those orders, the error follows the tolerance, the dense
-//! output has its stated order, frames land exactly, and a law that reads the velocities is
-//! refused.
+//! The pairs for tight tolerances, whose dense output is far below their steps' order: the
+//! Runge-Kutta-Nyström pairs and Verner's 9(8). Their tableaus meet the quadrature conditions
+//! of their orders, their steps converge at those orders, the error follows the tolerance, the
+//! dense output has its stated order, frames land exactly, events are located to the steps'
+//! accuracy, and the Nyström pairs refuse a law that reads the velocities.
 
-use lagrange_core::nalgebra::{SMatrix, SVector};
+use lagrange_core::nalgebra::{SMatrix, SVector, Vector1};
 use lagrange_core::{Error, EulerLagrange, Lagrangian, Mechanism, Real, Scalar, State};
 use lagrange_integrators::{
     AdaptiveSettings, DormandPrince853, DormandPrinceNystrom1210, DormandPrinceNystrom64,
     EmbeddedPair, EmbeddedRungeKutta, Integrator, Method, Nystrom1210Pair, Nystrom64Pair, Stop,
+    Verner98, Verner98Pair,
 };
-use lagrange_systems::exact::{kepler_orbit, pendulum_from_rest};
-use lagrange_systems::{Kepler, SimplePendulum};
+use lagrange_systems::exact::{kepler_orbit, pendulum_from_rest, DrivenOscillator};
+use lagrange_systems::{Kepler, SimplePendulum, SpringMassDamper};
 use lagrange_tests::{fitted_order, for_f32_and_f64, state_error};
 
 const G: f64 = 9.81;
@@ -100,6 +102,51 @@ fn tableaus_meet_their_quadrature_conditions() -> Result<(), String> {
     ])
 }
 
+/// The conditions a pair of the first-order system of order `p` with an embedded solution of
+/// order `p_hat` meets: each row `i` of `A` integrates `c^k` as `c_i^(k+1) / (k+1)` for `k <
+/// stage_orders[i]` (at least the row sum `c_i`; the counts are those the exact coefficients
+/// meet to 1e-25), `b` (the row of the stage at `(t0 + h, y1)`, whose node is 1) integrates
+/// `c^k` exactly for `k < p` and the embedded weights `b - E` for `k < p_hat`, but not for
+/// `k = p_hat`.
+fn check_first_order_tableau<const S: usize, const R: usize, P: EmbeddedPair<S, R>>(
+    stage_orders: [i32; S],
+) -> Result<(), String> {
+    let (p, p_hat) = (P::ORDER as i32, P::ERROR_EXPONENT as i32 - 1);
+    let f = P::FSAL;
+    assert_eq!(P::C[f], 1.0);
+    for (i, &conditions) in stage_orders.iter().enumerate() {
+        for k in 0..conditions.max(1) {
+            let expected = P::C[i].powi(k + 1) / f64::from(k + 1);
+            quadrature(&P::A[i], &P::C, k, expected)
+                .map_err(|e| format!("{} row {i}: {e}", P::NAME))?;
+        }
+        assert!(P::A[i][i..].iter().all(|&a| a == 0.0), "row {i} not lower");
+    }
+    let b = P::A[f];
+    let b_hat: Vec<f64> = b.iter().zip(&P::E).map(|(b, e)| b - e).collect();
+    for k in 0..p {
+        quadrature(&b, &P::C, k, 1.0 / f64::from(k + 1))
+            .map_err(|e| format!("{} b: {e}", P::NAME))?;
+        if k < p_hat {
+            quadrature(&b_hat, &P::C, k, 1.0 / f64::from(k + 1))
+                .map_err(|e| format!("{} embedded b: {e}", P::NAME))?;
+        }
+    }
+    assert!(
+        quadrature(&b_hat, &P::C, p_hat, 1.0 / f64::from(p_hat + 1)).is_err(),
+        "{}: the estimate is not of lower order",
+        P::NAME
+    );
+    Ok(())
+}
+
+#[test]
+fn verner_tableau_meets_its_conditions() -> Result<(), String> {
+    check_first_order_tableau::<17, 2, Verner98Pair>([
+        12, 1, 2, 3, 3, 4, 4, 5, 5, 5, 5, 5, 5, 5, 5, 5, 9,
+    ])
+}
+
 /// The 6(4) pair's coefficients are its published rationals to the nearest `f64` (one
 /// division of two exact integers is correctly rounded); the error weights `b - b^` and
 /// `b' - b'^` within 2 ulps of the larger of the two (two roundings and a subtraction).
@@ -173,49 +220,91 @@ fn the_6_4_pair_is_its_published_rationals() -> Result<(), String> {
     Ok(())
 }
 
-/// The global error at `t_end` of steps of `h` (the last shortened to land; the step bounds pinned, the
-/// tolerance loose) from the pendulum released at `th0`.
-fn fixed_step_error<const S: usize, const R: usize, P: EmbeddedPair<S, R>>(
-    th0: f64,
-    h: f64,
+/// A problem with a known end: the mechanism, its start and the exact state at `t_end`.
+struct Known<M> {
+    mechanism: M,
+    start: State<f64, 1>,
     t_end: f64,
+    exact: [f64; 2],
+}
+
+/// The pendulum released at `th0`, over `t_end`.
+fn pendulum(th0: f64, t_end: f64) -> Result<Known<SimplePendulum<f64>>, Error> {
+    let (th, thd) = pendulum_from_rest(th0, G.sqrt(), t_end)?;
+    Ok(Known {
+        mechanism: SimplePendulum::new(1.0, 1.0, G, 0.0)?,
+        start: State::at_rest([th0]),
+        t_end,
+        exact: [th, thd],
+    })
+}
+
+/// The global error at the end of `problem` of steps of `h` (the last shortened to land; the
+/// step bounds pinned, the tolerance loose).
+fn fixed_step_error<const S: usize, const R: usize, P: EmbeddedPair<S, R>, M: Mechanism<f64, 1>>(
+    problem: &Known<M>,
+    h: f64,
 ) -> Result<f64, Error> {
-    let p = SimplePendulum::new(1.0, 1.0, G, 0.0)?;
     let settings = AdaptiveSettings::new(0.5, 10.0)?
         .with_step_bounds(0.0, h)?
         .with_initial_step(h)?;
-    let mut rkn = EmbeddedRungeKutta::<f64, 1, S, R, P>::new(settings);
-    let end = rkn.integrate_to(&p, &State::at_rest([th0]), t_end)?;
-    let (th, thd) = pendulum_from_rest(th0, G.sqrt(), t_end)?;
-    let st = rkn.statistics();
-    assert_eq!(st.rejected, 0);
-    Ok(state_error(&end, &[th, thd]))
+    let mut rk = EmbeddedRungeKutta::<f64, 1, S, R, P>::new(settings);
+    let end = rk.integrate_to(&problem.mechanism, &problem.start, problem.t_end)?;
+    assert_eq!(rk.statistics().rejected, 0);
+    Ok(state_error(&end, &problem.exact))
 }
 
 /// Steps of a fixed `h` converge at the pair's order: the fitted slope of the global error
 /// against `h` is within 0.75 of it (measured 6.04 for 6(4) on the pendulum released at 0.5
 /// rad over 3.2 s, 12.63 for 12(10) released at 2 rad over 32 s, where its errors stay above
 /// rounding; a pair one order lower fits a slope a whole order lower).
+///
+/// Verner's pair is tuned for a small leading error term (`h^9` in the global error), so that
+/// wherever its errors stay above rounding the next term shows as well: measured slopes 10.18
+/// on the pendulum released at 2 rad over 32 s and 10.04 on the driven spring, so its bound
+/// above the order is 1.25 (below, it is the same 0.75).
 #[test]
 fn steps_converge_at_the_stated_order() -> Result<(), Error> {
-    order_within::<6, 2, Nystrom64Pair>(0.5, 3.2, [0.2, 0.1, 0.05, 0.025])?;
-    order_within::<18, 2, Nystrom1210Pair>(2.0, 32.0, [0.4, 0.3, 0.2, 0.15])
+    order_within::<6, 2, Nystrom64Pair, _>(&pendulum(0.5, 3.2)?, [0.2, 0.1, 0.05, 0.025], 0.75)?;
+    let hs = [0.4, 0.3, 0.2, 0.15];
+    order_within::<18, 2, Nystrom1210Pair, _>(&pendulum(2.0, 32.0)?, hs, 0.75)?;
+    order_within::<17, 2, Verner98Pair, _>(&driven(32.0)?, hs, 1.25)?;
+    let hs = [0.2, 0.15, 0.1, 0.075];
+    order_within::<17, 2, Verner98Pair, _>(&pendulum(2.0, 32.0)?, hs, 1.25)
 }
 
-/// The slope of the global error against the fixed steps `hs` from the pendulum released at
-/// `th0`, over `t_end`, within 0.75 of the pair's order.
-fn order_within<const S: usize, const R: usize, P: EmbeddedPair<S, R>>(
-    th0: f64,
-    t_end: f64,
+/// The driven, damped spring of `tests/adaptive.rs` (`m = 1`, `k = 4`, `c = 0.5`, a force
+/// `3 cos 3t`) from `x = 1` at rest, over `t_end`: a law that reads the velocity and the time.
+fn driven(t_end: f64) -> Result<Known<impl Mechanism<f64, 1>>, Error> {
+    let (x, v) = DrivenOscillator::new(1.0, 4.0, 0.5, 3.0, 3.0)?.state(1.0, 0.0, t_end)?;
+    let spring = SpringMassDamper::new(1.0, 4.0, 0.5)?
+        .with_force(|s: &State<f64, 1>| Vector1::new(3.0 * (3.0 * s.t).cos()));
+    Ok(Known {
+        mechanism: spring,
+        start: State::new(0.0, [1.0], [0.0]),
+        t_end,
+        exact: [x, v],
+    })
+}
+
+/// The slope of the global error of `problem` against the fixed steps `hs`: above the pair's
+/// order less 0.75, and below it plus `above`.
+fn order_within<const S: usize, const R: usize, P: EmbeddedPair<S, R>, M: Mechanism<f64, 1>>(
+    problem: &Known<M>,
     hs: [f64; 4],
+    above: f64,
 ) -> Result<(), Error> {
     let errs: Vec<f64> = hs
         .iter()
-        .map(|&h| fixed_step_error::<S, R, P>(th0, h, t_end))
+        .map(|&h| fixed_step_error::<S, R, P, M>(problem, h))
         .collect::<Result<_, _>>()?;
     let slope = fitted_order(&hs, &errs);
     println!("{}: {errs:?}, slope {slope:.2}", P::NAME);
-    assert!((slope - f64::from(P::ORDER)).abs() < 0.75, "slope {slope}");
+    let order = f64::from(P::ORDER);
+    assert!(
+        slope > order - 0.75 && slope < order + above,
+        "slope {slope}"
+    );
     Ok(())
 }
 
@@ -251,7 +340,8 @@ fn tolerance_sweep<const S: usize, const R: usize, P: EmbeddedPair<S, R>>(
 /// The final error follows the tolerance (fitted slope within 0.5 of 1) and stays below it
 /// (measured: 6(4) over rtol 1e-5..1e-10, slope 1.32, errors 0.004 to 0.09 tolerances;
 /// 12(10) over 1e-5..1e-9, whose tenth-order estimate is far above its twelfth-order steps'
-/// error: errors below a hundredth of the tolerance), for at most 10% more evaluations than
+/// error: errors below a hundredth of the tolerance; 9(8) over 1e-5..1e-10, slope 0.89, errors
+/// 0.002 to 0.14 tolerances), for at most 10% more evaluations than
 /// measured (the steps the estimate allows: an estimate scaled wrong takes more).
 #[test]
 fn error_follows_the_tolerance() -> Result<(), Error> {
@@ -276,13 +366,17 @@ fn error_follows_the_tolerance() -> Result<(), Error> {
     let rtols = [1e-5, 1e-6, 1e-7, 1e-8, 1e-9];
     let sweep = tolerance_sweep::<18, 2, Nystrom1210Pair>(&rtols)?;
     check(&rtols, sweep, &[444, 529, 631, 767, 937], "12(10)");
+    let rtols = [1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10];
+    let sweep = tolerance_sweep::<17, 2, Verner98Pair>(&rtols)?;
+    check(&rtols, sweep, &[546, 674, 834, 1042, 1314, 1682], "9(8)");
     Ok(())
 }
 
 /// The local error of the dense output of one step of `h` from an exact state shrinks like
 /// `h^5` (the velocity's quartic; the position's quintic is an order better): fitted slopes
 /// within 0.3 of `DENSE_ORDER + 1` and of one more for `q` (measured 5.14 and 6.12 for 6(4),
-/// 5.13 and 6.13 for 12(10): the interpolant is the same, the steps' errors far below it).
+/// 5.13 and 6.13 for 12(10) and 9(8): the interpolant is the same, the steps' errors far
+/// below it).
 fn dense_output_local_order<const S: usize, const R: usize, P: EmbeddedPair<S, R>>(
     hs: &[f64],
 ) -> Result<(), Error> {
@@ -322,7 +416,8 @@ fn dense_output_local_order<const S: usize, const R: usize, P: EmbeddedPair<S, R
 #[test]
 fn dense_output_has_its_stated_order() -> Result<(), Error> {
     dense_output_local_order::<6, 2, Nystrom64Pair>(&[0.2, 0.1, 0.05, 0.025])?;
-    dense_output_local_order::<18, 2, Nystrom1210Pair>(&[0.2, 0.1, 0.05, 0.025])
+    dense_output_local_order::<18, 2, Nystrom1210Pair>(&[0.2, 0.1, 0.05, 0.025])?;
+    dense_output_local_order::<17, 2, Verner98Pair>(&[0.2, 0.1, 0.05, 0.025])
 }
 
 /// A law that reads the velocities is refused by every entry point, before any evaluation,
@@ -407,8 +502,8 @@ fn frames<T: Real, I: Integrator<T, 1, SimplePendulum<T>>>(
 }
 
 /// Frames of 1/60 s land on their times exactly, by steps shortened to them: the pendulum
-/// after 600 frames within 10 tolerances (f64 at rtol 1e-10: measured 7.2e-14 for 6(4) and
-/// 4.9e-15 for 12(10); f32 at rtol 1e-5: 3.6e-7 and 1.7e-7).
+/// after 600 frames within 10 tolerances (f64 at rtol 1e-10: measured 7.2e-14 for 6(4),
+/// 4.9e-15 for 12(10) and 4.7e-15 for 9(8); f32 at rtol 1e-5: 3.6e-7, 1.7e-7 and 1.2e-6).
 fn frames_land_exactly<T: Real>() -> Result<(), Error> {
     let rtol = if T::EPSILON.to_f64() > 1e-10 {
         1e-5
@@ -424,8 +519,9 @@ fn frames_land_exactly<T: Real>() -> Result<(), Error> {
     let mut rkn12 = DormandPrinceNystrom1210::<T, 1>::new(settings);
     let end6 = frames(&mut rkn6, &p, s0, dt)?;
     let end12 = frames(&mut rkn12, &p, s0, dt)?;
+    let end9 = frames(&mut Verner98::<T, 1>::new(settings), &p, s0, dt)?;
     let (th, thd) = pendulum_from_rest(th0, G.sqrt(), end6.t.to_f64())?;
-    for (name, end) in [("6(4)", end6), ("12(10)", end12)] {
+    for (name, end) in [("6(4)", end6), ("12(10)", end12), ("9(8)", end9)] {
         let err = state_error(&end, &[th, thd]);
         println!(
             "{name} {}: 600 frames, error {err:.2e}",
@@ -497,7 +593,8 @@ fn a_users_orbit_in_cartesian_coordinates() -> Result<(), Error> {
 }
 
 /// The pendulum released from rest crosses `th = 0` at a quarter period: at rtol 1e-12,
-/// located within 1e-14 s by both pairs (measured 1.1e-16 and 2.2e-16), the state there
+/// located within 1e-14 s by the three pairs (measured 1.1e-16, 2.2e-16 and 4.4e-16 for
+/// 6(4), 12(10) and 9(8)), the state there
 /// within 1e-13 of the exact one. 12(10)'s steps are long beside its order-4 interpolant (on
 /// it alone the crossing was 1.5e-10 s off, the velocity 1.2e-8): the event is located again
 /// on its own steps, from the interpolant's time and a Newton step on its slope (measured 68
@@ -514,13 +611,19 @@ fn events_are_located_to_the_steps_accuracy() -> Result<(), Error> {
     let stop6 = rkn6.integrate_until_event(&p, &State::at_rest([th0]), 10.0, guard)?;
     let mut rkn12 = DormandPrinceNystrom1210::<f64, 1>::new(settings);
     let stop12 = rkn12.integrate_until_event(&p, &State::at_rest([th0]), 10.0, guard)?;
+    let stop9 = Verner98::<f64, 1>::new(settings).integrate_until_event(
+        &p,
+        &State::at_rest([th0]),
+        10.0,
+        guard,
+    )?;
     let evals = rkn12.statistics().evaluations;
     let mut plain = DormandPrinceNystrom1210::<f64, 1>::new(settings);
     plain.integrate_to(&p, &State::at_rest([th0]), stop12.state().t)?;
     let located_by_steps = evals - plain.statistics().evaluations;
     println!("12(10): {evals} evaluations, {located_by_steps} more than a run to the event");
     assert!(located_by_steps <= 5 * 17, "{located_by_steps}");
-    for (name, stop) in [("6(4)", stop6), ("12(10)", stop12)] {
+    for (name, stop) in [("6(4)", stop6), ("12(10)", stop12), ("9(8)", stop9)] {
         let Stop::Event(s) = stop else {
             return Err(Error::NoConvergence { iterations: 0 });
         };
