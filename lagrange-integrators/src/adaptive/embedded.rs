@@ -26,8 +26,8 @@ pub trait EmbeddedPair<const S: usize, const R: usize> {
     const ORDER: u32;
     /// `k` of the controller: the error estimate scales like `h^k`.
     const ERROR_EXPONENT: u32;
-    /// Order of the dense output. More than one below [`EmbeddedPair::ORDER`] (the Nyström
-    /// pairs), it is not trusted where a step is: [`Integrator::step`] lands on a frame's end by
+    /// Order of the dense output. More than one below [`EmbeddedPair::ORDER`] (the Nyström and
+    /// Verner pairs), it is not trusted where a step is: [`Integrator::step`] lands on a frame's end by
     /// a step shortened to it, and an event is located again on steps of the pair.
     const DENSE_ORDER: u32;
     /// The nodes `c_i`.
@@ -49,7 +49,8 @@ pub trait EmbeddedPair<const S: usize, const R: usize> {
     /// Whether the dense output is the quintic Hermite interpolant through `q`, `q'` and
     /// `q''` at the step's two ends (for `q'`, its derivative), at no evaluation: order 4, for
     /// a pair without a continuous extension of its own. It takes two rows (`R = 2`), whose
-    /// [`EmbeddedPair::DENSE`] entries are not read. The default: the Nyström pairs.
+    /// [`EmbeddedPair::DENSE`] entries are not read. The default: `true` for the Nyström
+    /// pairs.
     const HERMITE_DENSE: bool = Self::NYSTROM.is_some();
 }
 
@@ -67,9 +68,10 @@ pub struct Statistics {
 
 /// An adaptive explicit Runge-Kutta integrator on the pair `P`: use the aliases
 /// [`DormandPrince54`](crate::DormandPrince54) and
-/// [`DormandPrince853`](crate::DormandPrince853), and for laws that do not read the
-/// velocities the Runge-Kutta-Nyström [`DormandPrinceNystrom64`](crate::DormandPrinceNystrom64)
-/// and [`DormandPrinceNystrom1210`](crate::DormandPrinceNystrom1210).
+/// [`DormandPrince853`](crate::DormandPrince853) and [`Verner98`](crate::Verner98), and for
+/// laws that do not read the velocities the Runge-Kutta-Nyström
+/// [`DormandPrinceNystrom64`](crate::DormandPrinceNystrom64) and
+/// [`DormandPrinceNystrom1210`](crate::DormandPrinceNystrom1210).
 ///
 /// It advances by steps whose size a PI controller chooses from the embedded error estimate:
 ///
@@ -86,8 +88,8 @@ pub struct Statistics {
 /// - [`Integrator::step`] lands exactly on `state.t + dt` through the continuous extension
 ///   (dense output), so a frame loop ([`FixedTimestep`](crate::FixedTimestep), a scene) can
 ///   drive it with its own steps taken at the size the error control allows, not the frame's
-///   (a pair whose dense output is more than an order below its steps, the Nyström pairs',
-///   lands by a last step shortened to the frame's end instead);
+///   (a pair whose dense output is more than an order below its steps, the Nyström and
+///   Verner pairs', lands by a last step shortened to the frame's end instead);
 /// - [`EmbeddedRungeKutta::integrate_to`] steps to an end time, its last step shortened to
 ///   land there;
 /// - [`EmbeddedRungeKutta::next_step`] takes one step of the controller's choosing, and
@@ -798,7 +800,8 @@ where
     /// Lands on `state.t + dt` through the continuous extension, the internal steps as long
     /// as the tolerance allows (they run ahead of the landing; the next call from this one's
     /// result continues from them). A pair whose dense output is more than one order below
-    /// its own (the Nyström pairs: quintic Hermite under orders 6 and 12) lands by a last
+    /// its own (quintic Hermite under the orders 6, 9 and 12 of the Nyström and Verner pairs)
+    /// lands by a last
     /// step shortened to `state.t + dt` instead, so that a frame is as accurate as a step.
     fn step(&mut self, m: &M, state: &State<T, N>, dt: T) -> Result<State<T, N>, Error> {
         let dt = check_step(state, dt)?;

@@ -142,7 +142,7 @@ where
     /// The state at time `t` inside the last step taken by
     /// [`EmbeddedRungeKutta::next_step`] (from its start to its end), by the method's
     /// continuous extension (order 4 for Dormand-Prince 5(4), 7 for DOP853, 4 for the
-    /// Nyström pairs).
+    /// Nyström and Verner pairs).
     ///
     /// # Errors
     /// [`Error::InvalidParameter`] `t` when outside [`EmbeddedRungeKutta::dense_interval`]
@@ -168,7 +168,7 @@ where
     /// of the change on the dense output (the Illinois variant of regula falsi, to
     /// [`AdaptiveSettings::event_tolerance`](super::AdaptiveSettings::event_tolerance) or to
     /// rounding; for a pair whose dense output is more than an order below its steps, the
-    /// Nyström pairs, again on steps of the pair from there), and stops there; a call from the
+    /// Nyström and Verner pairs, again on steps of the pair from there), and stops there; a call from the
     /// state it returns continues the run.
     ///
     /// The guard is a function `g(t, q, q')` of the state. A sign change is a step from a
@@ -247,7 +247,7 @@ where
     /// at the step's end: the state there becomes the run's current one.
     ///
     /// The time is located on the dense output. Where that is more than an order below the
-    /// steps (the Nyström pairs), it is located again on steps of the method itself from the
+    /// steps (the Nyström and Verner pairs), it is located again on steps of the method itself from the
     /// step's start, the dense output's time tried first: the state returned is then as
     /// accurate as a step's, and the guard there is that state's.
     fn stop_at_event<M, G>(
