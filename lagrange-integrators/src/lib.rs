@@ -20,6 +20,7 @@
 //! | [`DormandPrince853`] | 8 (5, 3) | explicit, adaptive (PI control, dense output order 7, events) | no | 12 per accepted step (+3 where dense output is sampled) | high accuracy, tolerances `1e-7` to `1e-14` |
 //! | [`Verner98`] | 9 (8) | explicit, adaptive (PI control, dense output order 4, events) | no | 16 per accepted step | tight tolerances `1e-9` to `1e-14` on any law |
 //! | [`DormandPrinceNystrom64`] | 6 (4) | explicit Runge-Kutta-Nyström, adaptive (PI control, dense output order 4, events); laws that do not read `q'` only | no | 5 per accepted step | such laws (undamped pendulums, gravity, springs) at tolerances `1e-4` to `1e-9` |
+//! | [`DormandPrinceNystrom86`] | 8 (6) | explicit Runge-Kutta-Nyström, adaptive (PI control, dense output order 4, events); laws that do not read `q'` only | no | 8 per accepted step | such laws at tolerances `1e-6` to `1e-10` |
 //! | [`DormandPrinceNystrom1210`] | 12 (10) | explicit Runge-Kutta-Nyström, adaptive (PI control, dense output order 4, events); laws that do not read `q'` only | no | 17 per accepted step | such laws at tolerances `1e-9` to `1e-14` |
 //!
 //! "Constant `M`, forces of `q`" is the separable case, where `(q, q')` is a linear image of
@@ -83,8 +84,9 @@ mod yoshida;
 
 pub use adaptive::{
     lower_triangular, AdaptiveSettings, Dop853Pair, Dopri5Pair, DormandPrince54, DormandPrince853,
-    DormandPrinceNystrom1210, DormandPrinceNystrom64, EmbeddedPair, EmbeddedRungeKutta, Nystrom,
-    Nystrom1210Pair, Nystrom64Pair, Statistics, Stop, Verner98, Verner98Pair,
+    DormandPrinceNystrom1210, DormandPrinceNystrom64, DormandPrinceNystrom86, EmbeddedPair,
+    EmbeddedRungeKutta, Nystrom, Nystrom1210Pair, Nystrom64Pair, Nystrom86Pair, Statistics, Stop,
+    Verner98, Verner98Pair,
 };
 pub use backward_euler::{BackwardEuler, BackwardEulerTableau};
 pub use clock::Clock;

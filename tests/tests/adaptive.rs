@@ -355,6 +355,7 @@ fn adaptive_overflow_is_rejected<T: Real>() -> Result<(), Error> {
     overflow_is_rejected::<16, 4, lagrange_integrators::Dop853Pair, T>()?;
     // The Nyström pairs too: a falling particle's law does not read its velocity.
     overflow_is_rejected::<6, 2, lagrange_integrators::Nystrom64Pair, T>()?;
+    overflow_is_rejected::<9, 2, lagrange_integrators::Nystrom86Pair, T>()?;
     overflow_is_rejected::<18, 2, lagrange_integrators::Nystrom1210Pair, T>()?;
     overflow_is_rejected::<17, 2, lagrange_integrators::Verner98Pair, T>()
 }

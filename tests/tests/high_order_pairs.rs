@@ -8,8 +8,8 @@ use lagrange_core::nalgebra::{SMatrix, SVector, Vector1};
 use lagrange_core::{Error, EulerLagrange, Lagrangian, Mechanism, Real, Scalar, State};
 use lagrange_integrators::{
     AdaptiveSettings, DormandPrince853, DormandPrinceNystrom1210, DormandPrinceNystrom64,
-    EmbeddedPair, EmbeddedRungeKutta, Integrator, Method, Nystrom1210Pair, Nystrom64Pair, Stop,
-    Verner98, Verner98Pair,
+    DormandPrinceNystrom86, EmbeddedPair, EmbeddedRungeKutta, Integrator, Method, Nystrom1210Pair,
+    Nystrom64Pair, Nystrom86Pair, Stop, Verner98, Verner98Pair,
 };
 use lagrange_systems::exact::{kepler_orbit, pendulum_from_rest, DrivenOscillator};
 use lagrange_systems::{Kepler, SimplePendulum, SpringMassDamper};
@@ -97,6 +97,7 @@ fn check_tableau<const S: usize, const R: usize, P: EmbeddedPair<S, R>>(
 #[test]
 fn tableaus_meet_their_quadrature_conditions() -> Result<(), String> {
     check_tableau::<6, 2, Nystrom64Pair>([13, 1, 1, 1, 1, 5])?;
+    check_tableau::<9, 2, Nystrom86Pair>([14, 1, 3, 3, 3, 3, 3, 3, 7])?;
     check_tableau::<18, 2, Nystrom1210Pair>([
         13, 1, 3, 3, 4, 5, 5, 5, 5, 5, 5, 5, 5, 5, 5, 5, 5, 11,
     ])
@@ -256,7 +257,7 @@ fn fixed_step_error<const S: usize, const R: usize, P: EmbeddedPair<S, R>, M: Me
 
 /// Steps of a fixed `h` converge at the pair's order: the fitted slope of the global error
 /// against `h` is within 0.75 of it (measured 6.04 for 6(4) on the pendulum released at 0.5
-/// rad over 3.2 s, 12.63 for 12(10) released at 2 rad over 32 s, where its errors stay above
+/// rad over 3.2 s, 8.55 for 8(6) and 12.63 for 12(10) released at 2 rad over 32 s, where its errors stay above
 /// rounding; a pair one order lower fits a slope a whole order lower).
 ///
 /// Verner's pair is tuned for a small leading error term (`h^9` in the global error), so that
@@ -266,6 +267,7 @@ fn fixed_step_error<const S: usize, const R: usize, P: EmbeddedPair<S, R>, M: Me
 #[test]
 fn steps_converge_at_the_stated_order() -> Result<(), Error> {
     order_within::<6, 2, Nystrom64Pair, _>(&pendulum(0.5, 3.2)?, [0.2, 0.1, 0.05, 0.025], 0.75)?;
+    order_within::<9, 2, Nystrom86Pair, _>(&pendulum(2.0, 32.0)?, [0.2, 0.15, 0.1, 0.075], 0.75)?;
     let hs = [0.4, 0.3, 0.2, 0.15];
     order_within::<18, 2, Nystrom1210Pair, _>(&pendulum(2.0, 32.0)?, hs, 0.75)?;
     order_within::<17, 2, Verner98Pair, _>(&driven(32.0)?, hs, 1.25)?;
@@ -341,7 +343,8 @@ fn tolerance_sweep<const S: usize, const R: usize, P: EmbeddedPair<S, R>>(
 /// (measured: 6(4) over rtol 1e-5..1e-10, slope 1.32, errors 0.004 to 0.09 tolerances;
 /// 12(10) over 1e-5..1e-9, whose tenth-order estimate is far above its twelfth-order steps'
 /// error: errors below a hundredth of the tolerance; 9(8) over 1e-5..1e-10, slope 0.89, errors
-/// 0.002 to 0.14 tolerances), for at most 10% more evaluations than
+/// 0.002 to 0.14 tolerances; 8(6) over 1e-5..1e-10, slope 1.25, errors 0.0008 to 0.014
+/// tolerances), for at most 10% more evaluations than
 /// measured (the steps the estimate allows: an estimate scaled wrong takes more).
 #[test]
 fn error_follows_the_tolerance() -> Result<(), Error> {
@@ -363,6 +366,9 @@ fn error_follows_the_tolerance() -> Result<(), Error> {
     let rtols = [1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10];
     let sweep = tolerance_sweep::<6, 2, Nystrom64Pair>(&rtols)?;
     check(&rtols, sweep, &[407, 617, 952, 1542, 2402, 3822], "6(4)");
+    let rtols = [1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10];
+    let sweep = tolerance_sweep::<9, 2, Nystrom86Pair>(&rtols)?;
+    check(&rtols, sweep, &[362, 562, 698, 1010, 1338, 1802], "8(6)");
     let rtols = [1e-5, 1e-6, 1e-7, 1e-8, 1e-9];
     let sweep = tolerance_sweep::<18, 2, Nystrom1210Pair>(&rtols)?;
     check(&rtols, sweep, &[444, 529, 631, 767, 937], "12(10)");
@@ -375,7 +381,7 @@ fn error_follows_the_tolerance() -> Result<(), Error> {
 /// The local error of the dense output of one step of `h` from an exact state shrinks like
 /// `h^5` (the velocity's quartic; the position's quintic is an order better): fitted slopes
 /// within 0.3 of `DENSE_ORDER + 1` and of one more for `q` (measured 5.14 and 6.12 for 6(4),
-/// 5.13 and 6.13 for 12(10) and 9(8): the interpolant is the same, the steps' errors far
+/// 5.13 and 6.13 for 8(6), 12(10) and 9(8): the interpolant is the same, the steps' errors far
 /// below it).
 fn dense_output_local_order<const S: usize, const R: usize, P: EmbeddedPair<S, R>>(
     hs: &[f64],
@@ -416,6 +422,7 @@ fn dense_output_local_order<const S: usize, const R: usize, P: EmbeddedPair<S, R
 #[test]
 fn dense_output_has_its_stated_order() -> Result<(), Error> {
     dense_output_local_order::<6, 2, Nystrom64Pair>(&[0.2, 0.1, 0.05, 0.025])?;
+    dense_output_local_order::<9, 2, Nystrom86Pair>(&[0.2, 0.1, 0.05, 0.025])?;
     dense_output_local_order::<18, 2, Nystrom1210Pair>(&[0.2, 0.1, 0.05, 0.025])?;
     dense_output_local_order::<17, 2, Verner98Pair>(&[0.2, 0.1, 0.05, 0.025])
 }
@@ -460,6 +467,9 @@ fn laws_that_read_the_velocities_are_refused() -> Result<(), Error> {
             .map_err(|f| f.error),
     );
     assert_eq!(rkn.last_step().evaluations, 0);
+    let mut rkn8 = DormandPrinceNystrom86::<f64, 1>::new(settings);
+    refused(rkn8.integrate_to(&damped, &s0, 1.0).map_err(|f| f.error));
+    assert_eq!(rkn8.last_step().evaluations, 0);
     let mut polar = DormandPrinceNystrom1210::<f64, 2>::new(settings);
     let r = polar.integrate_to(&orbit, &State::new(0.0, [1.0, 0.0], [0.0, 1.0]), 1.0);
     assert!(
@@ -503,7 +513,8 @@ fn frames<T: Real, I: Integrator<T, 1, SimplePendulum<T>>>(
 
 /// Frames of 1/60 s land on their times exactly, by steps shortened to them: the pendulum
 /// after 600 frames within 10 tolerances (f64 at rtol 1e-10: measured 7.2e-14 for 6(4),
-/// 4.9e-15 for 12(10) and 4.7e-15 for 9(8); f32 at rtol 1e-5: 3.6e-7, 1.7e-7 and 1.2e-6).
+/// 1.8e-15 for 8(6), 4.9e-15 for 12(10) and 4.7e-15 for 9(8); f32 at rtol 1e-5: 3.6e-7,
+/// 2.7e-7, 1.7e-7 and 1.2e-6).
 fn frames_land_exactly<T: Real>() -> Result<(), Error> {
     let rtol = if T::EPSILON.to_f64() > 1e-10 {
         1e-5
@@ -520,8 +531,19 @@ fn frames_land_exactly<T: Real>() -> Result<(), Error> {
     let end6 = frames(&mut rkn6, &p, s0, dt)?;
     let end12 = frames(&mut rkn12, &p, s0, dt)?;
     let end9 = frames(&mut Verner98::<T, 1>::new(settings), &p, s0, dt)?;
+    let end8 = frames(
+        &mut DormandPrinceNystrom86::<T, 1>::new(settings),
+        &p,
+        s0,
+        dt,
+    )?;
     let (th, thd) = pendulum_from_rest(th0, G.sqrt(), end6.t.to_f64())?;
-    for (name, end) in [("6(4)", end6), ("12(10)", end12), ("9(8)", end9)] {
+    for (name, end) in [
+        ("6(4)", end6),
+        ("8(6)", end8),
+        ("12(10)", end12),
+        ("9(8)", end9),
+    ] {
         let err = state_error(&end, &[th, thd]);
         println!(
             "{name} {}: 600 frames, error {err:.2e}",
@@ -593,8 +615,8 @@ fn a_users_orbit_in_cartesian_coordinates() -> Result<(), Error> {
 }
 
 /// The pendulum released from rest crosses `th = 0` at a quarter period: at rtol 1e-12,
-/// located within 1e-14 s by the three pairs (measured 1.1e-16, 2.2e-16 and 4.4e-16 for
-/// 6(4), 12(10) and 9(8)), the state there
+/// located within 1e-14 s by the four pairs (measured 1.1e-16, 2.2e-16, 2.2e-16 and 4.4e-16
+/// for 6(4), 8(6), 12(10) and 9(8)), the state there
 /// within 1e-13 of the exact one. 12(10)'s steps are long beside its order-4 interpolant (on
 /// it alone the crossing was 1.5e-10 s off, the velocity 1.2e-8): the event is located again
 /// on its own steps, from the interpolant's time and a Newton step on its slope (measured 68
@@ -611,6 +633,12 @@ fn events_are_located_to_the_steps_accuracy() -> Result<(), Error> {
     let stop6 = rkn6.integrate_until_event(&p, &State::at_rest([th0]), 10.0, guard)?;
     let mut rkn12 = DormandPrinceNystrom1210::<f64, 1>::new(settings);
     let stop12 = rkn12.integrate_until_event(&p, &State::at_rest([th0]), 10.0, guard)?;
+    let stop8 = DormandPrinceNystrom86::<f64, 1>::new(settings).integrate_until_event(
+        &p,
+        &State::at_rest([th0]),
+        10.0,
+        guard,
+    )?;
     let stop9 = Verner98::<f64, 1>::new(settings).integrate_until_event(
         &p,
         &State::at_rest([th0]),
@@ -623,7 +651,12 @@ fn events_are_located_to_the_steps_accuracy() -> Result<(), Error> {
     let located_by_steps = evals - plain.statistics().evaluations;
     println!("12(10): {evals} evaluations, {located_by_steps} more than a run to the event");
     assert!(located_by_steps <= 5 * 17, "{located_by_steps}");
-    for (name, stop) in [("6(4)", stop6), ("12(10)", stop12), ("9(8)", stop9)] {
+    for (name, stop) in [
+        ("6(4)", stop6),
+        ("8(6)", stop8),
+        ("12(10)", stop12),
+        ("9(8)", stop9),
+    ] {
         let Stop::Event(s) = stop else {
             return Err(Error::NoConvergence { iterations: 0 });
         };

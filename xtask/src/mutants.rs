@@ -172,6 +172,7 @@ const AREAS: [Area; 14] = [
             "lagrange-integrators/src/adaptive/nystrom.rs",
             "lagrange-integrators/src/adaptive/hermite.rs",
             "lagrange-integrators/src/adaptive/nystrom64.rs",
+            "lagrange-integrators/src/adaptive/nystrom86.rs",
             "lagrange-integrators/src/adaptive/nystrom1210.rs",
             "lagrange-integrators/src/adaptive/verner98.rs",
             "lagrange-integrators/src/adaptive/controller.rs",

@@ -10,8 +10,8 @@ use lagrange_core::{Error, Mechanism, Real, State};
 use lagrange_integrators::{
     AdaptiveSettings, BackwardEuler, Clock, Dop853Pair, Dopri5Pair, EmbeddedPair,
     EmbeddedRungeKutta, ExplicitEuler, Failure, GaussLegendre2, ImplicitMidpoint, Integrator,
-    Nystrom1210Pair, Nystrom64Pair, RadauIIA2, Rk4, SemiImplicitEuler, StormerVerlet,
-    VariationalMidpoint, VelocityVerlet, Verner98Pair, Yoshida4,
+    Nystrom1210Pair, Nystrom64Pair, Nystrom86Pair, RadauIIA2, Rk4, SemiImplicitEuler,
+    StormerVerlet, VariationalMidpoint, VelocityVerlet, Verner98Pair, Yoshida4,
 };
 use std::marker::PhantomData;
 
@@ -162,6 +162,7 @@ pub fn for_each(v: &mut impl MethodVisitor) {
     ));
     v.visit(&Adaptive::<17, 2, Verner98Pair>::unpaired());
     v.visit(&Adaptive::<6, 2, Nystrom64Pair>::unpaired());
+    v.visit(&Adaptive::<9, 2, Nystrom86Pair>::unpaired());
     v.visit(&Adaptive::<18, 2, Nystrom1210Pair>::unpaired());
     v.visit(&HandRk4);
     v.visit(&OdeSolvers(Peer::Dopri5));
