@@ -357,6 +357,7 @@ fn adaptive_overflow_is_rejected<T: Real>() -> Result<(), Error> {
     overflow_is_rejected::<6, 2, lagrange_integrators::Nystrom64Pair, T>()?;
     overflow_is_rejected::<9, 2, lagrange_integrators::Nystrom86Pair, T>()?;
     overflow_is_rejected::<18, 2, lagrange_integrators::Nystrom1210Pair, T>()?;
+    // And Verner's 9(8), whose dense output is the Nyström pairs'.
     overflow_is_rejected::<17, 2, lagrange_integrators::Verner98Pair, T>()
 }
 
@@ -549,7 +550,7 @@ fn dop853_held_to_its_tolerance<T: Real>() -> Result<(), Error> {
 /// ```
 ///
 /// Its eighth-order estimate is far above its ninth-order steps' error: the errors are a
-/// fiftieth to a hundredth of the tolerance.
+/// seventh to a hundred-and-thirtieth of the tolerance.
 fn verner_held_to_its_tolerance<T: Real>() -> Result<(), Error> {
     let rtols = pick_rtols::<T>(
         &[1e-3, 1e-4, 1e-5],

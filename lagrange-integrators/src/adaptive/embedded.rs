@@ -49,8 +49,8 @@ pub trait EmbeddedPair<const S: usize, const R: usize> {
     /// Whether the dense output is the quintic Hermite interpolant through `q`, `q'` and
     /// `q''` at the step's two ends (for `q'`, its derivative), at no evaluation: order 4, for
     /// a pair without a continuous extension of its own. It takes two rows (`R = 2`), whose
-    /// [`EmbeddedPair::DENSE`] entries are not read. The default: `true` for the Nyström
-    /// pairs.
+    /// [`EmbeddedPair::DENSE`] entries are not read (a pair that sets it with another `R` does
+    /// not compile). The default: `true` for the Nyström pairs.
     const HERMITE_DENSE: bool = Self::NYSTROM.is_some();
 }
 
@@ -70,7 +70,8 @@ pub struct Statistics {
 /// [`DormandPrince54`](crate::DormandPrince54) and
 /// [`DormandPrince853`](crate::DormandPrince853) and [`Verner98`](crate::Verner98), and for
 /// laws that do not read the velocities the Runge-Kutta-Nyström
-/// [`DormandPrinceNystrom64`](crate::DormandPrinceNystrom64) and
+/// [`DormandPrinceNystrom64`](crate::DormandPrinceNystrom64),
+/// [`DormandPrinceNystrom86`](crate::DormandPrinceNystrom86) and
 /// [`DormandPrinceNystrom1210`](crate::DormandPrinceNystrom1210).
 ///
 /// It advances by steps whose size a PI controller chooses from the embedded error estimate:
@@ -800,9 +801,9 @@ where
     /// Lands on `state.t + dt` through the continuous extension, the internal steps as long
     /// as the tolerance allows (they run ahead of the landing; the next call from this one's
     /// result continues from them). A pair whose dense output is more than one order below
-    /// its own (quintic Hermite under the orders 6, 9 and 12 of the Nyström and Verner pairs)
-    /// lands by a last
-    /// step shortened to `state.t + dt` instead, so that a frame is as accurate as a step.
+    /// its own (quintic Hermite under the orders 6, 8, 9 and 12 of the Nyström and Verner
+    /// pairs) lands by a last step shortened to `state.t + dt` instead, so that a frame is as
+    /// accurate as a step.
     fn step(&mut self, m: &M, state: &State<T, N>, dt: T) -> Result<State<T, N>, Error> {
         let dt = check_step(state, dt)?;
         let exact_end = P::DENSE_ORDER + 1 < P::ORDER;

@@ -88,6 +88,7 @@ where
             hermite(y1.qd - y0.qd, k.kv[0], k.kv[f]),
         ));
         if P::HERMITE_DENSE {
+            const { assert!(!P::HERMITE_DENSE || R == 2, "HERMITE_DENSE takes R = 2") };
             if let ([q4, q5], [v4, v5]) = (&mut k.rows_q[..], &mut k.rows_v[..]) {
                 quintic_rows([q4, q5, v4, v5], &k.hermite, &k.kv, (&y0, &y1), h, f);
             }
