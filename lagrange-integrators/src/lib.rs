@@ -18,6 +18,7 @@
 //! | [`VariationalMidpoint`] | 2 | implicit (Newton on the discrete Euler-Lagrange equations) | yes, any Lagrangian, in `(q, p)`; cyclic momenta kept exactly | Lagrangian in dual numbers: 1 first-order per iteration + 1 second-order per Jacobian + 1 first-order | long runs of mechanisms whose mass matrix depends on `q`, momentum conservation, forced (Lagrange-d'Alembert) |
 //! | [`DormandPrince54`] | 5 (4) | explicit, adaptive (PI control, dense output order 4, events) | no | 6 per accepted step | general purpose, tolerances `1e-3` to `1e-8` |
 //! | [`DormandPrince853`] | 8 (5, 3) | explicit, adaptive (PI control, dense output order 7, events) | no | 12 per accepted step (+3 where dense output is sampled) | high accuracy, tolerances `1e-7` to `1e-14` |
+//! | [`Verner76`] | 7 (6) | explicit, adaptive (PI control, dense output order 4, events) | no | 10 per accepted step | tolerances `1e-6` to `1e-11` on any law |
 //! | [`Verner98`] | 9 (8) | explicit, adaptive (PI control, dense output order 4, events) | no | 16 per accepted step | tight tolerances `1e-9` to `1e-14` on any law |
 //! | [`DormandPrinceNystrom64`] | 6 (4) | explicit Runge-Kutta-Nyström, adaptive (PI control, dense output order 4, events); laws that do not read `q'` only | no | 5 per accepted step | such laws (undamped pendulums, gravity, springs) at tolerances `1e-4` to `1e-9` |
 //! | [`DormandPrinceNystrom86`] | 8 (6) | explicit Runge-Kutta-Nyström, adaptive (PI control, dense output order 4, events); laws that do not read `q'` only | no | 8 per accepted step | such laws at tolerances `1e-6` to `1e-10` |
@@ -86,7 +87,7 @@ pub use adaptive::{
     lower_triangular, AdaptiveSettings, Dop853Pair, Dopri5Pair, DormandPrince54, DormandPrince853,
     DormandPrinceNystrom1210, DormandPrinceNystrom64, DormandPrinceNystrom86, EmbeddedPair,
     EmbeddedRungeKutta, Nystrom, Nystrom1210Pair, Nystrom64Pair, Nystrom86Pair, Statistics, Stop,
-    Verner98, Verner98Pair,
+    Verner76, Verner76Pair, Verner98, Verner98Pair,
 };
 pub use backward_euler::{BackwardEuler, BackwardEulerTableau};
 pub use clock::Clock;

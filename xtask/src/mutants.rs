@@ -174,6 +174,7 @@ const AREAS: [Area; 14] = [
             "lagrange-integrators/src/adaptive/nystrom64.rs",
             "lagrange-integrators/src/adaptive/nystrom86.rs",
             "lagrange-integrators/src/adaptive/nystrom1210.rs",
+            "lagrange-integrators/src/adaptive/verner76.rs",
             "lagrange-integrators/src/adaptive/verner98.rs",
             "lagrange-integrators/src/adaptive/controller.rs",
         ],

@@ -11,7 +11,7 @@ use lagrange_integrators::{
     AdaptiveSettings, BackwardEuler, Clock, Dop853Pair, Dopri5Pair, EmbeddedPair,
     EmbeddedRungeKutta, ExplicitEuler, Failure, GaussLegendre2, ImplicitMidpoint, Integrator,
     Nystrom1210Pair, Nystrom64Pair, Nystrom86Pair, RadauIIA2, Rk4, SemiImplicitEuler,
-    StormerVerlet, VariationalMidpoint, VelocityVerlet, Verner98Pair, Yoshida4,
+    StormerVerlet, VariationalMidpoint, VelocityVerlet, Verner76Pair, Verner98Pair, Yoshida4,
 };
 use std::marker::PhantomData;
 
@@ -160,6 +160,7 @@ pub fn for_each(v: &mut impl MethodVisitor) {
     v.visit(&Adaptive::<16, 4, Dop853Pair>::new(
         Tableau::DormandPrince853,
     ));
+    v.visit(&Adaptive::<11, 2, Verner76Pair>::unpaired());
     v.visit(&Adaptive::<17, 2, Verner98Pair>::unpaired());
     v.visit(&Adaptive::<6, 2, Nystrom64Pair>::unpaired());
     v.visit(&Adaptive::<9, 2, Nystrom86Pair>::unpaired());

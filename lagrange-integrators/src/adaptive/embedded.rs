@@ -67,9 +67,9 @@ pub struct Statistics {
 }
 
 /// An adaptive explicit Runge-Kutta integrator on the pair `P`: use the aliases
-/// [`DormandPrince54`](crate::DormandPrince54) and
-/// [`DormandPrince853`](crate::DormandPrince853) and [`Verner98`](crate::Verner98), and for
-/// laws that do not read the velocities the Runge-Kutta-Nyström
+/// [`DormandPrince54`](crate::DormandPrince54), [`DormandPrince853`](crate::DormandPrince853),
+/// [`Verner76`](crate::Verner76) and [`Verner98`](crate::Verner98), and for laws that do not
+/// read the velocities the Runge-Kutta-Nyström
 /// [`DormandPrinceNystrom64`](crate::DormandPrinceNystrom64),
 /// [`DormandPrinceNystrom86`](crate::DormandPrinceNystrom86) and
 /// [`DormandPrinceNystrom1210`](crate::DormandPrinceNystrom1210).
@@ -801,7 +801,7 @@ where
     /// Lands on `state.t + dt` through the continuous extension, the internal steps as long
     /// as the tolerance allows (they run ahead of the landing; the next call from this one's
     /// result continues from them). A pair whose dense output is more than one order below
-    /// its own (quintic Hermite under the orders 6, 8, 9 and 12 of the Nyström and Verner
+    /// its own (quintic Hermite under the orders 6 to 12 of the Nyström and Verner
     /// pairs) lands by a last step shortened to `state.t + dt` instead, so that a frame is as
     /// accurate as a step.
     fn step(&mut self, m: &M, state: &State<T, N>, dt: T) -> Result<State<T, N>, Error> {

@@ -12,6 +12,7 @@ mod nystrom64;
 mod nystrom86;
 mod settings;
 mod sums;
+mod verner76;
 mod verner98;
 
 pub use dop853::{Dop853Pair, DormandPrince853};
@@ -23,4 +24,5 @@ pub use nystrom1210::{DormandPrinceNystrom1210, Nystrom1210Pair};
 pub use nystrom64::{DormandPrinceNystrom64, Nystrom64Pair};
 pub use nystrom86::{DormandPrinceNystrom86, Nystrom86Pair};
 pub use settings::AdaptiveSettings;
+pub use verner76::{Verner76, Verner76Pair};
 pub use verner98::{Verner98, Verner98Pair};

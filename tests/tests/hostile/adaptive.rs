@@ -14,7 +14,7 @@ use lagrange_core::nalgebra::SVector;
 use lagrange_core::{Mechanism, Real, State};
 use lagrange_integrators::{
     AdaptiveSettings, Dop853Pair, Dopri5Pair, EmbeddedPair, EmbeddedRungeKutta, Integrator,
-    Verner98Pair,
+    Verner76Pair, Verner98Pair,
 };
 use lagrange_systems::FallingParticle;
 
@@ -285,6 +285,7 @@ macro_rules! adaptive_case {
 
 adaptive_case!(dopri5, Dopri5Pair, 7, 1, "DormandPrince54");
 adaptive_case!(dop853, Dop853Pair, 16, 4, "DormandPrince853");
+adaptive_case!(verner76, Verner76Pair, 11, 2, "Verner76");
 adaptive_case!(verner98, Verner98Pair, 17, 2, "Verner98");
 
 /// The family.
@@ -293,6 +294,7 @@ pub fn family() -> Family {
     entries!(v, 0.5, "AdaptiveSettings", settings_case);
     entries!(v, 0.6, "DormandPrince54 calls", dopri5);
     entries!(v, 0.4, "DormandPrince853 calls", dop853);
+    entries!(v, 0.3, "Verner76 calls", verner76);
     entries!(v, 0.3, "Verner98 calls", verner98);
     Family {
         name: "adaptive",
