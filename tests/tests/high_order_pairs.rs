@@ -654,13 +654,6 @@ fn a_users_orbit_in_cartesian_coordinates() -> Result<(), Error> {
     Ok(())
 }
 
-/// The pendulum released from rest crosses `th = 0` at a quarter period: at rtol 1e-12,
-/// located within 1e-14 s by the five pairs (measured 1.1e-16, 2.2e-16, 2.2e-16, 7.8e-16 and
-/// 4.4e-16 for 6(4), 8(6), 12(10), 7(6) and 9(8)), the state there within 1e-13 of the exact
-/// one. 12(10)'s steps are long beside its order-4 interpolant (on
-/// it alone the crossing was 1.5e-10 s off, the velocity 1.2e-8): the event is located again
-/// on its own steps, from the interpolant's time and a Newton step on its slope (measured 68
-/// evaluations more than a run to that time, 4 steps' worth; at most 5 steps' worth).
 /// The pair `P`'s run from the pendulum released at rest at `th0` to its first crossing of
 /// `th = 0`.
 fn first_crossing<const S: usize, const R: usize, P: EmbeddedPair<S, R>>(
@@ -672,6 +665,13 @@ fn first_crossing<const S: usize, const R: usize, P: EmbeddedPair<S, R>>(
     Ok(rk.integrate_until_event(p, &State::at_rest([th0]), 10.0, |s: &State<f64, 1>| s.q[0])?)
 }
 
+/// The pendulum released from rest crosses `th = 0` at a quarter period: at rtol 1e-12,
+/// located within 1e-14 s by the five pairs (measured 1.1e-16, 2.2e-16, 2.2e-16, 7.8e-16 and
+/// 4.4e-16 for 6(4), 8(6), 12(10), 7(6) and 9(8)), the state there within 1e-13 of the exact
+/// one. 12(10)'s steps are long beside its order-4 interpolant (on it alone the crossing was
+/// 1.5e-10 s off, the velocity 1.2e-8): the event is located again on its own steps, from
+/// the interpolant's time and a Newton step on its slope (measured 68 evaluations more than a
+/// run to that time, 4 steps' worth; at most 5 steps' worth).
 #[test]
 fn events_are_located_to_the_steps_accuracy() -> Result<(), Error> {
     let th0 = 0.5;
