@@ -27,8 +27,9 @@ pub trait EmbeddedPair<const S: usize, const R: usize> {
     /// `k` of the controller: the error estimate scales like `h^k`.
     const ERROR_EXPONENT: u32;
     /// Order of the dense output. More than one below [`EmbeddedPair::ORDER`] (the Nyström and
-    /// Verner pairs), it is not trusted where a step is: [`Integrator::step`] lands on a frame's end by
-    /// a step shortened to it, and an event is located again on steps of the pair.
+    /// Verner pairs), it is not trusted where a step is: [`Integrator::step`] lands on a
+    /// frame's end by a step shortened to it, and an event is located again on steps of the
+    /// pair.
     const DENSE_ORDER: u32;
     /// The nodes `c_i`.
     const C: [f64; S];

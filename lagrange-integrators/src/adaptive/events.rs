@@ -169,8 +169,8 @@ where
     /// of the change on the dense output (the Illinois variant of regula falsi, to
     /// [`AdaptiveSettings::event_tolerance`](super::AdaptiveSettings::event_tolerance) or to
     /// rounding; for a pair whose dense output is more than an order below its steps, the
-    /// Nyström and Verner pairs, again on steps of the pair from there), and stops there; a call from the
-    /// state it returns continues the run.
+    /// Nyström and Verner pairs, again on steps of the pair from there), and stops there; a
+    /// call from the state it returns continues the run.
     ///
     /// The guard is a function `g(t, q, q')` of the state. A sign change is a step from a
     /// non-zero value to zero or to the opposite sign; the located time is the first one known
@@ -248,9 +248,9 @@ where
     /// at the step's end: the state there becomes the run's current one.
     ///
     /// The time is located on the dense output. Where that is more than an order below the
-    /// steps (the Nyström and Verner pairs), it is located again on steps of the method itself from the
-    /// step's start, the dense output's time tried first: the state returned is then as
-    /// accurate as a step's, and the guard there is that state's.
+    /// steps (the Nyström and Verner pairs), it is located again on steps of the method itself
+    /// from the step's start, the dense output's time tried first: the state returned is then
+    /// as accurate as a step's, and the guard there is that state's.
     fn stop_at_event<M, G>(
         &mut self,
         m: &M,
