@@ -552,7 +552,7 @@ fn dop853_held_to_its_tolerance<T: Real>() -> Result<(), Error> {
 ///
 /// Its eighth-order estimate is far above its ninth-order steps' error: the errors are a
 /// seventh to a hundred-and-thirtieth of the tolerance.
-fn verner_held_to_its_tolerance<T: Real>() -> Result<(), Error> {
+fn verner98_held_to_its_tolerance<T: Real>() -> Result<(), Error> {
     let rtols = pick_rtols::<T>(
         &[1e-3, 1e-4, 1e-5],
         &[1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11, 1e-12, 1e-13],
@@ -611,7 +611,7 @@ fn pick_rtols<T: Real>(f32: &'static [f64], f64: &'static [f64]) -> &'static [f6
 for_f32_and_f64!(
     dopri5_held_to_its_tolerance,
     dop853_held_to_its_tolerance,
-    verner_held_to_its_tolerance,
+    verner98_held_to_its_tolerance,
     verner76_held_to_its_tolerance
 );
 
