@@ -1,6 +1,6 @@
 //! Fixed-size Cholesky solve of `M x = b` for a symmetric positive definite mass matrix.
 
-use crate::{all_finite, Error, Real};
+use crate::{check_finite, Error, Real};
 use nalgebra::{SMatrix, SVector};
 
 /// Solves `m x = b` for symmetric positive definite `m` by Cholesky factorisation, on the
@@ -30,11 +30,7 @@ pub fn solve_spd<T: Real, const N: usize>(
     b: &SVector<T, N>,
 ) -> Result<SVector<T, N>, Error> {
     let x = Cholesky::factor(m)?.solve(b);
-    if all_finite(x.as_slice()) {
-        Ok(x)
-    } else {
-        Err(Error::NonFiniteState)
-    }
+    check_finite(x.as_slice(), Error::NonFiniteState).map(|()| x)
 }
 
 /// Up to how many coordinates [`Cholesky::factor`] checks its pivots after the loop rather

@@ -359,10 +359,11 @@ fn pick(take: bool, a: f32, b: f32) -> f32 {
     f32::from_bits((a.to_bits() & mask) | (b.to_bits() & !mask))
 }
 
-/// `sin_cos` of each of `L` arguments, bit for bit [`sin_cos`] of each: the arguments up to
-/// 512 in magnitude take the small and the medium path of every lane, selected lane by lane
-/// with no branch, so that the loop vectorizes; the rare one beyond 512, infinite or NaN, is
-/// then done alone. The same operations as [`sin_cos`], in the same order.
+/// `sin_cos` of each of `L` arguments, bit for bit [`sin_cos`] of each: when every lane is
+/// within pi/4, the small path alone; else every lane up to 512 in magnitude takes the medium
+/// path (a small one with no reduction, which gives the small path's bits), with no branch,
+/// so that the loop vectorizes; the rare one beyond 512, infinite or NaN, is then done alone.
+/// The same operations as [`sin_cos`], in the same order.
 #[must_use]
 #[inline(always)]
 pub fn sin_cos_lanes<const L: usize>(x: [f32; L]) -> ([f32; L], [f32; L]) {
@@ -391,8 +392,8 @@ pub fn sin_cos_lanes<const L: usize>(x: [f32; L]) -> ([f32; L], [f32; L]) {
     sin_cos_lanes_reduced(x)
 }
 
-/// [`sin_cos_lanes`] where some lane needs reducing: every lane through both the small and
-/// the medium path, selected lane by lane (out of line, so that the small path inlines).
+/// [`sin_cos_lanes`] where some lane needs reducing: every lane through the medium path, the
+/// small ones with `k = 0` (out of line, so that the small path inlines).
 #[inline(never)]
 fn sin_cos_lanes_reduced<const L: usize>(x: [f32; L]) -> ([f32; L], [f32; L]) {
     let [p1, p2, p3, p4] = FRAC_PI_2_PARTS;
@@ -400,15 +401,16 @@ fn sin_cos_lanes_reduced<const L: usize>(x: [f32; L]) -> ([f32; L], [f32; L]) {
     let mut rare = 0u32;
     for ((s, c), &xi) in sin.iter_mut().zip(&mut cos).zip(&x) {
         let abs = magnitude(xi);
-        // Small (|x| <= pi/4).
-        let small_sin = pick(abs < TINY_BITS as i32, xi, sin_kernel(xi));
-        let small_cos = cos_kernel(xi);
+        let small = abs <= FRAC_PI_4_BITS as i32;
         // Medium, as `reduce_medium` (k below 2^9 where it matters, so a signed conversion
-        // gives the same k); meaningless in the lanes that are small or rare, whose results
-        // come from elsewhere.
+        // gives the same k); meaningless in the lanes that are rare, whose results come from
+        // elsewhere. A small lane (|x| <= pi/4) takes k = 0: then `hi = |x|` and `lo = 0`
+        // exactly, the `_lo` kernels add a zero to the plain kernels' last sums, and the
+        // signs below restore `x`'s, so the small path's bits come out of the same formulas
+        // (the kernels are odd and even to the bit), at the cost of one path, not two.
         let ax = xi.abs();
         #[allow(clippy::cast_possible_truncation)] // saturating; exact where it is used
-        let k = (ax * core::f32::consts::FRAC_2_PI + 0.5) as i32;
+        let k = (ax * core::f32::consts::FRAC_2_PI + 0.5) as i32 & -i32::from(!small);
         #[allow(clippy::cast_precision_loss)] // below 2^9 where it is used: exact
         let kf = k as f32;
         let t1 = ax - kf * p1;
@@ -423,10 +425,10 @@ fn sin_cos_lanes_reduced<const L: usize>(x: [f32; L]) -> ([f32; L], [f32; L]) {
         let (first, second) = (pick(odd, mc, ms), pick(odd, ms, mc));
         let first = pick(k & 2 != 0, -first, first);
         let second = pick(k.wrapping_add(1) & 2 != 0, -second, second);
-        let medium_sin = pick(xi.to_bits() & SIGN == 0, first, -first);
-        let small = abs <= FRAC_PI_4_BITS as i32;
-        *s = pick(small, small_sin, medium_sin);
-        *c = pick(small, small_cos, second);
+        let sin = pick(xi.to_bits() & SIGN == 0, first, -first);
+        // The small path returns a tiny `x` itself.
+        *s = pick(abs < TINY_BITS as i32, xi, sin);
+        *c = second;
         rare |= u32::from(abs >= MEDIUM_BITS as i32);
     }
     if rare != 0 {

@@ -11,6 +11,13 @@
 //! ([`divergences`]). A caller that steps lanes reads the count before and after: unchanged,
 //! every lane took the branch its instance alone would have taken and the result is exact;
 //! changed, it discards the result and steps the instances one by one.
+//!
+//! The tests of a result before it is returned ([`check_finite`](crate::check_finite),
+//! [`Real::every_lane_finite`], [`Real::every_lane_positive`]) are data, not branches taken
+//! for all lanes: they hold when they hold in every lane and count nothing, because their
+//! failure is an error, which ends the computation for every lane, and a caller stepping lanes
+//! takes a failed step one instance at a time. Counting is a branch per test, and those
+//! branches kept the compiler from joining the tests of a step's stages.
 
 use crate::scalar::{powi_by_squaring, sin_cos_each, Real, Scalar};
 use core::cmp::Ordering;
@@ -32,7 +39,12 @@ use num_traits::{One, Zero};
 ///     assert_eq!(y.0[lane], xi.sin() * 2.0 + 1.0); // bit for bit
 /// }
 /// ```
+///
+/// Aligned to 32 bytes (a 256-bit vector; a smaller `Lanes` is padded to that size): left at
+/// the alignment of `T`, the compiler grouped the 8 lanes of an `f32` pendulum as 2, 4 and 2
+/// rather than 4 and 4, and stepping 1,024 of them in lanes of 8 took 1.25 times as long.
 #[derive(Debug, Clone, Copy)]
+#[repr(C, align(32))]
 pub struct Lanes<T, const L: usize>(pub [T; L]);
 
 impl<T: Real, const L: usize> Lanes<T, L> {
@@ -327,6 +339,30 @@ impl<T: Real, const L: usize> Real for Lanes<T, L> {
     }
     fn sin_cos_lanes<const K: usize>(x: [Self; K]) -> ([Self; K], [Self; K]) {
         sin_cos_each(x)
+    }
+    /// Every lane of every value finite, as a count (`x * 0` is zero exactly where `x` is
+    /// finite) that vectorises, with no branch: lanes that disagree count no divergence.
+    #[inline(always)]
+    fn every_lane_finite(values: &[Self]) -> bool {
+        let mut finite = 0usize;
+        for value in values {
+            for x in value.0 {
+                finite += usize::from(x * T::zero() == T::zero());
+            }
+        }
+        finite == values.len() * L
+    }
+    /// Every lane of every value positive, as a count with no branch (see
+    /// [`Lanes::every_lane_finite`]).
+    #[inline(always)]
+    fn every_lane_positive(values: &[Self]) -> bool {
+        let mut positive = 0usize;
+        for value in values {
+            for x in value.0 {
+                positive += usize::from(x > T::zero());
+            }
+        }
+        positive == values.len() * L
     }
 }
 

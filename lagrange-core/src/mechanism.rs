@@ -4,7 +4,7 @@
 use crate::constraints::{Constrained, Constraints, Held};
 use crate::forces::{Forced, NoForce};
 use crate::{
-    all_finite, central_difference_jacobian, solve_spd, Error, GeneralizedForce, Jacobian,
+    central_difference_jacobian, check_finite, solve_spd, Error, GeneralizedForce, Jacobian,
     Lagrangian, Lanes, Real, State,
 };
 use nalgebra::{SMatrix, SVector};
@@ -277,16 +277,12 @@ pub trait Mechanism<T: Real, const N: usize>: Lagrangian<T, N> {
 
 /// `v` when every component is finite, else [`Error::NonFiniteState`].
 ///
-/// Every component is tested ([`all_finite`]), with one branch for all (the profile of a
+/// Every component is tested ([`check_finite`]), with one branch for all (the profile of a
 /// DOP853 step of a 40-coordinate system showed the test as a scalar loop with a branch per
 /// component).
 #[inline(always)]
 pub(crate) fn finite<T: Real, const N: usize>(v: SVector<T, N>) -> Result<SVector<T, N>, Error> {
-    if all_finite(v.as_slice()) {
-        Ok(v)
-    } else {
-        Err(Error::NonFiniteState)
-    }
+    check_finite(v.as_slice(), Error::NonFiniteState).map(|()| v)
 }
 
 /// `(qdd, j)` when both are finite, else [`Error::NonFiniteState`]: what a wrapper checks

@@ -47,8 +47,15 @@ impl<T: Real, const N: usize> State<T, N> {
     ///
     /// # Errors
     /// [`Error::NonFiniteState`] when any component is NaN or infinite.
+    ///
+    /// Over [`Lanes`](crate::Lanes), every lane must be finite, and lanes that disagree count
+    /// no divergence ([`check_finite`]).
+    #[inline(always)]
     pub fn check_finite(&self) -> Result<(), Error> {
-        if self.is_finite() {
+        if T::every_lane_finite(&[self.t])
+            & T::every_lane_finite(self.q.as_slice())
+            & T::every_lane_finite(self.qd.as_slice())
+        {
             Ok(())
         } else {
             Err(Error::NonFiniteState)

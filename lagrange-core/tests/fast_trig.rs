@@ -324,3 +324,39 @@ fn lane_trig_is_the_scalar_trig() {
     }
     assert!(checked > 14_000);
 }
+
+/// Every `f32` from 2^-12 to a little past pi/4, of either sign, taken by the lanes' reduced
+/// path (a lane beyond pi/4 in the group sends every lane there, the small ones with no
+/// reduction): bit for bit the scalar sine and cosine. Below 2^-12 the lane returns `x` for
+/// the sine, as the scalar does, and the cosine's kernel is the one swept here.
+#[test]
+#[ignore = "exhaustive: about 5 s in release"]
+fn small_lanes_in_the_reduced_path_are_the_scalar_trig() {
+    const FROM: u32 = 0x3980_0000;
+    let to = FRAC_PI_4_F32.to_bits() + 64;
+    let check = |sign: f32| {
+        let mut bits = FROM;
+        while bits <= to {
+            // Seven small lanes and one that needs reducing.
+            let mut x = [sign * 1.0f32; L];
+            for (i, xi) in x.iter_mut().take(L - 1).enumerate() {
+                *xi = sign * f32::from_bits(bits + i as u32);
+            }
+            let (s, c) = fast_trig::sin_cos_lanes(x);
+            for (i, &xi) in x.iter().enumerate() {
+                let (es, ec) = fast_trig::sin_cos(xi);
+                assert_eq!(
+                    (s[i].to_bits(), c[i].to_bits()),
+                    (es.to_bits(), ec.to_bits()),
+                    "x = {xi:e}"
+                );
+            }
+            bits += L as u32 - 1;
+        }
+    };
+    std::thread::scope(|scope| {
+        let negative = scope.spawn(|| check(-1.0));
+        check(1.0);
+        assert!(negative.join().is_ok(), "the negative sweep failed");
+    });
+}

@@ -419,7 +419,7 @@ pub(crate) fn check_run<T: Real, const N: usize>(
 pub(crate) fn check_run_step<T: Real, const N: usize>(s: &State<T, N>, dt: T) -> Result<T, Error> {
     let dt = check_dt(dt)?;
     s.check_finite()?;
-    if (s.t + dt).is_finite() {
+    if T::every_lane_finite(&[s.t + dt]) {
         Ok(dt)
     } else {
         Err(Error::NonFiniteState)
@@ -460,9 +460,11 @@ pub(crate) fn check_signed<T: Real, const N: usize>(s: &State<T, N>, h: T) -> Re
     advances(s.t, h).map(|()| h)
 }
 
-/// `dt` when it is positive and finite.
+/// `dt` when it is positive and finite (in every lane: a test that fails counts no
+/// divergence, [`Real::every_lane_finite`]).
+#[inline(always)]
 pub(crate) fn check_dt<T: Real>(dt: T) -> Result<T, Error> {
-    if dt.is_finite() && dt > T::zero() {
+    if T::every_lane_finite(&[dt]) & T::every_lane_positive(&[dt]) {
         Ok(dt)
     } else {
         Err(Error::InvalidParameter {
@@ -475,12 +477,14 @@ pub(crate) fn check_dt<T: Real>(dt: T) -> Result<T, Error> {
 /// `Ok` when `t + dt` differs from `t` and is finite: a step that cannot move the clock is an
 /// error, not a silent no-op ([`Error::StepSizeUnderflow`]), and one that would carry it past
 /// the largest finite time would end in a state that is not finite
-/// ([`Error::NonFiniteState`]).
+/// ([`Error::NonFiniteState`]). `t` is finite; the tests count no divergence across lanes
+/// ([`Real::every_lane_finite`]).
+#[inline(always)]
 pub(crate) fn advances<T: Real>(t: T, dt: T) -> Result<(), Error> {
     let end = t + dt;
-    if end == t {
+    if !T::every_lane_positive(&[(end - t).abs()]) {
         Err(Error::StepSizeUnderflow)
-    } else if !end.is_finite() {
+    } else if !T::every_lane_finite(&[end]) {
         Err(Error::NonFiniteState)
     } else {
         Ok(())

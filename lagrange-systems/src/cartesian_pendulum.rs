@@ -2,7 +2,7 @@
 
 use lagrange_core::constraints::{Constraints, HolonomicConstraints};
 use lagrange_core::nalgebra::{Matrix1x2, Matrix2, SMatrix, SVector, Vector1, Vector2};
-use lagrange_core::{all_finite, validate, Error, Lagrangian, Mechanism, Real, Scalar, State};
+use lagrange_core::{check_finite, validate, Error, Lagrangian, Mechanism, Real, Scalar, State};
 
 /// A point mass `m` at `(x, y)` from a fixed pivot, in gravity `g`, held at distance `l` by a
 /// massless rod: the same pendulum as [`SimplePendulum`](crate::SimplePendulum), written in two
@@ -123,11 +123,7 @@ impl<T: Real> Mechanism<T, 2> for CartesianPendulum<T> {
     }
     fn solve_mass(&self, _s: &State<T, 2>, b: &Vector2<T>) -> Result<Vector2<T>, Error> {
         let x = b / self.mass;
-        if all_finite(x.as_slice()) {
-            Ok(x)
-        } else {
-            Err(Error::NonFiniteState)
-        }
+        check_finite(x.as_slice(), Error::NonFiniteState).map(|()| x)
     }
 }
 

@@ -2,7 +2,7 @@
 //! diagonal solve that reports the configuration where a diagonal entry vanishes.
 
 use lagrange_core::nalgebra::{Matrix2, SVector, Vector2};
-use lagrange_core::{all_finite, Error, Real, State};
+use lagrange_core::{all_finite, check_finite, Error, Real, State};
 
 /// Solves the symmetric positive definite 2x2 system `m x = b` by its closed-form inverse.
 ///
@@ -19,15 +19,19 @@ pub(crate) fn solve_sym2<T: Real>(m: &Matrix2<T>, b: &Vector2<T>) -> Result<Vect
 ///
 /// # Errors
 /// As [`solve_sym2`].
+///
+/// Inlined, and its tests of `det` count no divergence across lanes (an error fails the lane
+/// step, [`check_finite`]): called, it spilled every live float of a lane step around it.
+#[inline(always)]
 pub(crate) fn solve_sym2_det<T: Real>(
     m: &Matrix2<T>,
     det: T,
     b: &Vector2<T>,
 ) -> Result<Vector2<T>, Error> {
-    if !det.is_finite() {
+    if !T::every_lane_finite(&[det]) {
         return Err(Error::NonFiniteState);
     }
-    if det <= T::zero() {
+    if !T::every_lane_positive(&[det]) {
         return Err(Error::SingularMassMatrix { pivot: 1 });
     }
     let inv = T::one() / det;
@@ -97,18 +101,14 @@ pub(crate) fn radial_accelerations<T: Real>(
     Err(Error::Singularity { what })
 }
 
-/// `x` when every entry is finite, else `error`.
+/// `x` when every entry is finite, else `error`: every entry tested, with one branch for all
+/// ([`check_finite`]).
 #[inline]
 pub(crate) fn finite<T: Real, const N: usize>(
     x: SVector<T, N>,
     error: Error,
 ) -> Result<SVector<T, N>, Error> {
-    // Every entry tested, without a branch per entry (as `Mechanism::acceleration`'s test).
-    if all_finite(x.as_slice()) {
-        Ok(x)
-    } else {
-        Err(error)
-    }
+    check_finite(x.as_slice(), error).map(|()| x)
 }
 
 #[cfg(test)]

@@ -5,7 +5,7 @@
 //! `lagrange-core/tests/fast_trig.rs`.)
 
 use lagrange_core::nalgebra::SVector;
-use lagrange_core::{divergences, Error, Lanes, Mechanism, Real, State};
+use lagrange_core::{check_finite, divergences, Error, Lanes, Mechanism, Real, State};
 use lagrange_integrators::scene::{Bank, NeverSleeps, Scene};
 use lagrange_integrators::{
     ExplicitEuler, FixedTimestep, Integrator, Rk4, SemiImplicitEuler, VelocityVerlet,
@@ -187,7 +187,106 @@ fn a_bank_in_lanes_equals_its_instances_alone<T: Real>() -> Result<(), Error> {
     Ok(())
 }
 
+/// The tests of results over lanes ([`check_finite`], [`Real::every_lane_finite`],
+/// [`Real::every_lane_positive`]) hold exactly when they hold in every lane, and count no
+/// divergence where the lanes disagree (their failure is an error for the whole group).
+fn result_tests_hold_in_every_lane_and_count_nothing<T: Real>() -> Result<(), Error> {
+    let mut rng = Rng::new(21);
+    let specials = [
+        0.0,
+        -0.0,
+        1.0,
+        -2.5,
+        1e-30,
+        f64::NAN,
+        f64::INFINITY,
+        -f64::INFINITY,
+    ];
+    let value = |rng: &mut Rng| -> Lanes<T, L> {
+        Lanes::from_fn(|_| {
+            // Mostly finite and positive, so that every answer comes up.
+            if rng.unit() < 0.9 {
+                rng.uniform(0.5, 2.0)
+            } else {
+                T::from_f64(specials[(rng.unit() * specials.len() as f64) as usize % 8])
+            }
+        })
+    };
+    let before = divergences();
+    let (mut failed, mut passed) = (0, 0);
+    for _ in 0..4000 {
+        let values = [value(&mut rng), value(&mut rng)];
+        let every = |test: fn(T) -> bool| values.iter().all(|v| v.0.iter().all(|&x| test(x)));
+        let finite = every(|x| x.is_finite());
+        assert_eq!(Lanes::every_lane_finite(&values), finite, "{values:?}");
+        assert_eq!(
+            Lanes::every_lane_positive(&values),
+            every(|x| x > T::zero()),
+            "{values:?}"
+        );
+        let checked = check_finite(&values, Error::NonFiniteState);
+        assert_eq!(checked.is_ok(), finite);
+        if finite {
+            passed += 1;
+        } else {
+            failed += 1;
+        }
+    }
+    assert!(
+        failed > 500 && passed > 500,
+        "{failed} failed, {passed} passed"
+    );
+    assert_eq!(divergences(), before);
+    Ok(())
+}
+
+/// A group of pendulums one of which is thrown so fast that its step overflows: the lane step
+/// is an error, never `Ok` with an infinity, and counts no divergence; the others alone step
+/// as before.
+fn a_lane_that_blows_up_fails_the_group<T: Real>() -> Result<(), Error> {
+    let fast = T::MAX / T::from_f64(4.0);
+    let built: Vec<(SimplePendulum<T>, State<T, 1>)> = (0..L)
+        .map(|i| {
+            let v = if i == 5 {
+                fast
+            } else {
+                T::from_f64(0.1 * i as f64)
+            };
+            Ok((
+                SimplePendulum::new(T::one(), T::one(), T::from_f64(9.81), T::zero())?,
+                State::new(T::zero(), [T::from_f64(0.3)], [v]),
+            ))
+        })
+        .collect::<Result<_, Error>>()?;
+    let lanes = SimplePendulum::gather(core::array::from_fn(|i| &built[i].0)).ok_or(
+        Error::InvalidParameter {
+            name: "mechanism",
+            reason: "gathers no lanes",
+        },
+    )?;
+    let states: [&State<T, 1>; L] = core::array::from_fn(|i| &built[i].1);
+    let side = State {
+        t: Lanes::gather(&states, |s| s.t),
+        q: SVector::from_fn(|j, _| Lanes::gather(&states, |s| s.q[j])),
+        qd: SVector::from_fn(|j, _| Lanes::gather(&states, |s| s.qd[j])),
+    };
+    let dt = T::from_f64(0.01);
+    let before = divergences();
+    let stepped = Integrator::<T, 1, SimplePendulum<T>>::step_lanes(&Rk4, &lanes, &side, dt);
+    assert!(
+        matches!(stepped, Some(Err(Error::NonFiniteState))),
+        "{stepped:?}"
+    );
+    assert_eq!(divergences(), before);
+    for (i, (m, s)) in built.iter().enumerate() {
+        assert_eq!(Rk4.run_step(m, s, dt).is_ok(), i != 5, "lane {i}");
+    }
+    Ok(())
+}
+
 for_f32_and_f64!(
     every_gathering_mechanism,
-    a_bank_in_lanes_equals_its_instances_alone
+    a_bank_in_lanes_equals_its_instances_alone,
+    result_tests_hold_in_every_lane_and_count_nothing,
+    a_lane_that_blows_up_fails_the_group
 );

@@ -92,4 +92,19 @@ fn diverging_lanes_fall_back<T: Real>() -> Result<(), Error> {
     Ok(())
 }
 
-for_f32_and_f64!(diverging_lanes_fall_back);
+/// A branch on finiteness counts a divergence where the lanes disagree (unlike the tests of
+/// results, [`lagrange_core::check_finite`], whose failure ends the computation): a law may
+/// choose between two formulas by it.
+fn a_branch_on_finiteness_counts<T: Real>() -> Result<(), Error> {
+    let mixed = Lanes::<T, L>::from_fn(|i| if i == 3 { T::INFINITY } else { T::one() });
+    let before = divergences();
+    assert!(!mixed.is_finite());
+    if cfg!(target_has_atomic = "32") {
+        assert_ne!(divergences(), before, "a disagreement went uncounted");
+    }
+    assert!(Lanes::<T, L>::splat(T::one()).is_finite());
+    assert!(!Lanes::<T, L>::splat(T::INFINITY).is_finite());
+    Ok(())
+}
+
+for_f32_and_f64!(diverging_lanes_fall_back, a_branch_on_finiteness_counts);

@@ -4,8 +4,8 @@
 use super::{Constraints, Schur};
 use crate::mechanism::{finite, finite_jacobian};
 use crate::{
-    all_finite, validate, Error, GeneralizedForce, Jacobian, Lagrangian, Mechanism, NoForce, Real,
-    Scalar, State,
+    validate, Error, GeneralizedForce, Jacobian, Lagrangian, Mechanism, NoForce, Real, Scalar,
+    State,
 };
 use nalgebra::{SMatrix, SVector};
 
@@ -209,7 +209,8 @@ pub(crate) fn solve_kkt<T: Real, const N: usize, const C: usize>(
 ) -> Result<ConstrainedAcceleration<T, N, C>, Error> {
     let multipliers = schur.multipliers(&(target - schur.jacobian() * free_acceleration));
     let acceleration = free_acceleration + schur.response(&multipliers);
-    if all_finite(acceleration.as_slice()) & all_finite(multipliers.as_slice()) {
+    if T::every_lane_finite(acceleration.as_slice()) & T::every_lane_finite(multipliers.as_slice())
+    {
         Ok(ConstrainedAcceleration {
             acceleration,
             multipliers,
