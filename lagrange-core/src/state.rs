@@ -49,7 +49,7 @@ impl<T: Real, const N: usize> State<T, N> {
     /// [`Error::NonFiniteState`] when any component is NaN or infinite.
     ///
     /// Over [`Lanes`](crate::Lanes), every lane must be finite, and lanes that disagree count
-    /// no divergence ([`check_finite`]).
+    /// no divergence ([`check_finite`](crate::check_finite)).
     #[inline(always)]
     pub fn check_finite(&self) -> Result<(), Error> {
         if T::every_lane_finite(&[self.t])
