@@ -340,29 +340,31 @@ impl<T: Real, const L: usize> Real for Lanes<T, L> {
     fn sin_cos_lanes<const K: usize>(x: [Self; K]) -> ([Self; K], [Self; K]) {
         sin_cos_each(x)
     }
-    /// Every lane of every value finite, as a count (`x * 0` is zero exactly where `x` is
-    /// finite) that vectorises, with no branch: lanes that disagree count no divergence.
+    /// Every lane of every value finite (`x * 0` is zero exactly where `x` is finite), one
+    /// AND over the lanes that vectorises, with no branch: lanes that disagree count no
+    /// divergence. (A count of the finite lanes, compared with their number, took longer:
+    /// lanes of 8 pendulums at 3.1 rather than 3.8 times the scalar loop.)
     #[inline(always)]
     fn every_lane_finite(values: &[Self]) -> bool {
-        let mut finite = 0usize;
+        let mut finite = true;
         for value in values {
             for x in value.0 {
-                finite += usize::from(x * T::zero() == T::zero());
+                finite &= x * T::zero() == T::zero();
             }
         }
-        finite == values.len() * L
+        finite
     }
-    /// Every lane of every value positive, as a count with no branch (see
+    /// Every lane of every value positive, one AND with no branch (see
     /// [`Lanes::every_lane_finite`]).
     #[inline(always)]
     fn every_lane_positive(values: &[Self]) -> bool {
-        let mut positive = 0usize;
+        let mut positive = true;
         for value in values {
             for x in value.0 {
-                positive += usize::from(x > T::zero());
+                positive &= x > T::zero();
             }
         }
-        positive == values.len() * L
+        positive
     }
 }
 
