@@ -392,6 +392,24 @@ pub fn sin_cos_lanes<const L: usize>(x: [f32; L]) -> ([f32; L], [f32; L]) {
     sin_cos_lanes_reduced(x)
 }
 
+/// `v` truncated, as an integer and as an `f32`: `v as i32` and that as `f32` for
+/// `0 <= v < 2^23` (the medium reduction's `k`), meaningless otherwise. In float and integer
+/// operations that vectorize: `v as i32` saturates, which the compiler does lane by lane,
+/// and the lanes' reduction took 5 times as long as the small path for it. `v + 2^23` rounds
+/// `v` to the nearest integer in its low bits, exactly; one less where that rounded up.
+#[inline(always)]
+fn truncate(v: f32) -> (i32, f32) {
+    const TWO_23: f32 = 8_388_608.0;
+    let y = v + TWO_23;
+    let nearest = y - TWO_23;
+    let up = nearest > v;
+    #[allow(clippy::cast_possible_wrap)] // the bits of y, an f32 of 2^23 or more
+    let k = (y.to_bits() as i32)
+        .wrapping_sub(TWO_23.to_bits() as i32)
+        .wrapping_sub(i32::from(up));
+    (k, nearest - pick(up, 1.0, 0.0))
+}
+
 /// [`sin_cos_lanes`] where some lane needs reducing: every lane through the medium path, the
 /// small ones with `k = 0` (out of line, so that the small path inlines).
 #[inline(never)]
@@ -409,10 +427,8 @@ fn sin_cos_lanes_reduced<const L: usize>(x: [f32; L]) -> ([f32; L], [f32; L]) {
         // signs below restore `x`'s, so the small path's bits come out of the same formulas
         // (the kernels are odd and even to the bit), at the cost of one path, not two.
         let ax = xi.abs();
-        #[allow(clippy::cast_possible_truncation)] // saturating; exact where it is used
-        let k = (ax * core::f32::consts::FRAC_2_PI + 0.5) as i32 & -i32::from(!small);
-        #[allow(clippy::cast_precision_loss)] // below 2^9 where it is used: exact
-        let kf = k as f32;
+        let (k, kf) = truncate(ax * core::f32::consts::FRAC_2_PI + 0.5);
+        let (k, kf) = (k & -i32::from(!small), pick(small, 0.0, kf));
         let t1 = ax - kf * p1;
         let (t2, e2) = two_sum(t1, -(kf * p2));
         let (t3, e3) = two_sum(t2, -(kf * p3));
