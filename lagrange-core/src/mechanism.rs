@@ -238,6 +238,10 @@ pub trait Mechanism<T: Real, const N: usize>: Lagrangian<T, N> {
     /// is `instances[i]`), where the type can gather its parameters (a plain struct of
     /// scalars): what lets a scene step a bank `L` instances at a time, each lane bit for bit
     /// its instance alone. `None` by default, and then a bank steps them one by one.
+    ///
+    /// The gathered law must pass its errors on, not replace a failed result by another: the
+    /// tests of results ([`check_finite`](crate::check_finite)) fail for all lanes when one
+    /// lane fails and count no divergence, because the error sends the step's lanes one by one.
     fn gather<const L: usize>(instances: [&Self; L]) -> Option<impl Mechanism<Lanes<T, L>, N>> {
         let _ = instances;
         None::<Ungathered>

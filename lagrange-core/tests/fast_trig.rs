@@ -311,18 +311,23 @@ fn lane_trig_is_the_scalar_trig() {
     for group in inputs.chunks(L) {
         let mut x = [0.25f32; L];
         x[..group.len()].copy_from_slice(group);
-        let (s, c) = fast_trig::sin_cos_lanes(x);
-        for (i, &xi) in x.iter().enumerate() {
-            let (es, ec) = fast_trig::sin_cos(xi);
-            assert_eq!(
-                (s[i].to_bits(), c[i].to_bits()),
-                (es.to_bits(), ec.to_bits()),
-                "x = {xi:e}"
-            );
-            checked += 1;
-        }
+        assert_lanes_are_scalar(x);
+        checked += L;
     }
     assert!(checked > 14_000);
+}
+
+/// `sin_cos_lanes` of `x` is, lane by lane, the scalar `sin_cos` to the bit.
+fn assert_lanes_are_scalar(x: [f32; L]) {
+    let (s, c) = fast_trig::sin_cos_lanes(x);
+    for (i, &xi) in x.iter().enumerate() {
+        let (es, ec) = fast_trig::sin_cos(xi);
+        assert_eq!(
+            (s[i].to_bits(), c[i].to_bits()),
+            (es.to_bits(), ec.to_bits()),
+            "x = {xi:e}"
+        );
+    }
 }
 
 /// Every `f32` from 2^-12 to 512, of either sign, taken by the lanes' reduced path (a lane
@@ -343,15 +348,7 @@ fn lanes_in_the_reduced_path_are_the_scalar_trig() {
             for (i, xi) in x.iter_mut().take(L - 1).enumerate() {
                 *xi = sign * f32::from_bits((bits + i as u32).min(to - 1));
             }
-            let (s, c) = fast_trig::sin_cos_lanes(x);
-            for (i, &xi) in x.iter().enumerate() {
-                let (es, ec) = fast_trig::sin_cos(xi);
-                assert_eq!(
-                    (s[i].to_bits(), c[i].to_bits()),
-                    (es.to_bits(), ec.to_bits()),
-                    "x = {xi:e}"
-                );
-            }
+            assert_lanes_are_scalar(x);
             bits += L as u32 - 1;
         }
     };
