@@ -45,11 +45,12 @@ impl<T: Real, const N: usize> State<T, N> {
 
     /// `Ok(())` when finite, else [`Error::NonFiniteState`].
     ///
+    /// Over [`Lanes`](crate::Lanes), every lane must be finite, and lanes that disagree count
+    /// no divergence ([`check_finite`](crate::check_finite)). Inlined: called, it spilled
+    /// every live float of a step in lanes around it.
+    ///
     /// # Errors
     /// [`Error::NonFiniteState`] when any component is NaN or infinite.
-    ///
-    /// Over [`Lanes`](crate::Lanes), every lane must be finite, and lanes that disagree count
-    /// no divergence ([`check_finite`](crate::check_finite)).
     #[inline(always)]
     pub fn check_finite(&self) -> Result<(), Error> {
         if T::every_lane_finite(&[self.t])
