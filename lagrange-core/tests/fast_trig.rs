@@ -317,16 +317,16 @@ fn lane_trig_is_the_scalar_trig() {
     assert!(checked > 14_000);
 }
 
-/// `sin_cos_lanes` of `x` is, lane by lane, the scalar `sin_cos` to the bit.
+/// `sin_cos_lanes` of `x` is, lane by lane, the scalar `sin_cos` to the bit, and so are the
+/// scalar `sin` and `cos` (what `Lanes` takes lane by lane on a target without a vector unit).
 fn assert_lanes_are_scalar(x: [f32; L]) {
     let (s, c) = fast_trig::sin_cos_lanes(x);
     for (i, &xi) in x.iter().enumerate() {
         let (es, ec) = fast_trig::sin_cos(xi);
-        assert_eq!(
-            (s[i].to_bits(), c[i].to_bits()),
-            (es.to_bits(), ec.to_bits()),
-            "x = {xi:e}"
-        );
+        let bits = (es.to_bits(), ec.to_bits());
+        assert_eq!((s[i].to_bits(), c[i].to_bits()), bits, "x = {xi:e}");
+        let apart = (fast_trig::sin(xi).to_bits(), fast_trig::cos(xi).to_bits());
+        assert_eq!(apart, bits, "sin and cos apart, x = {xi:e}");
     }
 }
 

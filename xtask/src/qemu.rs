@@ -576,8 +576,8 @@ fn asleep_cost(per_step: &BTreeMap<usize, f64>) -> Option<String> {
     })
 }
 
-/// Prints what 16 pendulums cost per instance and step one by one and in lanes of 4 on the
-/// M4F (whose scenes step one by one: it has no vector unit).
+/// Prints what 16 pendulums cost per instance and step one by one, in lanes of 4, and in a
+/// scene's bank on the M4F.
 fn lane_cost(per_step: &BTreeMap<usize, f64>) {
     let find = |system: &str| {
         CASES
@@ -585,17 +585,20 @@ fn lane_cost(per_step: &BTreeMap<usize, f64>) {
             .position(|c| c.system == system)
             .and_then(|id| per_step.get(&id).copied())
     };
-    if let (Some(alone), Some(lanes)) = (
+    if let (Some(alone), Some(lanes), Some(bank)) = (
         find("16 pendulums, one by one"),
         find("16 pendulums, in lanes"),
+        find("16 pendulums, a scene's bank"),
     ) {
         let n = LANE_INSTANCES as f64;
         println!(
             "f32 RK4 pendulums on the M4F: {:.1} instructions per instance and step one by one, \
-             {:.1} in lanes of 4 ({:.2}x); scenes step one by one here",
+             {:.1} in lanes of 4 ({:.2}x), {:.1} in a scene's bank ({:.2}x)",
             alone / n,
             lanes / n,
-            lanes / alone
+            lanes / alone,
+            bank / n,
+            bank / alone
         );
     }
 }

@@ -1,11 +1,13 @@
-//! The lane cases: 16 `f32` pendulums of different lengths stepped by RK4 one by one, and
-//! the same in lanes of 4 (gathered, as a scene's bank does on x86_64): the same bits, and
-//! what each costs per instance and step on the M4F, which has no vector unit.
+//! The lane cases: 16 `f32` pendulums of different lengths stepped by RK4 one by one, the
+//! same in lanes of 4 (gathered once), and the same in a scene's bank (which gathers them
+//! every step where it steps lanes): the same bits, and what each costs per instance and step
+//! on the M4F, which has no vector unit.
 
 use core::hint::black_box;
 
 use lagrange_core::nalgebra::SVector;
 use lagrange_core::{Error, Lanes, Mechanism, State};
+use lagrange_integrators::scene::{Bank, NeverSleeps, Scene};
 use lagrange_integrators::{Integrator, Rk4};
 use lagrange_systems::SimplePendulum;
 
@@ -53,6 +55,11 @@ fn digest(states: impl Iterator<Item = State<f32, 1>>) -> Outcome {
 /// # Errors
 /// A step's error (none for these values).
 pub fn pendulums_alone(steps: u32) -> Result<Outcome, Error> {
+    Ok(digest(alone(steps)?.into_iter()))
+}
+
+/// The pendulums' states after `steps` steps one by one.
+fn alone(steps: u32) -> Result<[State<f32, 1>; LANE_INSTANCES], Error> {
     let mut all = pendulums()?;
     let dt = black_box(DT);
     for _ in 0..black_box(steps) {
@@ -60,7 +67,49 @@ pub fn pendulums_alone(steps: u32) -> Result<Outcome, Error> {
             *s = Rk4.step(p, s, dt)?;
         }
     }
-    Ok(digest(all.iter().map(|(_, s)| *s)))
+    Ok(all.map(|(_, s)| s))
+}
+
+/// [`pendulums_alone`] with the times left out, as [`pendulums_in_a_bank`] digests them.
+#[cfg(test)]
+pub(crate) fn alone_untimed(steps: u32) -> Result<Outcome, Error> {
+    Ok(digest(
+        alone(steps)?.map(|s| State { t: 0.0, ..s }).into_iter(),
+    ))
+}
+
+/// The pendulums in a scene's bank, one step of the same `dt` a frame for `steps` frames.
+/// Their times are the scene's (the bank lands each step there), so the outcome digests
+/// their angles and rates only.
+///
+/// # Errors
+/// A step's error (none for these values), or a frame that did not take one step.
+pub fn pendulums_in_a_bank(steps: u32) -> Result<Outcome, Error> {
+    let mut bank: Bank<f32, 1, LANE_INSTANCES, SimplePendulum<f32>, Rk4, NeverSleeps> =
+        Bank::new(Rk4, NeverSleeps)?;
+    let mut ids = [None; LANE_INSTANCES];
+    for (id, (p, s)) in ids.iter_mut().zip(pendulums()?) {
+        *id = Some(bank.add(p, s)?);
+    }
+    let dt = black_box(DT);
+    let mut scene = Scene::new(&mut bank, dt, 1)?;
+    for _ in 0..black_box(steps) {
+        if scene.advance(dt)?.steps != 1 {
+            return Err(Error::InvalidParameter {
+                name: "dt",
+                reason: "a frame of one dt took other than one step",
+            });
+        }
+    }
+    let bank = scene.banks();
+    let mut out = [State::at_rest([0.0f32]); LANE_INSTANCES];
+    for (state, id) in out.iter_mut().zip(ids.into_iter().flatten()) {
+        *state = State {
+            t: 0.0,
+            ..*bank.state(id)?
+        };
+    }
+    Ok(digest(out.into_iter()))
 }
 
 /// The pendulums stepped `steps` times in lanes of 4 (their parameters gathered once).

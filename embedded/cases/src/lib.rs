@@ -34,7 +34,7 @@ mod spring_chain;
 
 pub use case::{Case, Outcome, Precision, MAX_WORDS};
 pub use kernels::{Kernel, KERNELS, KERNEL_CALLS};
-pub use lanes::{pendulums_alone, pendulums_in_lanes, LANE_INSTANCES};
+pub use lanes::{pendulums_alone, pendulums_in_a_bank, pendulums_in_lanes, LANE_INSTANCES};
 pub use libm_trig_pendulum::LibmTrigPendulum;
 pub use scenes::{many_sleepers, no_sleepers, scripted, with_sleepers, SLEEPERS};
 pub use setups::{
@@ -60,7 +60,7 @@ pub const STEPS: u32 = 1000;
 /// Stormer-Verlet (symmetric, with an implicit kick), and by the variational midpoint rule,
 /// symplectic for any Lagrangian (on the automatic Euler-Lagrange path, Newton iterations in
 /// dual numbers).
-pub const CASES: [Case; 24] = [
+pub const CASES: [Case; 25] = [
     Case::new::<f32, 1, PendulumSetup, Rk4>(),
     Case::new::<f64, 1, PendulumSetup, Rk4>(),
     Case::new::<f32, 1, PendulumSetup, VelocityVerlet>(),
@@ -103,6 +103,13 @@ pub const CASES: [Case; 24] = [
         1,
         pendulums_in_lanes,
     ),
+    Case::scripted(
+        "16 pendulums, a scene's bank",
+        "RK4",
+        "f32",
+        1,
+        pendulums_in_a_bank,
+    ),
 ];
 
 #[cfg(test)]
@@ -132,6 +139,14 @@ mod tests {
     #[test]
     fn lanes_give_the_bits_of_one_by_one() -> Result<(), lagrange_core::Error> {
         assert_eq!(pendulums_in_lanes(STEPS)?, pendulums_alone(STEPS)?);
+        Ok(())
+    }
+
+    /// The pendulums in a scene's bank end with the angles and rates of one by one (their
+    /// times are the scene's).
+    #[test]
+    fn a_bank_gives_the_bits_of_one_by_one() -> Result<(), lagrange_core::Error> {
+        assert_eq!(pendulums_in_a_bank(STEPS)?, lanes::alone_untimed(STEPS)?);
         Ok(())
     }
 }
