@@ -88,6 +88,10 @@ where
             }
         },
     );
+    // From the start again, so that one by one and the bank step the same states in lockstep
+    // (the cost of a double pendulum's step depends on its angles: past pi/4 its sines take
+    // the reduced path).
+    alone.clone_from(&built);
     let (bank_ratio, _, ns_bank) = ratio(
         budget,
         || {
