@@ -42,19 +42,16 @@ impl Method for Rk4 {
 }
 
 impl<T: Real, const N: usize, M: Mechanism<T, N>> Integrator<T, N, M> for Rk4 {
-    /// The same step over lanes: it keeps nothing between steps.
+    /// The same step over lanes: it keeps nothing between steps. Inlined whole into the
+    /// caller (see [`Integrator::step_lanes`]).
+    #[inline(always)]
     fn step_lanes<const L: usize, G: Mechanism<Lanes<T, L>, N>>(
         &self,
         mechanism: &G,
         state: &State<Lanes<T, L>, N>,
         dt: T,
     ) -> Option<Result<State<Lanes<T, L>, N>, Error>> {
-        Some(Integrator::<Lanes<T, L>, N, G>::run_step(
-            &mut Rk4,
-            mechanism,
-            state,
-            Lanes::splat(dt),
-        ))
+        Some(run_step(mechanism, state, Lanes::splat(dt)))
     }
 
     fn step(&mut self, m: &M, s: &State<T, N>, dt: T) -> Result<State<T, N>, Error> {
@@ -63,8 +60,7 @@ impl<T: Real, const N: usize, M: Mechanism<T, N>> Integrator<T, N, M> for Rk4 {
     }
 
     fn run_step(&mut self, m: &M, s: &State<T, N>, dt: T) -> Result<State<T, N>, Error> {
-        let h = check_run_step(s, dt)?;
-        finish(stages(m, s, h)?)
+        run_step(m, s, dt)
     }
 
     /// As the default, with `dt` and the start checked once; from 5 coordinates the states
@@ -98,6 +94,16 @@ impl<T: Real, const N: usize, M: Mechanism<T, N>> Integrator<T, N, M> for Rk4 {
     ) -> Result<State<T, N>, Failure<T, N>> {
         step_loop(state, dt, steps, |s| finish(stages(m, s, dt)?), observe)
     }
+}
+
+/// [`Integrator::run_step`], over plain numbers or lanes.
+#[inline(always)]
+fn run_step<T: Real, const N: usize, M: Mechanism<T, N>>(
+    m: &M,
+    s: &State<T, N>,
+    dt: T,
+) -> Result<State<T, N>, Error> {
+    finish(stages(m, s, check_run_step(s, dt)?)?)
 }
 
 /// One step of `h` from `s`, unchecked.

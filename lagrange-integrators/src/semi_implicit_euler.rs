@@ -22,19 +22,19 @@ impl Method for SemiImplicitEuler {
 }
 
 impl<T: Real, const N: usize, M: Mechanism<T, N>> Integrator<T, N, M> for SemiImplicitEuler {
-    /// The same step over lanes: it keeps nothing between steps.
+    /// The same step over lanes: it keeps nothing between steps. Inlined whole into the
+    /// caller (see [`Integrator::step_lanes`]).
+    #[inline(always)]
     fn step_lanes<const L: usize, G: Mechanism<Lanes<T, L>, N>>(
         &self,
         mechanism: &G,
         state: &State<Lanes<T, L>, N>,
         dt: T,
     ) -> Option<Result<State<Lanes<T, L>, N>, Error>> {
-        Some(Integrator::<Lanes<T, L>, N, G>::run_step(
-            &mut SemiImplicitEuler,
-            mechanism,
-            state,
-            Lanes::splat(dt),
-        ))
+        Some(match check_run_step(state, Lanes::splat(dt)) {
+            Ok(h) => advance(mechanism, state, h),
+            Err(e) => Err(e),
+        })
     }
 
     fn step(&mut self, m: &M, s: &State<T, N>, dt: T) -> Result<State<T, N>, Error> {
