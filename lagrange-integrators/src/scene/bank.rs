@@ -138,8 +138,8 @@ struct Entry {
 /// ([`Mechanism::gather`], [`Integrator::step_lanes`]): 8 on x86_64 and aarch64 (two or one
 /// vector registers of `f32`); none elsewhere, where there is no vector unit to use. On the
 /// Cortex-M4F lanes of 4 gathered once cost 0.86 times the instructions of one by one, but a
-/// bank gathers and scatters its slots every step, and a bank in lanes of 4 took 1.18 times
-/// (`cargo xtask qemu`, 16 `f32` pendulums by RK4).
+/// bank gathers and scatters its slots every step, and a bank in lanes of 4 took 1.09 times
+/// (`cargo xtask qemu`, 16 `f32` pendulums by RK4), in a third more code.
 #[cfg(any(target_arch = "x86_64", target_arch = "aarch64"))]
 const LANES: usize = 8;
 /// See above.
