@@ -357,8 +357,9 @@ impl<T: Real, const L: usize> Real for Lanes<T, L> {
     fn sin_cos_lanes<const K: usize>(x: [Self; K]) -> ([Self; K], [Self; K]) {
         sin_cos_each(x)
     }
-    /// Every lane of every value finite, with no branch per lane and no divergence counted
-    /// ([`every_lane_finite_and`] over a vector unit, [`every_lane_finite_sum`] elsewhere).
+    /// Every lane of every value finite, with no branch per lane and no divergence counted:
+    /// over a vector unit one AND a lane (`x * 0 == 0`), elsewhere one sum of `x * 0` over
+    /// them all, compared with zero once.
     #[inline(always)]
     fn every_lane_finite(values: &[Self]) -> bool {
         if VECTOR_UNIT {
