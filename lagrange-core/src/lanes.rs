@@ -2,15 +2,15 @@
 //! any integrator written for a [`Real`] steps `L` instances at once, each lane bit for bit
 //! what the same code gives for that instance alone.
 //!
-//! Arithmetic and every function act lane by lane with the scalar's own operation (the lane
-//! sine and cosine of `f32` are [`fast_trig::sin_cos_lanes`](crate::fast_trig::sin_cos_lanes),
-//! bit for bit the scalar ones): plain arrays, which the compiler vectorizes, no fused
-//! multiply-add. What cannot act lane by lane is a branch: code that compares values takes one
-//! branch for all lanes. A comparison is therefore true when it holds in every lane, false
-//! when in none, and when the lanes disagree it answers false and counts a divergence
-//! ([`divergences`]). A caller that steps lanes reads the count before and after: unchanged,
-//! every lane took the branch its instance alone would have taken and the result is exact;
-//! changed, it discards the result and steps the instances one by one.
+//! Arithmetic and every function act lane by lane with the scalar's own operation (over a vector
+//! unit the lane sine and cosine of `f32` are [`sin_cos_lanes`], bit for bit the scalar ones;
+//! elsewhere the scalar `sin` and `cos`, lane by lane): plain arrays, which the compiler
+//! vectorizes, no fused multiply-add. What cannot act lane by lane is a branch: code that compares
+//! values takes one branch for all lanes. A comparison is therefore true when it holds in every
+//! lane, false when in none, and when the lanes disagree it answers false and counts a divergence
+//! ([`divergences`]). A caller that steps lanes reads the count before and after: unchanged, every
+//! lane took the branch its instance alone would have taken and the result is exact; changed, it
+//! discards the result and steps the instances one by one.
 //!
 //! The tests of a result before it is returned ([`check_finite`](crate::check_finite),
 //! [`Real::every_lane_finite`], [`Real::every_lane_positive`]) are data, not branches taken
@@ -18,6 +18,8 @@
 //! failure is an error, which ends the computation for every lane, and a caller stepping lanes
 //! takes a failed step one instance at a time. Counting is a branch per test, and those
 //! branches kept the compiler from joining the tests of a step's stages.
+//!
+//! [`sin_cos_lanes`]: crate::fast_trig::sin_cos_lanes
 
 use crate::scalar::{powi_by_squaring, sin_cos_each, Real, Scalar};
 use core::cmp::Ordering;
@@ -441,7 +443,7 @@ mod tests {
             T::zero(),
             -T::zero(),
             T::from_f64(1.5),
-            T::from_f64(-1e-310),
+            -(T::MIN_POSITIVE * T::HALF),
             -T::MAX,
             T::MAX,
             T::from_f64(f64::NAN),

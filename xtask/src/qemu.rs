@@ -485,7 +485,7 @@ fn lockstep(elf: &Path, decoder: &Path) -> Result<Vec<String>, String> {
          SysTick tick), {STEPS} steps of 1 ms:"
     );
     println!(
-        "{:>3}  {:<22} {:<21} {:<5} {:<12} {:>12} {:>8}",
+        "{:>3}  {:<28} {:<21} {:<5} {:<12} {:>12} {:>8}",
         "id", "system", "integrator", "type", "host = M4F", "instr/step", "stack B"
     );
     let mut per_step = BTreeMap::new();
@@ -521,7 +521,7 @@ fn lockstep(elf: &Path, decoder: &Path) -> Result<Vec<String>, String> {
             .get(&id)
             .map_or_else(|| "-".into(), u64::to_string);
         println!(
-            "{id:>3}  {:<22} {:<21} {:<5} {:<12} {cost:>12} {stack:>8}",
+            "{id:>3}  {:<28} {:<21} {:<5} {:<12} {cost:>12} {stack:>8}",
             case.system, case.method, case.precision, verdict
         );
     }
@@ -593,7 +593,7 @@ fn lane_cost(per_step: &BTreeMap<usize, f64>) {
         let n = LANE_INSTANCES as f64;
         println!(
             "f32 RK4 pendulums on the M4F: {:.1} instructions per instance and step one by one, \
-             {:.1} in lanes of 4 ({:.2}x), {:.1} in a scene's bank ({:.2}x)",
+             {:.1} in lanes of 4 ({:.2}x), {:.1} in a scene's bank, one by one here ({:.2}x)",
             alone / n,
             lanes / n,
             lanes / alone,

@@ -139,7 +139,8 @@ struct Entry {
 /// vector registers of `f32`); none elsewhere, where there is no vector unit to use. On the
 /// Cortex-M4F lanes of 4 gathered once cost 0.86 times the instructions of one by one, but a
 /// bank gathers and scatters its slots every step, and a bank in lanes of 4 took 1.09 times
-/// (`cargo xtask qemu`, 16 `f32` pendulums by RK4), in a third more code.
+/// (16 `f32` pendulums by RK4 under `cargo xtask qemu`, with this constant set to 4 for the
+/// measurement), in a third more code.
 #[cfg(any(target_arch = "x86_64", target_arch = "aarch64"))]
 const LANES: usize = 8;
 /// See above.
