@@ -87,7 +87,7 @@ pub use adaptive::{
     lower_triangular, AdaptiveSettings, Dop853Pair, Dopri5Pair, DormandPrince54, DormandPrince853,
     DormandPrinceNystrom1210, DormandPrinceNystrom64, DormandPrinceNystrom86, EmbeddedPair,
     EmbeddedRungeKutta, Nystrom, Nystrom1210Pair, Nystrom64Pair, Nystrom86Pair, Statistics, Stop,
-    Verner76, Verner76Pair, Verner98, Verner98Pair,
+    Verner76, Verner76Pair, Verner98, Verner98Pair, ENERGY_PROJECTION_LIMIT,
 };
 pub use backward_euler::{BackwardEuler, BackwardEulerTableau};
 pub use clock::Clock;

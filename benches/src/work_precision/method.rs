@@ -162,6 +162,12 @@ pub fn for_each(v: &mut impl MethodVisitor) {
     ));
     v.visit(&Adaptive::<11, 2, Verner76Pair>::unpaired());
     v.visit(&Adaptive::<17, 2, Verner98Pair>::unpaired());
+    v.visit(&Adaptive::<16, 4, Dop853Pair>::holding_energy(
+        "Dormand-Prince 8(5,3), energy held",
+    ));
+    v.visit(&Adaptive::<17, 2, Verner98Pair>::holding_energy(
+        "Verner 9(8), energy held",
+    ));
     v.visit(&Adaptive::<6, 2, Nystrom64Pair>::unpaired());
     v.visit(&Adaptive::<9, 2, Nystrom86Pair>::unpaired());
     v.visit(&Adaptive::<18, 2, Nystrom1210Pair>::unpaired());
@@ -347,9 +353,12 @@ impl<F: FixedStep> Method for Library<F> {
     }
 }
 
-/// An adaptive embedded Runge-Kutta pair of the library (`S` stages, `R` dense-output rows).
+/// An adaptive embedded Runge-Kutta pair of the library (`S` stages, `R` dense-output rows),
+/// with or without the energy projection.
 pub struct Adaptive<const S: usize, const R: usize, P> {
     tableau: Option<Tableau>,
+    /// Its own name where it holds the energy (`None`: the pair's).
+    holding_energy: Option<&'static str>,
     pair: PhantomData<P>,
 }
 
@@ -358,6 +367,7 @@ impl<const S: usize, const R: usize, P> Adaptive<S, R, P> {
     pub fn new(tableau: Tableau) -> Self {
         Self {
             tableau: Some(tableau),
+            holding_energy: None,
             pair: PhantomData,
         }
     }
@@ -366,6 +376,18 @@ impl<const S: usize, const R: usize, P> Adaptive<S, R, P> {
     pub fn unpaired() -> Self {
         Self {
             tableau: None,
+            holding_energy: None,
+            pair: PhantomData,
+        }
+    }
+
+    /// The pair `P` with the energy projection
+    /// ([`AdaptiveSettings::with_energy_projection`]), named `name`: another method than the
+    /// pair alone, which no peer has.
+    pub fn holding_energy(name: &'static str) -> Self {
+        Self {
+            tableau: None,
+            holding_energy: Some(name),
             pair: PhantomData,
         }
     }
@@ -376,7 +398,7 @@ const MAX_ADAPTIVE_STEPS: u64 = 10_000_000;
 
 impl<const S: usize, const R: usize, Pair: EmbeddedPair<S, R>> Method for Adaptive<S, R, Pair> {
     fn name(&self) -> &'static str {
-        Pair::NAME
+        self.holding_energy.unwrap_or(Pair::NAME)
     }
     fn origin(&self) -> Origin {
         Origin::Library
@@ -410,9 +432,12 @@ impl<const S: usize, const R: usize, Pair: EmbeddedPair<S, R>> Method for Adapti
         }
         let solve = || -> Result<Outcome<T, N>, String> {
             let tol = T::real(tol);
-            let settings = AdaptiveSettings::new(tol, tol)
+            let mut settings = AdaptiveSettings::new(tol, tol)
                 .and_then(|s| s.with_max_steps(MAX_ADAPTIVE_STEPS))
                 .map_err(|e| e.to_string())?;
+            if self.holding_energy.is_some() {
+                settings = settings.with_energy_projection();
+            }
             let mut rk = EmbeddedRungeKutta::<T, N, S, R, Pair>::new(settings);
             let end = match observe {
                 None => rk.integrate_to(mechanism, start, t_end),

@@ -75,8 +75,12 @@ where
             self.stages.kq[i] = s.qd;
             self.stages.kv[i] = self.eval(m, &s)?;
         }
-        // The step's end, recomputed from the stages (a state cut by an event is not it).
-        let y1 = self.stage_state(&y0, h, P::FSAL);
+        // The step's end: where the energy projection moved it, else recomputed from the
+        // stages (a state cut by an event is not it).
+        let y1 = match self.stages.end {
+            Some(end) => end,
+            None => self.stage_state(&y0, h, P::FSAL),
+        };
         let hermite = |dy: SVector<T, N>, k0: SVector<T, N>, k1: SVector<T, N>| {
             let c3 = k0 * h - dy;
             [dy, c3, dy - k1 * h - c3]
@@ -317,6 +321,7 @@ where
         };
         self.h_last = t - self.previous.t;
         self.stages.hermite = None;
+        self.stages.end = None;
         self.prepare_dense(m)?;
         Ok(s)
     }

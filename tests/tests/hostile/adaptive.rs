@@ -1,5 +1,5 @@
-//! Family `adaptive`: `AdaptiveSettings` and its builders, and sequences of calls of both
-//! adaptive pairs (`integrate_to`, `next_step`, the landing `step`, `integrate_until_event`
+//! Family `adaptive`: `AdaptiveSettings` and its builders, and sequences of calls of the
+//! adaptive pairs (with the energy projection now and then) (`integrate_to`, `next_step`, the landing `step`, `integrate_until_event`
 //! with a guard that may return NaN, `dense_output`) from continued, repeated and new states,
 //! with end times at their edges (an ulp away, before the start, huge, NaN). After every error
 //! the integrator's observable state (step size, dense interval and output) must be as before.
@@ -18,9 +18,11 @@ use lagrange_integrators::{
 };
 use lagrange_systems::FallingParticle;
 
-/// Settings drawn: tolerances at their edges, and each builder now and then. The step limit
-/// is kept small most of the time (a long run is not a hang).
-pub fn settings<T: Real>(ctx: &mut Ctx) -> Result<AdaptiveSettings<T>, Verdict> {
+/// Settings drawn: tolerances at their edges, and each builder now and then (the energy
+/// projection only where `projecting` may be drawn: its callers then allow the error that
+/// names the mechanism). The step limit is kept small most of the time (a long run is not a
+/// hang).
+pub fn settings<T: Real>(ctx: &mut Ctx, projecting: bool) -> Result<AdaptiveSettings<T>, Verdict> {
     let [rtol, atol] = ctx.values::<T, 2>(Kind::Tolerance);
     say!(
         ctx,
@@ -58,6 +60,10 @@ pub fn settings<T: Real>(ctx: &mut Ctx) -> Result<AdaptiveSettings<T>, Verdict> 
         );
         s = checked(s.with_event_tolerance(e), &["event_tolerance"])?;
     }
+    if projecting && ctx.pick(4) == 0 {
+        say!(ctx, "let settings = settings.with_energy_projection();");
+        s = s.with_energy_projection();
+    }
     if ctx.pick(20) != 0 {
         let n = ctx.count().min(2000);
         say!(ctx, "let settings = settings.with_max_steps({n})?;");
@@ -94,7 +100,7 @@ fn checked<T: Real>(
 }
 
 fn settings_case<T: Real>(ctx: &mut Ctx) -> Verdict {
-    match settings::<T>(ctx) {
+    match settings::<T>(ctx, true) {
         Ok(_) => Verdict::Ok,
         Err(v) => v,
     }
@@ -141,7 +147,16 @@ where
     M: Mechanism<T, N>,
     P: EmbeddedPair<S, R>,
 {
-    let settings = tryv!(settings::<T>(ctx));
+    let settings = tryv!(settings::<T>(ctx, true));
+    // With the energy projection, a mechanism that does not conserve its energy (a damped
+    // pendulum, a driven one) is refused by name.
+    let with = |params: &[&'static str]| -> Vec<&'static str> {
+        let mut all = params.to_vec();
+        if settings.energy_projection() {
+            all.push("mechanism");
+        }
+        all
+    };
     say!(
         ctx,
         "let mut rk = {pair}::<{}, {N}>::new(settings);",
@@ -172,19 +187,19 @@ where
                 let t_end = end(ctx, from.t);
                 say!(ctx, "let last = rk.integrate_to(&m, &s, {})?;", lit(t_end));
                 let r = rk.integrate_to(m, &from, t_end).map_err(|f| f.error);
-                (verdict(&r, &["state", "t_end"]), r.ok())
+                (verdict(&r, &with(&["state", "t_end"])), r.ok())
             }
             1 => {
                 let t_end = end(ctx, from.t);
                 say!(ctx, "let last = rk.next_step(&m, &s, {})?;", lit(t_end));
                 let r = rk.next_step(m, &from, t_end);
-                (verdict(&r, &["state", "t_end"]), r.ok())
+                (verdict(&r, &with(&["state", "t_end"])), r.ok())
             }
             2 => {
                 let dt = ctx.value::<T>(Kind::Step);
                 say!(ctx, "let last = rk.step(&m, &s, {})?;", lit(dt));
                 let r = rk.step(m, &from, dt);
-                (verdict(&r, &["dt", "state"]), r.ok())
+                (verdict(&r, &with(&["dt", "state"])), r.ok())
             }
             3 => {
                 let t_end = end(ctx, from.t);
@@ -210,7 +225,7 @@ where
                 let r = rk
                     .integrate_until_event(m, &from, t_end, guard)
                     .map_err(|f| f.error);
-                let v = verdict(&r, &["state", "t_end", "guard"]);
+                let v = verdict(&r, &with(&["state", "t_end", "guard"]));
                 (v, r.ok().map(|stop| *stop.state()))
             }
             _ => {

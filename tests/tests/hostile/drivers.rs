@@ -91,7 +91,7 @@ where
 }
 
 fn dopri<T: Real, const N: usize>(ctx: &mut Ctx) -> Made<DormandPrince54<T, N>> {
-    let s = crate::adaptive::settings::<T>(ctx)?;
+    let s = crate::adaptive::settings::<T>(ctx, false)?;
     Ok((
         DormandPrince54::new(s),
         format!("DormandPrince54::<{}, {N}>::new(settings)", ty::<T>()),
