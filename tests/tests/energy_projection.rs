@@ -3,10 +3,15 @@
 //! points too at no evaluation more, the dense output ends on the projected state, events are
 //! found and a run continues past them, and a driven or damped mechanism is refused.
 
-use lagrange_core::{Constrained, Constraints, Error, Lagrangian, Mechanism, Real, State};
+use core::cell::Cell;
+use lagrange_core::nalgebra::{SMatrix, SVector};
+use lagrange_core::{
+    Constrained, Constraints, Error, GeneralizedForce, Lagrangian, Mechanism, Real, Scalar, State,
+    ViscousDamping,
+};
 use lagrange_integrators::{
-    AdaptiveSettings, DormandPrince853, EmbeddedPair, EmbeddedRungeKutta, Integrator, Stop,
-    Verner98,
+    AdaptiveSettings, DormandPrince853, DormandPrinceNystrom86, EmbeddedPair, EmbeddedRungeKutta,
+    Integrator, Stop, Verner98,
 };
 use lagrange_systems::exact::kepler_orbit;
 use lagrange_systems::{BeadOnRotatingHoop, CartesianPendulum, Kepler, SimplePendulum};
@@ -85,13 +90,14 @@ fn kepler_orbit_holds_its_energy_and_phase<T: Real>() -> Result<(), Error> {
     Ok(())
 }
 
-/// The pendulum released from 1 rad, 200 s (about 100 swings) by DOP853: held, its energy
-/// stays at the start's to [`HELD_EPSILONS`] (measured 5.0e-16 in f64 and 1.8e-7 in f32,
-/// against 1.5e-7 and 3.3e-4 without), although every swing passes two turning points where
-/// the kinetic energy is too small to carry the correction (those steps are left as they
-/// are, and no NaN comes of them). Its law does not read the velocities, so the derivative at
-/// a projected end is the stages' own: no evaluation more per step (at most 2% more in all,
-/// the steps taken differing by a few; measured 0% and -0.2%).
+/// The pendulum released from 1 rad, 200 s (about 100 swings) by DOP853 and by the Nyström
+/// 8(6) pair: held, its energy stays at the start's to [`HELD_EPSILONS`] (DOP853 measured
+/// 5.0e-16 in f64 and 1.8e-7 in f32, against 1.5e-7 and 3.3e-4 without), although every
+/// swing passes two turning points where the kinetic energy is too small to carry the
+/// correction (those steps are left as they are, and no NaN comes of them). Its law does not
+/// read the velocities, so the derivative at a projected end is the stages' own: no evaluation
+/// more per step (at most 2% more in all, the steps taken differing by a few; measured 0% and
+/// -0.2%).
 fn pendulum_holds_its_energy_through_turning_points<T: Real>() -> Result<(), Error> {
     let tol = pick::<T>(1e-5, 1e-8);
     let p = SimplePendulum::new(T::one(), T::one(), T::from_f64(9.81), T::zero())?;
@@ -104,11 +110,16 @@ fn pendulum_holds_its_energy_through_turning_points<T: Real>() -> Result<(), Err
         plain.statistics().evaluations,
         held.statistics().evaluations,
     ];
-    println!("pendulum: energy error {drift:.1e} -> {worst:.1e}, evaluations {evals:?}");
+    println!("pendulum, DOP853: energy error {drift:.1e} -> {worst:.1e}, evaluations {evals:?}");
     assert!(end.is_finite());
     assert!(worst <= HELD_EPSILONS * T::EPSILON.to_f64(), "{worst:e}");
     assert!(worst * 100.0 <= drift, "{worst:e} against {drift:e}");
     assert!(evals[1] as f64 <= 1.02 * evals[0] as f64, "{evals:?}");
+    let mut nystrom = DormandPrinceNystrom86::new(settings::<T>(tol, true)?);
+    let (end, worst) = run1(&mut nystrom, &p, &start, 200.0)?;
+    println!("pendulum, Nystrom 8(6): energy error {worst:.1e}");
+    assert!(end.is_finite());
+    assert!(worst <= HELD_EPSILONS * T::EPSILON.to_f64(), "{worst:e}");
     Ok(())
 }
 
@@ -197,26 +208,37 @@ fn a_damped_mechanism_fails_its_first_moving_step() -> Result<(), Error> {
 }
 
 /// The dense output of a projected step ends on the projected state: sampled a billionth of
-/// the step before its end it is within `1e-9 h |y'|` of it (here at most 1e-8), where the
-/// step's own end differs from the projected one by the energy correction (rtol 1e-6 on the
-/// Kepler orbit: velocity corrections up to about 1e-6 of the speed, so a dense output that
-/// ended on the unprojected state would miss by up to that much, 1e-5 of `phi'` here).
+/// the step before its end it is within 1e-8 of it (the step's `1e-9 h |y'|`), where the
+/// step's own end is off the projected one by the energy correction: at rtol 1e-4 on the
+/// Kepler orbit a plain step changes the energy by up to the printed figure (asserted above
+/// 1e-7 of it), which at speeds below 3.5 moves the velocities by more than 1e-8: a dense
+/// output that ended on the step's own end would miss by that much.
 #[test]
 fn the_dense_output_ends_on_the_projected_state() -> Result<(), Error> {
     let kepler = Kepler::new(1.0)?;
-    let mut rk = DormandPrince853::new(settings::<f64>(1e-6, true)?);
-    let mut s = kepler_periapsis::<f64>();
-    let mut worst = 0.0f64;
-    for _ in 0..200 {
-        let next = rk.next_step(&kepler, &s, 100.0)?;
-        let (t0, t1) = rk.dense_interval().ok_or(UNEXPECTED)?;
-        let before = rk.dense_output(t1 - (t1 - t0) * 1e-9)?;
-        let gap = (before.q - next.q).amax().max((before.qd - next.qd).amax());
-        worst = worst.max(gap);
-        s = next;
+    let e0 = kepler.energy(&kepler_periapsis::<f64>());
+    let mut worst = [0.0f64; 2];
+    for (held, worst) in [true, false].into_iter().zip(&mut worst) {
+        let mut rk = DormandPrince853::new(settings::<f64>(1e-4, held)?);
+        let mut s = kepler_periapsis::<f64>();
+        for _ in 0..200 {
+            let next = rk.next_step(&kepler, &s, 100.0)?;
+            if held {
+                let (t0, t1) = rk.dense_interval().ok_or(UNEXPECTED)?;
+                let before = rk.dense_output(t1 - (t1 - t0) * 1e-9)?;
+                let gap = (before.q - next.q).amax().max((before.qd - next.qd).amax());
+                *worst = worst.max(gap);
+            } else {
+                let step = ((kepler.energy(&next) - kepler.energy(&s)) / e0).abs();
+                *worst = worst.max(step);
+            }
+            s = next;
+        }
     }
-    println!("dense output a billionth of a step before the end: {worst:.1e} from the state");
-    assert!(worst <= 1e-8, "{worst:e}");
+    let [gap, step] = worst;
+    println!("dense output {gap:.1e} from the projected end; a plain step changes E by {step:.1e}");
+    assert!(gap <= 1e-8, "{gap:e}");
+    assert!(step >= 1e-7, "{step:e}");
     Ok(())
 }
 
@@ -288,9 +310,10 @@ fn crossings<const S: usize, const R: usize, P: EmbeddedPair<S, R>>(
 /// velocities scales `J q'` with them (by a factor within 1e-4 of 1 here), so the velocity
 /// residual stays where the steps leave it: within 10% of the plain run's (measured equal,
 /// 8.9e-7 m/s after 60 s at rtol 1e-6, no drift control). Driven by the frame loop
-/// (`Integrator::step`, 120 frames of 0.5 s), Verner 9(8) lands every frame by a step
-/// shortened to it, so every frame is a projected step's end: its energy is the start's to
-/// [`HELD_EPSILONS`] (measured 6.7e-16), where the plain run drifts to 9.6e-5.
+/// (`Integrator::step`, 120 frames of 0.5 s), every frame holds the start's energy to
+/// [`HELD_EPSILONS`] (measured 6.7e-16), where the plain runs drift to 9.1e-4: Verner 9(8)
+/// lands every frame by a step shortened to it, a projected step's end, and DOP853 on its
+/// continuous extension inside a step, projected too.
 #[test]
 fn a_constrained_mechanism_holds_its_energy_at_every_frame() -> Result<(), Error> {
     // Frames long enough that the pair takes steps of its own choosing inside them.
@@ -301,10 +324,13 @@ fn a_constrained_mechanism_holds_its_energy_at_every_frame() -> Result<(), Error
     let e0 = pendulum.energy(&start);
     let mut results = [(0.0f64, 0.0f64); 2];
     for (held, result) in [false, true].into_iter().zip(&mut results) {
-        let mut rk = Verner98::new(settings::<f64>(1e-6, held)?);
-        let mut s = start;
+        let mut verner = Verner98::new(settings::<f64>(1e-6, held)?);
+        let mut dop853 = DormandPrince853::new(settings::<f64>(1e-6, held)?);
+        let (mut s, mut d) = (start, start);
         for _ in 0..FRAMES {
-            s = rk.step(&pendulum, &s, FRAME)?;
+            s = verner.step(&pendulum, &s, FRAME)?;
+            d = dop853.step(&pendulum, &d, FRAME)?;
+            result.0 = result.0.max((pendulum.energy(&d) / e0 - 1.0).abs());
             result.0 = result.0.max((pendulum.energy(&s) / e0 - 1.0).abs());
         }
         result.1 = pendulum.residual(&s).velocity;
@@ -319,5 +345,112 @@ fn a_constrained_mechanism_holds_its_energy_at_every_frame() -> Result<(), Error
         residual <= 1.1 * plain_residual,
         "{residual:e} against {plain_residual:e}"
     );
+    Ok(())
+}
+
+/// A mechanism that counts its law's calls and keeps the last state it was evaluated at.
+struct Recording<M, const N: usize> {
+    inner: M,
+    calls: Cell<u64>,
+    last: Cell<Option<State<f64, N>>>,
+}
+
+impl<M: Mechanism<f64, N>, const N: usize> Lagrangian<f64, N> for Recording<M, N> {
+    const DRIVEN: bool = M::DRIVEN;
+    fn kinetic<S: Scalar<Real = f64>>(&self, t: S, q: &SVector<S, N>, qd: &SVector<S, N>) -> S {
+        self.inner.kinetic(t, q, qd)
+    }
+    fn potential<S: Scalar<Real = f64>>(&self, t: S, q: &SVector<S, N>) -> S {
+        self.inner.potential(t, q)
+    }
+    fn non_conservative_force(&self, s: &State<f64, N>) -> SVector<f64, N> {
+        self.inner.non_conservative_force(s)
+    }
+}
+
+impl<M: Mechanism<f64, N>, const N: usize> Mechanism<f64, N> for Recording<M, N> {
+    fn mass_matrix(&self, s: &State<f64, N>) -> SMatrix<f64, N, N> {
+        self.inner.mass_matrix(s)
+    }
+    fn rhs(&self, s: &State<f64, N>) -> SVector<f64, N> {
+        self.inner.rhs(s)
+    }
+    fn law<F: GeneralizedForce<f64, N>>(
+        &self,
+        s: &State<f64, N>,
+        extra: &F,
+    ) -> Result<SVector<f64, N>, Error> {
+        self.calls.set(self.calls.get() + 1);
+        self.last.set(Some(*s));
+        self.inner.law(s, extra)
+    }
+}
+
+/// Where the law reads the velocities (the polar Kepler orbit), a held run evaluates it once
+/// more per accepted step, at the projected end: `integrate_to` from a fresh start costs the
+/// first derivative, the initial step's estimate and `FSAL` evaluations per attempted step,
+/// plus, held, one per accepted step exactly, the run's last evaluation being at the state it
+/// returns (DOP853 at rtol 1e-8 over 10 periods).
+#[test]
+fn a_held_step_evaluates_the_law_once_more_at_its_end() -> Result<(), Error> {
+    let kepler = Recording {
+        inner: Kepler::new(1.0)?,
+        calls: Cell::new(0),
+        last: Cell::new(None),
+    };
+    let t_end = 20.0 * core::f64::consts::PI;
+    for held in [false, true] {
+        kepler.calls.set(0);
+        let mut rk = DormandPrince853::new(settings::<f64>(1e-8, held)?);
+        let end = rk.integrate_to(&kepler, &kepler_periapsis(), t_end)?;
+        let st = rk.statistics();
+        let fsal = <lagrange_integrators::Dop853Pair as EmbeddedPair<16, 4>>::FSAL as u64;
+        let expected = 2 + fsal * (st.accepted + st.rejected) + u64::from(held) * st.accepted;
+        assert_eq!(
+            (kepler.calls.get(), st.evaluations),
+            (expected, expected),
+            "held {held}"
+        );
+        if held {
+            assert_eq!(kepler.last.get(), Some(end));
+        }
+    }
+    Ok(())
+}
+
+/// A call that fails leaves the energy held as it found it: a held Kepler run interrupted,
+/// after 50 steps, by a call from another start with a damped orbit (it starts, then fails at
+/// its first step's end) goes on to the bits of the same run never interrupted.
+#[test]
+fn a_failed_call_keeps_the_energy_held() -> Result<(), Error> {
+    let kepler = Kepler::new(1.0)?;
+    let damped = Kepler::new(1.0)?.with_force(ViscousDamping::uniform(0.1)?);
+    let t_end = 20.0 * core::f64::consts::PI;
+    let mut ends = [kepler_periapsis::<f64>(); 2];
+    for (interrupted, end) in [false, true].into_iter().zip(&mut ends) {
+        let mut rk = Verner98::new(settings::<f64>(1e-9, true)?);
+        let mut s = kepler_periapsis::<f64>();
+        for _ in 0..50 {
+            s = rk.next_step(&kepler, &s, t_end)?;
+        }
+        if interrupted {
+            let other = State::new(0.0, [0.7, 0.0], [0.1, 1.5]);
+            let Err(failure) = rk.integrate_to(&damped, &other, t_end) else {
+                return Err(UNEXPECTED);
+            };
+            assert!(
+                matches!(
+                    failure.error,
+                    Error::InvalidParameter {
+                        name: "mechanism",
+                        ..
+                    }
+                ),
+                "{failure}"
+            );
+        }
+        *end = rk.integrate_to(&kepler, &s, t_end)?;
+    }
+    assert_eq!(ends[0], ends[1]);
     Ok(())
 }

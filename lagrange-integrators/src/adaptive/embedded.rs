@@ -266,8 +266,9 @@ where
 
     /// Forgets the run, so that the next call starts afresh from its state (after the
     /// mechanism changed between calls): the derivative kept for the next step, the
-    /// controller's history and the dense output go; the proposed step size stays as the first
-    /// step to try.
+    /// controller's history and the dense output go, and the energy held
+    /// ([`AdaptiveSettings::with_energy_projection`]) is the new start's; the proposed step
+    /// size stays as the first step to try.
     pub fn restart(&mut self) {
         self.output = None;
     }
@@ -723,7 +724,7 @@ where
         if self.state.t >= t_end {
             // Continuing from a landing that the last step already passed: the end is
             // inside that step.
-            let s = self.interpolate(mechanism, t_end)?;
+            let s = self.landing(mechanism, t_end)?;
             self.output = Some(s);
             return Ok(s);
         }
@@ -731,6 +732,17 @@ where
         self.prepare_dense(mechanism)?;
         self.output = Some(self.state);
         Ok(self.state)
+    }
+
+    /// The state a call returns at `t` inside the last accepted step: the continuous
+    /// extension's, projected onto the energy where the run holds it (the run itself goes on
+    /// from the step's end).
+    fn landing<M: Mechanism<T, N>>(&mut self, m: &M, t: T) -> Result<State<T, N>, Error> {
+        let mut s = self.interpolate(m, t)?;
+        if let Some(e0) = self.energy {
+            project(m, &mut s, e0)?;
+        }
+        Ok(s)
     }
 
     /// The state at `t` inside the last accepted step, by the continuous extension.
@@ -791,7 +803,7 @@ where
         let out = if self.state.t == t_end {
             self.state
         } else {
-            self.interpolate(mechanism, t_end)
+            self.landing(mechanism, t_end)
                 .map_err(|e| fail(e, steps, &self.previous))?
         };
         self.output = Some(out);
@@ -824,7 +836,9 @@ where
     const ORDER: u32 = P::ORDER;
     /// Per internal step accepted (`fixed`, with the first stage of the next step reused), and
     /// per rejected attempt (`per_iteration`: a rejection is an iteration of the step-size
-    /// search); [`Method::last_step`] reports both counts of a call.
+    /// search); [`Method::last_step`] reports both counts of a call. Holding the energy
+    /// ([`AdaptiveSettings::with_energy_projection`]) costs one more per accepted step where
+    /// the law reads the velocities, which `last_step` counts and this constant does not.
     const COST: Cost = Cost {
         fixed: P::FSAL as u32,
         per_iteration: P::FSAL as u32,

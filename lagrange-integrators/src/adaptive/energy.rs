@@ -22,7 +22,8 @@ where
             reason: "is driven: its energy T + V is not conserved, and cannot be projected onto",
         });
     }
-    let e0 = m.energy(state);
+    // T and V apart, as `project` takes them.
+    let e0 = m.kinetic_energy(state) + m.potential_energy(state);
     if e0.is_finite() {
         Ok(e0)
     } else {
