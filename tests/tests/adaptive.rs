@@ -1217,3 +1217,75 @@ fn a_late_crossing_is_located_to_rounding() -> Result<(), Error> {
     late_crossing::<11, 2, lagrange_integrators::Verner76Pair>()?;
     late_crossing::<17, 2, lagrange_integrators::Verner98Pair>()
 }
+
+/// An undamped spring `x'' = -w^2 x` whose law refuses to be evaluated more than `budget`
+/// times (`Singularity`): a run that would retry the same step for ever ends with that error
+/// instead of hanging the test.
+struct BudgetedSpring {
+    w2: f32,
+    calls: core::cell::Cell<u32>,
+    budget: u32,
+}
+
+impl Lagrangian<f32, 1> for BudgetedSpring {
+    fn kinetic<S: Scalar<Real = f32>>(&self, _t: S, _q: &SVector<S, 1>, qd: &SVector<S, 1>) -> S {
+        qd[0] * qd[0] * 0.5
+    }
+    fn potential<S: Scalar<Real = f32>>(&self, _t: S, q: &SVector<S, 1>) -> S {
+        q[0] * q[0] * (0.5 * self.w2)
+    }
+}
+
+impl Mechanism<f32, 1> for BudgetedSpring {
+    fn mass_matrix(&self, _s: &State<f32, 1>) -> lagrange_core::nalgebra::Matrix1<f32> {
+        lagrange_core::nalgebra::Matrix1::new(1.0)
+    }
+    fn rhs(&self, s: &State<f32, 1>) -> SVector<f32, 1> {
+        Vector1::new(-self.w2 * s.q[0])
+    }
+    fn law<F: lagrange_core::GeneralizedForce<f32, 1>>(
+        &self,
+        s: &State<f32, 1>,
+        extra: &F,
+    ) -> Result<SVector<f32, 1>, Error> {
+        self.calls.set(self.calls.get() + 1);
+        if self.calls.get() > self.budget {
+            return Err(Error::Singularity {
+                what: "the test's budget of evaluations is spent",
+            });
+        }
+        Ok(self.rhs(s) + extra.force(s))
+    }
+}
+
+/// A step the clock cannot make smaller: an f32 spring of `w` about 43 rad/s late in a run
+/// (t = 16384 s, where an ulp of the time is 2e-3 s) at rtol 1e-5 needs steps below an ulp.
+/// A rejected step of one ulp shrunk by 0.9 rounds back up to one ulp on the clock, so the
+/// same trial was rejected again for ever (these three frequencies hung before the fix); it
+/// is `StepSizeUnderflow`, within a few hundred evaluations (measured 205 to 247; budget
+/// 100,000, past which the law refuses and the test fails instead of hanging).
+#[test]
+fn a_step_below_an_ulp_of_the_time_underflows_instead_of_retrying() -> Result<(), Error> {
+    for w in [42.445_976_f32, 43.294_895, 44.160_793] {
+        let spring = BudgetedSpring {
+            w2: w * w,
+            calls: core::cell::Cell::new(0),
+            budget: 100_000,
+        };
+        let settings = AdaptiveSettings::new(1e-5f32, 1e-5)?.with_initial_step(0.5)?;
+        let mut rk = DormandPrince54::new(settings);
+        let failed = rk.integrate_to(&spring, &State::new(16384.0, [1.0], [0.0]), 16385.0);
+        println!(
+            "w {w}: {:?} after {} evaluations",
+            failed.map(|s| s.t),
+            spring.calls.get()
+        );
+        assert_eq!(
+            failed.map_err(|f| f.error),
+            Err(Error::StepSizeUnderflow),
+            "w {w}"
+        );
+        assert!(spring.calls.get() < 1000, "w {w}: {}", spring.calls.get());
+    }
+    Ok(())
+}

@@ -529,7 +529,9 @@ where
     ///
     /// Every trial step is finite (at most `h_max`, at most the distance to `t_end`, never
     /// above `T::MAX`) and each rejection shrinks it by at least the controller's 0.9, so the
-    /// loop ends: accepted, or [`Error::StepSizeUnderflow`] once `t + h` rounds to `t`.
+    /// loop ends: accepted, or [`Error::StepSizeUnderflow`] once `t + h` rounds to `t`, or
+    /// to the step just rejected (below two ulps of the time, 0.9 of a step rounds back up to
+    /// it: the same trial, rejected again, for ever).
     ///
     /// Never inlined: a step is a chain of dependent stages, and merged into a caller's loop
     /// (the bench's timed closure) it was compiled with a longer chain, 15% slower per step
@@ -549,6 +551,9 @@ where
             h = h.max(y0.t.abs() * T::EPSILON).min(self.settings.h_max());
         }
         let mut stretch = real::<T>(1.01);
+        // The last trial rejected: a trial the clock rounds back up to it (a step below an
+        // ulp of the time, rounded to one) cannot shrink any further.
+        let mut rejected = T::INFINITY;
         loop {
             // An end too far to be reached in one finite step (t_end - t overflows) is not
             // a last step.
@@ -565,6 +570,9 @@ where
                 // difference is exact): the state moves by as much time as its clock, or a
                 // late run (an f32 clock after an hour, an ulp of 2.4e-4 s) drifts in phase.
                 h = (y0.t + h) - y0.t;
+                if h >= rejected {
+                    return Err(Error::StepSizeUnderflow);
+                }
             }
             let mut y1 = y0;
             run_stages!(self, m, y0, h, y1; 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17);
@@ -600,6 +608,7 @@ where
                 self.work.steps += 1;
                 return Ok(());
             }
+            rejected = h;
             h *= T::from_f32(self.controller.reject(err_sq.to_f32()));
             stretch = T::one();
             self.stats.rejected += 1;

@@ -25,9 +25,10 @@ pub struct AdaptiveSettings<T> {
 /// The default step limit per call.
 const DEFAULT_MAX_STEPS: u64 = 100_000;
 
-/// The largest change of the speed an energy projection makes
+/// The largest relative change of the speed an energy projection makes at the end of a step
 /// ([`AdaptiveSettings::with_energy_projection`]): a step whose end would need more (a state
-/// near rest, whose kinetic energy is too small to carry the correction) is left as it is.
+/// near rest, whose kinetic energy is too small to carry the correction, or a run that has
+/// drifted) has its speed changed by this much, towards the energy held.
 pub const ENERGY_PROJECTION_LIMIT: f64 = 0.01;
 
 /// The smallest relative tolerance, in machine epsilons: below it the error estimate is
@@ -145,10 +146,11 @@ impl<T: Real> AdaptiveSettings<T> {
     /// periods of a pendulum, a chaotic chain), the projection gains nothing.
     ///
     /// Scaling keeps the coordinates, the direction of motion and every velocity constraint
-    /// `J q' = 0` of a constrained mechanism. A step that ends so near rest that the scaling
-    /// would change the speed by more than [`ENERGY_PROJECTION_LIMIT`] (a pendulum at the top
-    /// of its swing, whose kinetic energy cannot carry the correction) is left as it is; the
-    /// next steps restore the energy.
+    /// `J q' = 0` of a constrained mechanism. Where the exact factor would change the speed
+    /// by more than [`ENERGY_PROJECTION_LIMIT`] (a pendulum at the top of its swing, whose
+    /// kinetic energy cannot carry the correction, or a run that drifted far before), the
+    /// speed changes by that much, towards the energy held, and the next steps go on
+    /// restoring it; a state at rest is left as it is.
     ///
     /// The states a call returns hold the energy: the steps' ends, and the landings of
     /// `integrate_to` and `Integrator::step` inside a step (the continuous extension there,
