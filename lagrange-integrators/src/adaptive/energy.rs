@@ -53,7 +53,9 @@ where
     let kinetic = m.kinetic_energy(y);
     // The square of the exact factor: the kinetic energy wanted over the one there is.
     let ratio = (e0 - m.potential_energy(y)) / kinetic;
-    if !(kinetic > T::zero()) || ratio.partial_cmp(&T::zero()).is_none() {
+    // At rest (or a kinetic energy that is not a number), or energies that are not numbers.
+    let moving = kinetic.partial_cmp(&T::zero()) == Some(core::cmp::Ordering::Greater);
+    if !moving || ratio.partial_cmp(&T::zero()).is_none() {
         return Ok(());
     }
     let limit = real::<T>(ENERGY_PROJECTION_LIMIT);
