@@ -34,15 +34,15 @@ fn settings<T: Real>(tol: f64, held: bool) -> Result<AdaptiveSettings<T>, Error>
 
 /// A run of `rk` on `m` to `t_end`, and the worst relative energy error at the end of any of
 /// its steps (seen through a guard that never changes sign).
-fn run<T, M, const S: usize, const R: usize, P>(
-    rk: &mut EmbeddedRungeKutta<T, 2, S, R, P>,
+fn run<T, M, const N: usize, const S: usize, const R: usize, P>(
+    rk: &mut EmbeddedRungeKutta<T, N, S, R, P>,
     m: &M,
-    start: &State<T, 2>,
+    start: &State<T, N>,
     t_end: f64,
-) -> Result<(State<T, 2>, f64), Error>
+) -> Result<(State<T, N>, f64), Error>
 where
     T: Real,
-    M: Mechanism<T, 2>,
+    M: Mechanism<T, N>,
     P: EmbeddedPair<S, R>,
 {
     let e0 = m.energy(start).to_f64();
@@ -103,9 +103,9 @@ fn pendulum_holds_its_energy_through_turning_points<T: Real>() -> Result<(), Err
     let p = SimplePendulum::new(T::one(), T::one(), T::from_f64(9.81), T::zero())?;
     let start = State::at_rest([T::one()]);
     let mut plain = DormandPrince853::new(settings::<T>(tol, false)?);
-    let (_, drift) = run1(&mut plain, &p, &start, 200.0)?;
+    let (_, drift) = run(&mut plain, &p, &start, 200.0)?;
     let mut held = DormandPrince853::new(settings::<T>(tol, true)?);
-    let (end, worst) = run1(&mut held, &p, &start, 200.0)?;
+    let (end, worst) = run(&mut held, &p, &start, 200.0)?;
     let evals = [
         plain.statistics().evaluations,
         held.statistics().evaluations,
@@ -116,32 +116,11 @@ fn pendulum_holds_its_energy_through_turning_points<T: Real>() -> Result<(), Err
     assert!(worst * 100.0 <= drift, "{worst:e} against {drift:e}");
     assert!(evals[1] as f64 <= 1.02 * evals[0] as f64, "{evals:?}");
     let mut nystrom = DormandPrinceNystrom86::new(settings::<T>(tol, true)?);
-    let (end, worst) = run1(&mut nystrom, &p, &start, 200.0)?;
+    let (end, worst) = run(&mut nystrom, &p, &start, 200.0)?;
     println!("pendulum, Nystrom 8(6): energy error {worst:.1e}");
     assert!(end.is_finite());
     assert!(worst <= HELD_EPSILONS * T::EPSILON.to_f64(), "{worst:e}");
     Ok(())
-}
-
-/// [`run`] for a mechanism of one coordinate.
-fn run1<T, M, const S: usize, const R: usize, P>(
-    rk: &mut EmbeddedRungeKutta<T, 1, S, R, P>,
-    m: &M,
-    start: &State<T, 1>,
-    t_end: f64,
-) -> Result<(State<T, 1>, f64), Error>
-where
-    T: Real,
-    M: Mechanism<T, 1>,
-    P: EmbeddedPair<S, R>,
-{
-    let e0 = m.energy(start).to_f64();
-    let mut worst = 0.0f64;
-    let stop = rk.integrate_until_event(m, start, T::from_f64(t_end), |s| {
-        worst = worst.max(((m.energy(s).to_f64() - e0) / e0).abs());
-        T::one()
-    })?;
-    Ok((*stop.state(), worst))
 }
 
 for_f32_and_f64!(
