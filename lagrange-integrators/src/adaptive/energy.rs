@@ -82,8 +82,8 @@ mod tests {
     }
 
     /// Scaled onto the energy to rounding where the speed changes by at most 1%; by 1%
-    /// towards it beyond (the exact factors 1/1.02, about 45,000 near rest, and none where the
-    /// potential energy alone is above the target); left alone at rest.
+    /// towards it beyond (the exact factors 1/1.02 and 1/0.98, about 45,000 near rest, and
+    /// none where the potential energy alone is above the target); left alone at rest.
     #[test]
     fn scales_onto_the_energy_or_by_the_limit_towards_it() -> Result<(), Error> {
         let p = pendulum(0.0)?;
@@ -96,6 +96,7 @@ mod tests {
         let lowered = p.energy(&State::at_rest([0.3])) - 1e-3;
         for (s, target, factor) in [
             (State::new(0.0, [0.0], [1.02]), e0, 0.99),
+            (State::new(0.0, [0.0], [0.98]), e0, 1.01),
             (State::new(0.0, [0.3], [1e-6]), raised, 1.01),
             (State::new(0.0, [0.3], [1e-6]), lowered, 0.99),
             (State::at_rest([0.3]), raised, 1.0),
