@@ -583,7 +583,7 @@ where
             // rejected.
             let err_sq = self.error_norm_sq(h, &y1);
             if err_sq <= T::one() {
-                self.stages.end = None;
+                // (A run that holds no energy never sets `stages.end`: nothing to clear here.)
                 if let Some(e0) = self.energy {
                     self.hold_energy(m, &mut y1, e0)?;
                 }
