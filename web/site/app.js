@@ -35,6 +35,11 @@ window.lagrange = state;
 
 function ex() { return state.wasm.exports; }
 
+// Until main() has instantiated the module and built the panels, nothing may read it: every
+// entry point (the test's probes, keys, pointers) answers NOT_READY or does nothing.
+function ready() { return state.ready === true; }
+const NOT_READY = JSON.stringify({ ready: false });
+
 function text(len = ex().lg_text_len()) {
   const bytes = new Uint8Array(ex().memory.buffer, ex().lg_text(), len);
   return new TextDecoder().decode(bytes);
@@ -208,7 +213,7 @@ function setCartInput() {
 }
 
 window.addEventListener('keydown', (e) => {
-  if (e.key !== 'ArrowLeft' && e.key !== 'ArrowRight') return;
+  if (!ready() || (e.key !== 'ArrowLeft' && e.key !== 'ArrowRight')) return;
   e.preventDefault();
   const key = e.key === 'ArrowLeft' ? 'left' : 'right';
   if (state.keys[key]) return;
@@ -216,7 +221,7 @@ window.addEventListener('keydown', (e) => {
   setCartInput();
 });
 window.addEventListener('keyup', (e) => {
-  if (e.key !== 'ArrowLeft' && e.key !== 'ArrowRight') return;
+  if (!ready() || (e.key !== 'ArrowLeft' && e.key !== 'ArrowRight')) return;
   state.keys[e.key === 'ArrowLeft' ? 'left' : 'right'] = false;
   setCartInput();
 });
@@ -431,6 +436,7 @@ function runScenario() {
 // Bad input, as a user would give it: a dt of 0, a dt of NaN, a throw at an absurd speed.
 // What the page showed for each, and whether every panel still steps and draws finite points.
 window.lagrangeBadInput = function badInput() {
+  if (!ready()) return NOT_READY;
   const before = state.shownErrors.length;
   const results = {
     dtZero: setDt(0, 0),
@@ -453,6 +459,7 @@ window.lagrangeBadInput = function badInput() {
 // Where point `k` of panel `p`'s main instance is on the screen (CSS pixels), for the test's
 // mouse.
 window.lagrangeScreenPoint = function screenPoint(p, k) {
+  if (!ready()) return NOT_READY;
   const ui = state.panels[p];
   const at = points(p).main[k];
   const t = transform(p);
@@ -463,18 +470,22 @@ window.lagrangeScreenPoint = function screenPoint(p, k) {
 
 // Chooses as a user would: `select` (an id, or panel p's integrator picker) set to `value`.
 window.lagrangeChoose = function choose(p, value) {
+  if (!ready()) return NOT_READY;
   const select = p < 0 ? document.getElementById('precision') : state.panels[p].method;
   select.value = String(value);
   select.dispatchEvent(new Event('change'));
   return 'ok';
 };
 
+// The page's state for the test. Statuses are read from the library, not from the last
+// frame's, so that a wake shows before the next frame is drawn.
 window.lagrangeProbe = function probe() {
+  if (!ready()) return NOT_READY;
   return JSON.stringify({
-    ready: state.ready === true,
+    ready: true,
     frames: state.frames,
     times: state.panels.map((_, p) => ex().lg_time(p)),
-    statuses: state.panels.map((ui) => ui.status),
+    statuses: state.panels.map((_, p) => ex().lg_status(p)),
     cartX: points(4).main[0]?.[0] ?? null,
     double: state.double,
     methods: state.panels.map((ui) => Number(ui.method.value)),
@@ -486,6 +497,7 @@ window.lagrangeProbe = function probe() {
 async function main() {
   const status = document.getElementById('status');
   const response = await fetch('lagrange_web.wasm');
+  if (!response.ok) throw new Error(`lagrange_web.wasm: ${response.status} ${response.statusText}`);
   const bytes = await response.arrayBuffer();
   const { instance } = await WebAssembly.instantiate(bytes, {});
   state.wasm = instance;

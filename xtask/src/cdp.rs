@@ -9,6 +9,15 @@ use std::process::{Child, ChildStdin, Command, Stdio};
 use std::sync::mpsc::{self, Receiver, RecvTimeoutError};
 use std::time::{Duration, Instant};
 
+/// What an expression evaluated in the page gave ([`Browser::evaluate`]).
+#[derive(Debug, Clone, PartialEq)]
+pub enum Evaluated {
+    /// Its value, a string.
+    Value(String),
+    /// The exception it threw, described.
+    Exception(String),
+}
+
 /// A JSON value.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Json {
@@ -281,8 +290,9 @@ pub struct Browser {
     pub console_errors: Vec<String>,
 }
 
-/// How long one command may take.
-const REPLY_TIMEOUT: Duration = Duration::from_secs(60);
+/// How long one command may take: a bound that turns a hung browser into a failure, not a
+/// claim about speed (a loaded machine starting Chromium for the first time is slow).
+const REPLY_TIMEOUT: Duration = Duration::from_secs(180);
 
 impl Browser {
     /// Starts `chromium` headless with its stderr to `log`, and opens a page attached to a
@@ -459,8 +469,10 @@ impl Browser {
         }
     }
 
-    /// Evaluates `expression` in the page: its value, which must be a string.
-    pub fn eval(&mut self, expression: &str) -> Result<String, String> {
+    /// Evaluates `expression` in the page: its value (which must be a string) or the
+    /// exception it threw; `Err` when the browser could not evaluate it at all (a page that
+    /// is being replaced, a closed pipe).
+    pub fn evaluate(&mut self, expression: &str) -> Result<Evaluated, String> {
         let result = self.call(
             "Runtime.evaluate",
             &format!(
@@ -476,14 +488,23 @@ impl Browser {
                 .str()
                 .or_else(|| details.get("text").str())
                 .unwrap_or("exception");
-            return Err(format!("{expression}: {text}"));
+            return Ok(Evaluated::Exception(text.to_string()));
         }
         result
             .get("result")
             .get("value")
             .str()
-            .map(str::to_string)
+            .map(|v| Evaluated::Value(v.to_string()))
             .ok_or_else(|| format!("{expression}: not a string"))
+    }
+
+    /// Evaluates `expression` in the page: its value, which must be a string; an exception
+    /// it threw is an `Err` naming it.
+    pub fn eval(&mut self, expression: &str) -> Result<String, String> {
+        match self.evaluate(expression)? {
+            Evaluated::Value(v) => Ok(v),
+            Evaluated::Exception(e) => Err(format!("{expression}: {e}")),
+        }
     }
 
     /// Reads events for `time` (so that console errors arriving meanwhile are noted).
