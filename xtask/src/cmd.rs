@@ -10,6 +10,39 @@ pub fn project_root() -> PathBuf {
         .map_or_else(|| PathBuf::from("."), Path::to_path_buf)
 }
 
+/// A child that is waited for with a limit ([`overdue`]) may take this many times the limit
+/// in wall time when its CPU time cannot be read or it is blocked.
+pub const WALL_FACTOR: u64 = 10;
+
+/// Whether the process `pid`, running for `wall`, has overrun `limit`: used `limit` of CPU
+/// time (user and system, from `/proc/PID/stat`), so that a loaded machine, which slows a
+/// child down in wall time, cannot make it overrun; or, where that cannot be read (not
+/// Linux) or the child waits without using the CPU, `WALL_FACTOR` times `limit` of wall
+/// time. A limit only turns a hang into a failure.
+pub fn overdue(pid: u32, wall: std::time::Duration, limit: std::time::Duration) -> bool {
+    if wall.as_secs_f64() > (WALL_FACTOR as f64) * limit.as_secs_f64() {
+        return true;
+    }
+    if wall <= limit {
+        return false;
+    }
+    let cpu = std::fs::read_to_string(format!("/proc/{pid}/stat"))
+        .ok()
+        .and_then(|stat| {
+            // Fields after the command name (in parentheses, which may hold spaces): utime
+            // and stime are the 12th and 13th, in clock ticks of 1/100 s.
+            let after = stat.get(stat.rfind(')')? + 1..)?.to_string();
+            let fields: Vec<f64> = after
+                .split_whitespace()
+                .skip(11)
+                .take(2)
+                .filter_map(|f| f.parse().ok())
+                .collect();
+            (fields.len() == 2).then(|| (fields[0] + fields[1]) / 100.0)
+        });
+    cpu.is_none_or(|cpu| cpu > limit.as_secs_f64())
+}
+
 /// The cargo that runs this xtask.
 pub fn cargo() -> Command {
     let mut c = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()));

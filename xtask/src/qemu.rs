@@ -60,8 +60,9 @@ const DEFMT_PRINT: &str = "defmt-print";
 /// The decoder's pinned version (it decodes defmt 1.x's wire format).
 const DEFMT_PRINT_VERSION: &str = "1.2.0";
 
-/// Longest a QEMU run or a decode may take. The lockstep image runs in under a second of host
-/// time here; the limit only turns a hang (a fault loop, a lost exit) into a failure.
+/// CPU time a QEMU run or a decode may use ([`cmd::overdue`]). The lockstep image runs in
+/// under a second of host time here; the limit only turns a hang (a fault loop, a lost exit)
+/// into a failure, and counts CPU time so that a busy machine cannot trip it.
 const RUN_TIMEOUT: Duration = Duration::from_secs(120);
 
 /// The budget: instructions per step of the `f32` RK4 pendulum on the M4F.
@@ -316,17 +317,20 @@ fn run_captured(command: &mut Command, input: Vec<u8>) -> Result<(ExitStatus, Ve
         let _ = stdout.read_to_end(&mut out);
         out
     });
-    let deadline = Instant::now() + RUN_TIMEOUT;
+    let started = Instant::now();
     let status = loop {
         match child.try_wait() {
             Ok(Some(status)) => break status,
-            Ok(None) if Instant::now() < deadline => std::thread::sleep(Duration::from_millis(20)),
+            Ok(None) if !cmd::overdue(child.id(), started.elapsed(), RUN_TIMEOUT) => {
+                std::thread::sleep(Duration::from_millis(20));
+            }
             Ok(None) => {
                 let _ = child.kill();
                 let _ = child.wait();
                 return Err(format!(
-                    "timed out after {} s and killed: {shown}",
-                    RUN_TIMEOUT.as_secs()
+                    "used {} s of CPU time (or {} s of wall time) and was killed: {shown}",
+                    RUN_TIMEOUT.as_secs(),
+                    cmd::WALL_FACTOR * RUN_TIMEOUT.as_secs()
                 ));
             }
             Err(e) => return Err(format!("lost ({e}): {shown}")),

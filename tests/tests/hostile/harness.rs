@@ -324,7 +324,56 @@ struct Shared {
     current: Mutex<(usize, u64)>,
     /// When the call in flight started, in ns since the run started (0 when idle).
     started: AtomicU64,
+    /// The worker thread's entry under `/proc/self/task` (Linux), for its CPU time.
+    task: Mutex<Option<String>>,
     done: AtomicBool,
+}
+
+/// CPU time the thread `task` (a `/proc/self/task` entry) has used, s: its user and system
+/// clock ticks (`utime`, `stime`, fields 14 and 15 of its `stat`), at the 100 ticks a second
+/// Linux reports them in. `None` where there is no such file (not Linux).
+fn cpu_seconds(task: &str) -> Option<f64> {
+    let stat = std::fs::read_to_string(format!("/proc/self/task/{task}/stat")).ok()?;
+    // The command name (field 2) is in parentheses and may hold spaces: count after it.
+    let after = &stat[stat.rfind(')')? + 1..];
+    let fields: Vec<&str> = after.split_whitespace().collect();
+    let ticks = |i: usize| fields.get(i)?.parse::<f64>().ok();
+    Some((ticks(11)? + ticks(12)?) / 100.0)
+}
+
+/// A call is a hang when it has run for the deadline and then used the deadline again in CPU
+/// time. The second half makes the verdict independent of the machine's load: a call that a
+/// busy machine (or the campaign's other families, one thread each) starves of the CPU runs
+/// longer in wall time but not in CPU time, while a loop that never ends uses all it gets.
+/// Without `/proc` (not Linux) the wall time alone decides.
+struct HangWatch {
+    /// The call watched and the worker's CPU time when its wall time passed the deadline.
+    over: Option<((usize, u64), f64)>,
+}
+
+impl HangWatch {
+    /// Whether call `current`, running for `wall`, hangs.
+    fn hangs(
+        &mut self,
+        current: (usize, u64),
+        wall: Duration,
+        deadline: Duration,
+        task: Option<&str>,
+    ) -> bool {
+        if wall <= deadline {
+            return false;
+        }
+        let Some(cpu) = task.and_then(cpu_seconds) else {
+            return true;
+        };
+        match self.over {
+            Some((call, from)) if call == current => cpu - from > deadline.as_secs_f64(),
+            _ => {
+                self.over = Some((current, cpu));
+                false
+            }
+        }
+    }
 }
 
 thread_local! {
@@ -475,6 +524,7 @@ fn run_family(family: Arc<Family>, share: &[u64], base: u64, cfg: &Config) -> Fa
         findings: Mutex::new(Vec::new()),
         current: Mutex::new((0, 0)),
         started: AtomicU64::new(0),
+        task: Mutex::new(None),
         done: AtomicBool::new(false),
     });
     let epoch = Instant::now();
@@ -486,6 +536,7 @@ fn run_family(family: Arc<Family>, share: &[u64], base: u64, cfg: &Config) -> Fa
             .spawn(move || work(&family, &shared, &share, base, seed, keep, epoch))
     };
     let mut hung = false;
+    let mut watch = HangWatch { over: None };
     loop {
         std::thread::sleep(Duration::from_millis(2));
         if shared.done.load(Ordering::Acquire) {
@@ -493,10 +544,15 @@ fn run_family(family: Arc<Family>, share: &[u64], base: u64, cfg: &Config) -> Fa
         }
         let started = shared.started.load(Ordering::Acquire);
         let now = epoch.elapsed().as_nanos() as u64;
-        if started != 0 && now.saturating_sub(started) > cfg.deadline.as_nanos() as u64 {
+        let wall = Duration::from_nanos(now.saturating_sub(started));
+        if started == 0 || wall <= cfg.deadline {
+            continue;
+        }
+        let (ei, index) = shared.current.lock().map(|c| *c).unwrap_or((0, 0));
+        let task = shared.task.lock().ok().and_then(|t| t.clone());
+        if watch.hangs((ei, index), wall, cfg.deadline, task.as_deref()) {
             // A hang: count it, record its reproducer, and give up on this family (the
             // worker cannot be stopped; it is left behind).
-            let (ei, index) = shared.current.lock().map(|c| *c).unwrap_or((0, 0));
             hung = true;
             if let Some(entry) = family.entries.get(ei) {
                 let repro = reproducer(
@@ -556,6 +612,12 @@ fn work(
     keep: usize,
     epoch: Instant,
 ) {
+    // This thread's entry under /proc/self/task, "PID/task/TID" read from /proc/thread-self.
+    if let Ok(mut task) = shared.task.lock() {
+        *task = std::fs::read_link("/proc/thread-self")
+            .ok()
+            .and_then(|p| Some(p.file_name()?.to_string_lossy().into_owned()));
+    }
     for (ei, entry) in family.entries.iter().enumerate() {
         let entry_id = base + ei as u64;
         let mut kept = [0usize; 8];
