@@ -362,11 +362,51 @@ fn adaptive_overflow_is_rejected<T: Real>() -> Result<(), Error> {
     overflow_is_rejected::<17, 2, lagrange_integrators::Verner98Pair, T>()
 }
 
+/// An end equal to the start: `next_step` promises one accepted step and a dense interval,
+/// so it refuses it (it returned the state untouched with no dense interval); a run to it
+/// (`integrate_to`) is empty and returns the state. Both from a fresh pair and from the end
+/// of a run.
+fn end_at_start<const S: usize, const R: usize, P: EmbeddedPair<S, R>, T: Real>(
+) -> Result<(), Error> {
+    let p = SimplePendulum::new(T::one(), T::one(), T::from_f64(G), T::zero())?;
+    let settings = AdaptiveSettings::new(T::from_f64(1e-4), T::from_f64(1e-6))?;
+    let mut rk = EmbeddedRungeKutta::<T, 1, S, R, P>::new(settings);
+    let start = State::new(T::one(), [T::HALF], [T::zero()]);
+    let end = rk.integrate_to(&p, &start, T::from_f64(1.25))?;
+    for s in [start, end] {
+        let refused = rk.next_step(&p, &s, s.t);
+        assert!(
+            matches!(refused, Err(Error::InvalidParameter { name: "t_end", .. })),
+            "{}: {refused:?}",
+            P::NAME
+        );
+        let mut fresh = EmbeddedRungeKutta::<T, 1, S, R, P>::new(settings);
+        assert!(fresh.next_step(&p, &s, s.t).is_err());
+        assert_eq!(fresh.dense_interval(), None);
+        assert_eq!(rk.integrate_to(&p, &s, s.t).map_err(|f| f.error)?, s);
+    }
+    // A step to an end after the start is taken, and leaves its dense interval.
+    let next = rk.next_step(&p, &end, T::from_f64(2.0))?;
+    assert!(next.t > end.t && rk.dense_interval().is_some());
+    Ok(())
+}
+
+fn every_pair_refuses_a_step_to_its_start<T: Real>() -> Result<(), Error> {
+    end_at_start::<7, 1, lagrange_integrators::Dopri5Pair, T>()?;
+    end_at_start::<16, 4, lagrange_integrators::Dop853Pair, T>()?;
+    end_at_start::<6, 2, lagrange_integrators::Nystrom64Pair, T>()?;
+    end_at_start::<9, 2, lagrange_integrators::Nystrom86Pair, T>()?;
+    end_at_start::<18, 2, lagrange_integrators::Nystrom1210Pair, T>()?;
+    end_at_start::<11, 2, lagrange_integrators::Verner76Pair, T>()?;
+    end_at_start::<17, 2, lagrange_integrators::Verner98Pair, T>()
+}
+
 for_f32_and_f64!(
     adaptive_in_both_precisions,
     impossible_runs_are_errors,
     bad_settings_and_calls_are_refused,
-    adaptive_overflow_is_rejected
+    adaptive_overflow_is_rejected,
+    every_pair_refuses_a_step_to_its_start
 );
 
 /// An input changed between calls: after `restart` the next call starts afresh from the

@@ -719,7 +719,7 @@ where
         state: &State<T, N>,
         t_end: T,
     ) -> Result<State<T, N>, Error> {
-        let t_end = check_end(state, t_end)?;
+        let t_end = check_end_after(state, t_end)?;
         self.call(|rk| rk.next_step_from(mechanism, state, t_end))
     }
 
@@ -769,7 +769,9 @@ where
     }
 
     /// Steps from `state` until the time is `t_end` exactly (the last step is shortened to
-    /// land on it); returns the state there.
+    /// land on it); returns the state there. An end equal to `state.t` takes no step and
+    /// returns `state` (a run of length zero; [`EmbeddedRungeKutta::next_step`], which
+    /// promises a step, refuses it).
     ///
     /// # Errors
     /// [`Error::InvalidParameter`] `t_end` before `state.t` or not finite;
@@ -820,7 +822,19 @@ where
     }
 }
 
-/// `t_end` when it is finite and not before `state.t`.
+/// `t_end` when it is finite and after `state.t`: the end of one step, which must move.
+fn check_end_after<T: Real, const N: usize>(state: &State<T, N>, t_end: T) -> Result<T, Error> {
+    if t_end.is_finite() && t_end > state.t {
+        Ok(t_end)
+    } else {
+        Err(Error::InvalidParameter {
+            name: "t_end",
+            reason: "must be finite and after the state's time",
+        })
+    }
+}
+
+/// `t_end` when it is finite and not before `state.t`: the end of a run, which may be empty.
 pub(super) fn check_end<T: Real, const N: usize>(
     state: &State<T, N>,
     t_end: T,

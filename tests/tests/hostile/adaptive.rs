@@ -195,7 +195,25 @@ where
                 let t_end = end(ctx, from.t);
                 say!(ctx, "let last = rk.next_step(&m, &s, {})?;", lit(t_end));
                 let r = rk.next_step(m, &from, t_end);
-                (verdict(&r, &with(&["state", "t_end"])), r.ok())
+                let v = verdict(&r, &with(&["state", "t_end"]));
+                // One accepted step: the time moves, and the returned state lies in the dense
+                // interval it leaves.
+                let stepped = |s: &State<T, N>| {
+                    s.t > from.t
+                        && rk
+                            .dense_interval()
+                            .is_some_and(|(a, b)| a <= s.t && s.t <= b)
+                };
+                match &r {
+                    Ok(s) if v == Verdict::Ok && !stepped(s) => {
+                        let dense = rk.dense_interval();
+                        return Verdict::Broken(format!(
+                            "next_step from t = {:?} to {t_end:?} returned t = {:?} with dense interval {dense:?}",
+                            from.t, s.t
+                        ));
+                    }
+                    _ => (v, r.ok()),
+                }
             }
             2 => {
                 let dt = ctx.value::<T>(Kind::Step);

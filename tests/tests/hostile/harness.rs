@@ -30,6 +30,9 @@ pub enum Verdict {
     Changed(String),
     /// Two ways to ask the same thing disagreed (a step and a one-step run).
     Inconsistent(String),
+    /// `Ok` with a result that breaks what the docs promise of it (a contact ended below the
+    /// floor, an impact gained energy, a step that took no step).
+    Broken(String),
 }
 
 /// The classes of [`Verdict`], for counting.
@@ -43,10 +46,11 @@ pub enum Class {
     Wrong,
     Changed,
     Inconsistent,
+    Broken,
 }
 
 /// Every class, in the columns' order.
-pub const CLASSES: [Class; 8] = [
+pub const CLASSES: [Class; 9] = [
     Class::Ok,
     Class::Error,
     Class::Panic,
@@ -55,6 +59,7 @@ pub const CLASSES: [Class; 8] = [
     Class::Wrong,
     Class::Changed,
     Class::Inconsistent,
+    Class::Broken,
 ];
 
 impl Class {
@@ -69,6 +74,7 @@ impl Class {
             Self::Wrong => "wrong",
             Self::Changed => "changed",
             Self::Inconsistent => "incons.",
+            Self::Broken => "broken",
         }
     }
 
@@ -90,6 +96,7 @@ impl Verdict {
             Self::WrongName(_) => Class::Wrong,
             Self::Changed(_) => Class::Changed,
             Self::Inconsistent(_) => Class::Inconsistent,
+            Self::Broken(_) => Class::Broken,
         }
     }
 }
@@ -275,7 +282,7 @@ pub struct Config {
 /// Counts per class of one entry point, and its slowest call.
 #[derive(Debug, Clone, Default)]
 pub struct Counts {
-    pub by_class: [u64; 8],
+    pub by_class: [u64; 9],
     /// The longest a call took, and which.
     pub slowest: (Duration, u64),
 }
@@ -620,7 +627,7 @@ fn work(
     }
     for (ei, entry) in family.entries.iter().enumerate() {
         let entry_id = base + ei as u64;
-        let mut kept = [0usize; 8];
+        let mut kept = [0usize; 9];
         let mut local = Counts::default();
         for index in 0..share[ei] {
             if let Ok(mut c) = shared.current.lock() {
@@ -725,9 +732,10 @@ pub fn report(reports: &[FamilyReport], cfg: &Config) -> Counts {
     }
     println!();
     println!(
-        "{} state changed on error, {} inconsistent",
+        "{} state changed on error, {} inconsistent, {} broken promises",
         all.get(Class::Changed),
-        all.get(Class::Inconsistent)
+        all.get(Class::Inconsistent),
+        all.get(Class::Broken)
     );
     println!(
         "{} calls, {} panics, {} hangs, {} silent non-finite, {} wrong parameter",
