@@ -2,9 +2,7 @@
 //! at the contact time, resting contacts held as constraints (the laws of
 //! [`lagrange_core::constraints::contact`]).
 
-use lagrange_core::constraints::contact::{
-    drop_dependent_contacts, ActiveRows, ContactModel, Contacts, Impact, Impacts,
-};
+use lagrange_core::constraints::contact::{ActiveRows, ContactModel, Contacts, Impact, Impacts};
 
 use crate::integrator::{check_run_step, check_step, continues, step_loop};
 use crate::{Cost, Failure, Integrator, Method, Work};
@@ -23,22 +21,29 @@ use lagrange_core::{Error, Mechanism, Real, State};
 ///    stretch, until the bracket is shorter than time_tolerance; advance to its early end
 ///    (the contact is then open by at most |w| time_tolerance: no penetration)
 /// 4. impact there (velocity jump, see ContactModel and Impact), back to 1
-/// 5. project onto the bilateral and resting rows (Projection); release the resting contacts
-///    whose multiplier would pull
+/// 5. project onto the contacts' feasible positions (Projection::project_contacts: the
+///    bilateral and resting rows onto zero, every other contact kept at or above zero) and
+///    the velocities onto the rows held; release the resting contacts that would pull
 /// ```
 ///
 /// Between events the inner integrator's order holds; each event costs about
 /// `log2(dt / time_tolerance)` re-steps. A contact that opens and closes again within one step
 /// without being open at its end is not seen (choose `dt` so that a bounce lasts several
-/// steps). Depth: a free contact never ends a step deeper than it started it or below zero, a
-/// resting one is projected to within the projection's tolerance. At most `4 C + 8` events per
-/// step: beyond that the step fails with [`Error::NoConvergence`] rather than loop, which
-/// with resting contacts (no Zeno) does not happen.
+/// steps). Depth: no contact ends a step deeper than it started it and below the projection's
+/// tolerance (`g >= min(g_start, -tolerance)` for every contact, every step); a resting one
+/// ends within the tolerance of zero. At most `4 C + 8` events per step: beyond that the step
+/// fails with [`Error::NoConvergence`] rather than loop, which with resting contacts (no Zeno)
+/// does not happen in `f64`; in `f32` a ragdoll's many resting contacts can reach it as it
+/// lands (single precision cannot tell their rounding from motion): use `f64` here, or the
+/// time-stepping stepper.
 ///
-/// Contacts that depend on the other rows in force (several rows for one contact, more resting
-/// contacts than degrees of freedom) are left out of each solve: the others already hold the
-/// motion, and the force distribution among them is not determined. Dependent bilateral rows
-/// are an error ([`Error::RedundantConstraints`]).
+/// The resting contacts' forces are their complementarity problem solved exactly: each
+/// pushes and holds, or lets go as the motion lifts it and is held again if it would close.
+/// Contacts that depend on the others in force (several rows for one contact, more resting
+/// contacts than degrees of freedom) are left out of a solve while those hold the motion (the
+/// force distribution among them is not determined), and rejoin when one lets go. Dependent
+/// bilateral rows are an error ([`Error::RedundantConstraints`]). Impacts never add kinetic
+/// energy (Poisson's law; see [`Impacts::impact`]).
 ///
 /// A start state must satisfy the bilateral rows to within the projection's tolerance and
 /// have every gap above `-tolerance`; the first step from any state other than this stepper's
@@ -245,19 +250,6 @@ where
             let (lo, at, struck) = self.locate(mechanism, &s, &start_gaps, remaining, crossed)?;
             let impacts = Impacts::new(&self.contacts, &self.model, self.bilateral);
             let (after, impact) = impacts.impact(mechanism, &at, struck, &mut self.resting)?;
-            // Resting contacts that depend on the others (more of them than degrees of
-            // freedom) are left free: the others hold the motion.
-            let mut held = self.held();
-            drop_dependent_contacts(
-                mechanism,
-                &self.contacts,
-                &after,
-                &mut held,
-                &self.bilateral,
-            )?;
-            for (r, h) in self.resting.iter_mut().zip(held) {
-                *r = *r && h;
-            }
             observe(&impact);
             self.impacts += 1;
             events += 1;
@@ -269,11 +261,18 @@ where
             s = after;
             remaining -= lo;
         }
+        // Every step ends on the contacts' feasible positions: the held rows drift with the
+        // integrator's error, and a contact the last event released may have drifted below
+        // zero while it was held.
         let held = self.held();
+        s = self.projection.project_contacts(
+            mechanism,
+            &self.contacts,
+            &s,
+            &self.bilateral,
+            &held,
+        )?;
         if held.iter().any(|&h| h) {
-            s = self
-                .projection
-                .project_rows(mechanism, &self.contacts, &s, &held)?;
             let rows = active(
                 mechanism,
                 &self.contacts,

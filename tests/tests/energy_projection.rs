@@ -197,7 +197,11 @@ fn the_dense_output_ends_on_the_projected_state() -> Result<(), Error> {
     for (held, worst) in [true, false].into_iter().zip(&mut worst) {
         let mut rk = DormandPrince853::new(settings::<f64>(1e-4, held)?);
         let mut s = kepler_periapsis::<f64>();
+        // Until the end (a step to an end the run has reached is refused).
         for _ in 0..200 {
+            if s.t >= 100.0 {
+                break;
+            }
             let next = rk.next_step(&kepler, &s, 100.0)?;
             if held {
                 let (t0, t1) = rk.dense_interval().ok_or(UNEXPECTED)?;

@@ -24,7 +24,6 @@ mod schur;
 mod set;
 
 pub use automatic::{Holonomic, HolonomicConstraints, Pfaffian, PfaffianConstraints};
-pub(crate) use constrained::constrained_acceleration;
 pub use constrained::{Constrained, ConstrainedAcceleration, Held, Stabilization};
 pub use projection::Projection;
 pub(crate) use schur::Schur;

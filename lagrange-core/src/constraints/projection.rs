@@ -1,5 +1,6 @@
 //! [`Projection`]: a state moved back onto `phi = 0` and `J q' = 0`, mass-weighted.
 
+use super::contact::lcp::{Delassus, Row};
 use super::{max_abs, Constraints, Schur};
 use crate::{validate, Error, Mechanism, Real, State};
 use nalgebra::SVector;
@@ -122,6 +123,98 @@ impl<T: Real> Projection<T> {
             s.q -= schur.correction(&phi);
             iterations += 1;
         }
+    }
+}
+
+impl<T: Real> Projection<T> {
+    /// `state` projected onto a contact set's feasible positions, mass-weighted: the `held`
+    /// rows (bilateral rows and resting contacts) onto `phi = 0`, every other contact onto
+    /// `g >= 0`, each Newton iteration a complementarity problem (a free contact that is
+    /// open stays free unless the correction would close it; one that is closed or pushed
+    /// shut is held at zero), until the held rows are within the tolerance of zero and no
+    /// contact is below `-tolerance`; then the velocities onto `J q' = 0` over the held rows.
+    /// Resting contacts that depend on the others (more of them than degrees of freedom) are
+    /// left out of both solves: held with the others, they follow.
+    ///
+    /// Unlike [`Projection::project_rows`] over the rows held, this never moves a free
+    /// contact below zero: the correction of the held rows is found with every contact's
+    /// inequality in force.
+    ///
+    /// # Errors
+    /// As [`Projection::project_rows`].
+    pub fn project_contacts<M, K, const N: usize, const C: usize>(
+        &self,
+        mechanism: &M,
+        contacts: &K,
+        state: &State<T, N>,
+        bilateral: &[bool; C],
+        held: &[bool; C],
+    ) -> Result<State<T, N>, Error>
+    where
+        M: Mechanism<T, N>,
+        K: Constraints<T, N, C>,
+    {
+        let mut s = *state;
+        let mut iterations = 0;
+        // Resting contacts are pulled back to zero from above too, unless they conflict:
+        // more of them than the motion has freedoms, one left out as dependent on the others
+        // and below zero. From then on each contact is only kept above zero.
+        let mut two_sided = true;
+        let mut dependent = [false; C];
+        loop {
+            let g = contacts.position_residual(&s.q);
+            two_sided &= !(0..C).any(|i| dependent[i] && g[i] < -self.tolerance);
+            let mut worst = T::zero();
+            for i in 0..C {
+                let off = if bilateral[i] || (held[i] && two_sided && !dependent[i]) {
+                    g[i].abs()
+                } else {
+                    -g[i]
+                };
+                if !off.is_finite() {
+                    return Err(Error::NonFiniteState);
+                }
+                worst = worst.max(off);
+            }
+            if worst <= self.tolerance {
+                break;
+            }
+            if iterations == self.max_iterations {
+                return Err(Error::NoConvergence { iterations });
+            }
+            let rows = Delassus::new(
+                contacts.jacobian(&s.q),
+                |b| mechanism.solve_mass(&s, b),
+                &[true; C],
+            )?;
+            let kinds: [Row; C] = core::array::from_fn(|i| match (bilateral[i], held[i]) {
+                (true, _) => Row::Bilateral,
+                (false, true) if two_sided => Row::Held,
+                _ => Row::Unilateral,
+            });
+            let solved = rows.complementary(&g, &kinds)?;
+            dependent = core::array::from_fn(|i| kinds[i] == Row::Held && !solved.active[i]);
+            s.q += rows.response(&solved.lambda);
+            iterations += 1;
+        }
+        if !held.iter().any(|&h| h) {
+            return s.check_finite().map(|()| s);
+        }
+        let mut independent = *held;
+        let unilateral: [bool; C] = core::array::from_fn(|i| !bilateral[i]);
+        let schur = loop {
+            match Schur::new(mechanism, contacts, &s, &independent) {
+                Err(Error::RedundantConstraints { row })
+                    if unilateral.get(row).copied().unwrap_or(false) && independent[row] =>
+                {
+                    independent[row] = false;
+                }
+                other => break other?,
+            }
+        };
+        let w = schur.jacobian() * s.qd;
+        s.qd -= schur.correction(&w);
+        s.check_finite().map(|()| s)
     }
 }
 

@@ -103,23 +103,7 @@ impl<T: Real, const N: usize, const C: usize> Schur<T, N, C> {
     /// ignored): the multipliers or impulses that change `J q` (or `J q'`) by `r`.
     #[must_use]
     pub(crate) fn multipliers(&self, r: &SVector<T, C>) -> SVector<T, C> {
-        let mut x = SVector::<T, C>::from_fn(|i, _| if self.active[i] { r[i] } else { T::zero() });
-        let l = &self.factor;
-        for i in 0..C {
-            let mut s = x[i];
-            for k in 0..i {
-                s -= l[(i, k)] * x[k];
-            }
-            x[i] = s / l[(i, i)];
-        }
-        for i in (0..C).rev() {
-            let mut s = x[i];
-            for k in i + 1..C {
-                s -= l[(k, i)] * x[k];
-            }
-            x[i] = s / l[(i, i)];
-        }
-        x
+        cholesky_solve(&self.factor, &self.active, r)
     }
 
     /// `M^-1 J^T lambda`: the change of `q''` (or `q'`, or `q`) that the generalized force
@@ -137,9 +121,36 @@ impl<T: Real, const N: usize, const C: usize> Schur<T, N, C> {
     }
 }
 
+/// `S^-1 r` on the `active` rows of a factor `l` from [`cholesky`] (identity on the inactive
+/// rows, whose entries of `r` are ignored), zero on the inactive ones.
+pub(crate) fn cholesky_solve<T: Real, const C: usize>(
+    l: &SMatrix<T, C, C>,
+    active: &[bool; C],
+    r: &SVector<T, C>,
+) -> SVector<T, C> {
+    let mut x = SVector::<T, C>::from_fn(|i, _| if active[i] { r[i] } else { T::zero() });
+    for i in 0..C {
+        let mut s = x[i];
+        for k in 0..i {
+            s -= l[(i, k)] * x[k];
+        }
+        x[i] = s / l[(i, i)];
+    }
+    for i in (0..C).rev() {
+        let mut s = x[i];
+        for k in i + 1..C {
+            s -= l[(k, i)] * x[k];
+        }
+        x[i] = s / l[(i, i)];
+    }
+    x
+}
+
 /// The lower Cholesky factor of the symmetric `s`, refusing a pivot below `sqrt(EPSILON)` of
 /// its diagonal entry.
-fn cholesky<T: Real, const C: usize>(s: &SMatrix<T, C, C>) -> Result<SMatrix<T, C, C>, Error> {
+pub(crate) fn cholesky<T: Real, const C: usize>(
+    s: &SMatrix<T, C, C>,
+) -> Result<SMatrix<T, C, C>, Error> {
     let threshold = T::EPSILON.sqrt();
     let mut l = SMatrix::<T, C, C>::zeros();
     for j in 0..C {

@@ -158,6 +158,14 @@ impl Ctx {
         core::array::from_fn(|_| self.value(kind))
     }
 
+    /// A value of `T` uniform in `[lo, hi)`: ordinary input, drawn to reach states (a body
+    /// in flight, a pose within its limits) rather than to be hostile.
+    pub fn uniform<T: Real>(&mut self, lo: f64, hi: f64) -> T {
+        let drawn = lo + (hi - lo) * self.rng.unit();
+        let single = T::EPSILON.to_f64() > 1e-10;
+        T::from_f64(self.slot(drawn, Slot::Float(single)))
+    }
+
     /// A count.
     pub fn count(&mut self) -> u64 {
         let drawn = values::count(&mut self.rng) as f64;

@@ -2,8 +2,9 @@
 //! rows and resting contacts), which is what a contact stepper's integrator steps between
 //! events; and [`drop_dependent_contacts`], which keeps the rows in force independent.
 
+use super::lcp::{Delassus, Row};
 use super::{ContactModel, Contacts};
-use crate::constraints::{constrained_acceleration, ConstrainedAcceleration, Schur, Stabilization};
+use crate::constraints::{ConstrainedAcceleration, Schur};
 use crate::mechanism::{finite, finite_jacobian};
 use crate::nalgebra::{SMatrix, SVector};
 use crate::{
@@ -13,9 +14,9 @@ use crate::{
 /// A mechanism held by the rows of its contact set that are in force (bilateral rows and
 /// resting contacts): the law that a contact stepper's integrator steps between events.
 ///
-/// Inside every solve, a unilateral row whose multiplier comes out negative (its contact
-/// would pull) is dropped and the rest solved again, so a resting contact lets go as soon as
-/// the motion lifts it. With friction, a resting contact slides against a Coulomb force
+/// Every solve is the contacts' complementarity problem, solved exactly: a resting contact
+/// either pushes and holds, or lets go as soon as the motion lifts it (it would pull), and
+/// one that let go is held again when it would close. With friction, a resting contact slides against a Coulomb force
 /// `-mu lambda_n sat(u / slip_speed)` along its tangent (`u` the sliding speed): the normal
 /// force from the frictionless solve, then one more solve with the friction forces applied
 /// (exact when tangent and normal are decoupled in the mass metric, as for a point on flat
@@ -64,7 +65,10 @@ impl<'a, T: Real, const C: usize, M, K> ActiveRows<'a, T, C, M, K> {
     }
 
     /// Accelerations and multipliers at `state` with `extra` force, and the rows still in
-    /// force after the pulling ones were dropped.
+    /// force: the contacts' complementarity problem solved exactly ([`Delassus::complementary`]:
+    /// every resting contact either pushes and holds, or lets go and opens; none pulls and
+    /// none is left to close), then, with friction, solved once more with the Coulomb forces
+    /// of the first solution's normal forces applied.
     fn solve<F: GeneralizedForce<T, N>, const N: usize>(
         &self,
         state: &State<T, N>,
@@ -74,66 +78,41 @@ impl<'a, T: Real, const C: usize, M, K> ActiveRows<'a, T, C, M, K> {
         M: Mechanism<T, N>,
         K: Contacts<T, N, C>,
     {
-        let mut active = self.active;
-        // Each pass either returns or drops at least one active row, so at most C + 1 passes.
-        loop {
-            let mut solved = match self.solve_rows(state, extra, &active) {
-                Err(Error::RedundantConstraints { row })
-                    if redundant_contact(row, &active, &self.unilateral) =>
-                {
-                    active[row] = false;
-                    continue;
-                }
-                other => other?,
-            };
-            if self.friction > T::zero() {
-                if let Some(tangents) = self.contacts.tangent_jacobian(&state.q) {
-                    let friction = Input {
-                        value: self.sliding_friction(
-                            state,
-                            &tangents,
-                            &solved.multipliers,
-                            &active,
-                        ),
-                    };
-                    solved = self.solve_rows(state, &(Borrowed(extra), friction), &active)?;
-                }
+        let rows = Delassus::new(
+            self.contacts.jacobian(&state.q),
+            |b| self.mechanism.solve_mass(state, b),
+            &self.active,
+        )?;
+        let kinds: [Row; C] = core::array::from_fn(|i| {
+            if self.unilateral[i] {
+                Row::Unilateral
+            } else {
+                Row::Bilateral
             }
-            // The row that pulls hardest lets go, alone, and the rest is solved again: rows
-            // that pulled only because of it stay (dropping every pulling row at once lets
-            // many resting contacts, a ragdoll's, go and strike again at once).
-            let mut pulling: Option<(usize, T)> = None;
-            for (i, on) in active.iter().enumerate() {
-                let pulls = *on && self.unilateral[i] && solved.multipliers[i] < T::zero();
-                if pulls && pulling.is_none_or(|(_, m)| solved.multipliers[i] < m) {
-                    pulling = Some((i, solved.multipliers[i]));
-                }
-            }
-            match pulling {
-                Some((i, _)) => active[i] = false,
-                None => return Ok((solved, active)),
+        });
+        let velocity_product = self.contacts.velocity_product(&state.q, &state.qd);
+        let held = |free: SVector<T, N>| -> Result<_, Error> {
+            let b = rows.jacobian() * free + velocity_product;
+            let solved = rows.complementary(&b, &kinds)?;
+            let acceleration = free + rows.response(&solved.lambda);
+            Ok((
+                ConstrainedAcceleration {
+                    acceleration: finite(acceleration)?,
+                    multipliers: solved.lambda,
+                },
+                solved.active,
+            ))
+        };
+        let (solved, active) = held(self.mechanism.law(state, extra)?)?;
+        if self.friction > T::zero() {
+            if let Some(tangents) = self.contacts.tangent_jacobian(&state.q) {
+                let friction = Input {
+                    value: self.sliding_friction(state, &tangents, &solved.multipliers, &active),
+                };
+                return held(self.mechanism.law(state, &(Borrowed(extra), friction))?);
             }
         }
-    }
-
-    fn solve_rows<F: GeneralizedForce<T, N>, const N: usize>(
-        &self,
-        state: &State<T, N>,
-        extra: &F,
-        active: &[bool; C],
-    ) -> Result<ConstrainedAcceleration<T, N, C>, Error>
-    where
-        M: Mechanism<T, N>,
-        K: Contacts<T, N, C>,
-    {
-        constrained_acceleration(
-            self.mechanism,
-            self.contacts,
-            &Stabilization::None,
-            state,
-            extra,
-            active,
-        )
+        Ok((solved, active))
     }
 
     /// The generalized Coulomb force of the active, pushing contacts.

@@ -1,11 +1,11 @@
 //! Impacts: the jump of the generalized velocities by mass-weighted impulses, and the
 //! [`Impact`] record an observer receives.
 
-use super::active_rows::independent;
+use super::lcp::{Delassus, Row};
 use super::{ContactModel, Contacts};
 use crate::constraints::Schur;
 use crate::nalgebra::SVector;
-use crate::{Error, Mechanism, Real, State};
+use crate::{Error, Lagrangian, Mechanism, Real, State};
 
 /// One impact: the state just before and just after the velocity jump.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -49,13 +49,6 @@ impl<T: Real, const N: usize, const C: usize> Impact<T, N, C> {
     }
 }
 
-/// The outcome of one impulse: new velocities, the impulses, the rows that took part.
-struct Jump<T: Real, const N: usize, const C: usize> {
-    velocity: SVector<T, N>,
-    impulses: SVector<T, C>,
-    kept: [bool; C],
-}
-
 /// The impact law of a contact set: what an impact acts on, the rows' roles and the model.
 #[derive(Debug, Clone, Copy)]
 pub struct Impacts<'a, T, const C: usize, K> {
@@ -79,34 +72,42 @@ impl<'a, T: Real, const C: usize, K> Impacts<'a, T, C, K> {
     /// `resting` (updated: contacts that come to rest join, contacts the impact lifts leave).
     ///
     /// ```text
-    /// w = J q'-, S_A = J M^-1 J^T over the rows A = bilateral + resting + approaching struck
+    /// w = J q'-, W = J M^-1 J^T over the rows A0 = bilateral + resting + approaching struck
+    /// compression: the plastic impulses p_c >= 0 with w_c = w + W p_c >= 0, p_c w_c = 0
+    ///              (zero on the bilateral rows: exact complementarity, Delassus::complementary)
     /// e_event = e when some approaching struck row would rebound at e |w_i| >= rest_speed,
     ///           else 0 (a plastic impact: those contacts come to rest)
-    /// w+ = -e_event w on the struck rows, 0 on the held ones;  p = S_A^-1 (w+ - w)
-    /// q'+ = q'- + M^-1 J^T p              one contact: q'- - (1 + e) M^-1 J^T S^-1 J q'-
+    /// expansion:   p = (1 + e_event) p_c    (Poisson's law)
+    /// q'+ = q'- + M^-1 J^T p                one contact: q'- - (1 + e) M^-1 J^T S^-1 J q'-
     /// ```
     ///
-    /// A unilateral row whose impulse comes out negative (it would pull) leaves `A` (and the
-    /// resting set) and the rest is solved again. A struck row that is not approaching (it
-    /// crossed within the time tolerance by acceleration alone, so `w` is at most
-    /// `|g''| time_tolerance`; or it creeps in at below `rest_speed / 1000`) comes to rest
-    /// without an impulse, and an event of such
-    /// rows alone changes no velocity and releases no resting contact (many contacts at
-    /// rest, a ragdoll's, otherwise evict each other on the sign of rounding noise).
+    /// The compression is the impulse of a perfectly plastic impact: every row of `A0` ends
+    /// pushing and held (`w_c = 0`) or free and opening, none pulling. Restitution scales it,
+    /// so a row held at the end of the compression rebounds at `-e_event w`: Newton's law for
+    /// a single contact, and for a row struck beside resting ones. Poisson's law never adds
+    /// energy, whatever the rows and their coupling in the mass metric: the jump takes
+    /// `(1 - e_event^2)/2 |M^-1 J^T p_c|_M^2` from the kinetic energy. (Newton's law row by row
+    /// can add energy when several rows act at once, as they do when events pile up at one
+    /// instant: a ragdoll struck at extreme joint speeds gained four times its kinetic energy
+    /// that way.) A struck row that is not approaching (it crossed within the time tolerance
+    /// by acceleration alone, so `w` is at most `|g''| time_tolerance`; or it creeps in at
+    /// below `rest_speed / 1000`) comes to rest without an impulse, and an event of such rows
+    /// alone changes no velocity and releases no resting contact (many contacts at rest, a
+    /// ragdoll's, otherwise evict each other on the sign of rounding noise).
     ///
-    /// One coefficient for every row of an event keeps the energy law exact: the held rows have
-    /// `w = 0`, so the jump takes from the kinetic energy exactly `(1 - e_event^2)` times the
-    /// energy `w^T S_A^-1 w / 2` of the removed part and never adds any (a per-row choice of
-    /// plastic or elastic could, through rows coupled in the mass metric). A slow contact struck
-    /// together with a fast one rebounds at most at `e rest_speed` and rests at its next,
-    /// plastic, event. With friction, each struck contact then gets a Coulomb tangential
-    /// impulse (at most `mu` times its normal impulse, never reversing the sliding) and the
-    /// velocities are projected once more onto the bilateral and resting rows; both only
-    /// remove energy.
+    /// A slow contact struck together with a fast one rebounds at most at `e rest_speed` and
+    /// rests at its next, plastic, event. With friction, each struck contact then gets a
+    /// Coulomb tangential impulse (at most `mu` times its normal impulse, never reversing the
+    /// sliding) and the velocities are projected once more onto the bilateral and resting
+    /// rows; both only remove energy. Last, the kinetic energy `q'^T M q' / 2` after is
+    /// compared with the energy before in floating point, and where rounding (or rows so
+    /// ill-conditioned at extreme speeds that the solve is inexact) leaves it larger, the
+    /// velocities are scaled down to it: the jump never adds energy, not even a rounding.
     ///
     /// # Errors
     /// [`Error::RedundantConstraints`] for dependent bilateral rows; [`Error::NonFiniteState`];
-    /// whatever [`Mechanism::solve_mass`] returns.
+    /// [`Error::NoConvergence`] where the complementarity problem cycles; whatever
+    /// [`Mechanism::solve_mass`] returns.
     pub fn impact<M, const N: usize>(
         &self,
         mechanism: &M,
@@ -119,7 +120,8 @@ impl<'a, T: Real, const C: usize, K> Impacts<'a, T, C, K> {
         K: Contacts<T, N, C>,
     {
         let e = self.model.restitution();
-        let w = self.contacts.jacobian(&state.q) * state.qd;
+        let jacobian = self.contacts.jacobian(&state.q);
+        let w = jacobian * state.qd;
         // Approach speeds a thousand times below the resting threshold (a contact reached by
         // acceleration alone, or by the creep of a body settling on many contacts) are no
         // approach: the contact comes to rest, and the projection at the end of the step
@@ -129,21 +131,20 @@ impl<'a, T: Real, const C: usize, K> Impacts<'a, T, C, K> {
         let approaching: [bool; C] = core::array::from_fn(|i| struck[i] && w[i] < -noise);
         let elastic = (0..C).any(|i| approaching[i] && -e * w[i] >= self.model.rest_speed());
         let e_event = if elastic { e } else { T::zero() };
-        let active: [bool; C] =
+        let candidate: [bool; C] =
             core::array::from_fn(|i| self.bilateral[i] || resting[i] || approaching[i]);
-        let Jump {
-            velocity: mut after,
-            impulses,
-            kept,
-        } = if approaching.iter().any(|&a| a) {
-            self.jump(mechanism, state, active, &approaching, e_event)?
+        let (mut after, impulses, kept) = if approaching.iter().any(|&a| a) {
+            let rows = Delassus::new(jacobian, |b| mechanism.solve_mass(state, b), &candidate)?;
+            let compression = rows.complementary(&w, &Row::kinds(&self.bilateral))?;
+            let impulses = compression.lambda * (T::one() + e_event);
+            (
+                state.qd + rows.response(&impulses),
+                impulses,
+                compression.active,
+            )
         } else {
             // Only contacts that settle: no impulse, nothing released.
-            Jump {
-                velocity: state.qd,
-                impulses: SVector::zeros(),
-                kept: active,
-            }
+            (state.qd, SVector::zeros(), candidate)
         };
         for i in 0..C {
             let settles = struck[i] && !approaching[i];
@@ -153,6 +154,7 @@ impl<'a, T: Real, const C: usize, K> Impacts<'a, T, C, K> {
         if self.model.friction() > T::zero() {
             after = self.friction(mechanism, state, after, &impulses, &approaching, resting)?;
         }
+        let after = no_energy_gain(mechanism, state, after)?;
         let next = State {
             t: state.t,
             q: state.q,
@@ -169,61 +171,6 @@ impl<'a, T: Real, const C: usize, K> Impacts<'a, T, C, K> {
             resting: *resting,
         };
         Ok((next, record))
-    }
-
-    /// The impulse over the rows `active` that sends `w = J q'` to `-e w` on the rows `bounce`
-    /// and to zero on the others, dropping unilateral rows that would pull: the new
-    /// velocities, the impulses and the rows that stayed.
-    fn jump<M, const N: usize>(
-        &self,
-        mechanism: &M,
-        state: &State<T, N>,
-        mut active: [bool; C],
-        bounce: &[bool; C],
-        e: T,
-    ) -> Result<Jump<T, N, C>, Error>
-    where
-        M: Mechanism<T, N>,
-        K: Contacts<T, N, C>,
-    {
-        // Each pass either finishes or removes at least one row, so at most C + 1 passes.
-        loop {
-            let schur = independent(
-                mechanism,
-                self.contacts,
-                state,
-                &mut active,
-                &self.bilateral,
-            )?;
-            let w = schur.jacobian() * state.qd;
-            let change = SVector::<T, C>::from_fn(|i, _| {
-                if bounce[i] {
-                    -(T::one() + e) * w[i]
-                } else {
-                    -w[i]
-                }
-            });
-            let impulses = schur.multipliers(&change);
-            // The row that pulls hardest leaves, alone: dropping every pulling row at once
-            // also drops rows that only pulled because of it (with many contacts, a
-            // ragdoll's, that evicts most of the resting set at every event).
-            let mut pulled: Option<(usize, T)> = None;
-            for i in 0..C {
-                let pulls = active[i] && !self.bilateral[i] && impulses[i] < T::zero();
-                if pulls && pulled.is_none_or(|(_, p)| impulses[i] < p) {
-                    pulled = Some((i, impulses[i]));
-                }
-            }
-            if let Some((i, _)) = pulled {
-                active[i] = false;
-            } else {
-                return Ok(Jump {
-                    velocity: state.qd + schur.response(&impulses),
-                    impulses,
-                    kept: active,
-                });
-            }
-        }
     }
 
     /// Coulomb tangential impulses at the struck contacts, then a projection back onto the
@@ -266,6 +213,43 @@ impl<'a, T: Real, const C: usize, K> Impacts<'a, T, C, K> {
         }
         Ok(v)
     }
+}
+
+/// `after` at `state` (which holds the velocities before), scaled down where its kinetic
+/// energy (the mechanism's own [`Lagrangian::kinetic_energy`], what an observer compares) is
+/// above the energy before in floating point, so that it is not: the last guard of every
+/// velocity jump (a jump that cannot add energy in real arithmetic can still gain a rounding).
+/// Scaling keeps the direction of the motion and every row held at zero velocity.
+///
+/// # Errors
+/// [`Error::NoConvergence`] where scaling cannot bring the energy down (a kinetic energy that
+/// is not a quadratic form of the velocities, or not finite).
+pub(crate) fn no_energy_gain<T, M, const N: usize>(
+    mechanism: &M,
+    state: &State<T, N>,
+    after: SVector<T, N>,
+) -> Result<SVector<T, N>, Error>
+where
+    T: Real,
+    M: Lagrangian<T, N>,
+{
+    let energy = |qd: SVector<T, N>| mechanism.kinetic_energy(&State { qd, ..*state });
+    let limit = energy(state.qd);
+    let mut v = after;
+    // The square root of the ratio, then a few ulps more each time: it settles in one or two.
+    for _ in 0..8 {
+        let e = energy(v);
+        if e <= limit {
+            return Ok(v);
+        }
+        let scale = if limit > T::zero() && e.is_finite() {
+            (limit / e).sqrt() * (T::one() - T::from_f64(4.0) * T::EPSILON)
+        } else {
+            T::zero()
+        };
+        v *= scale;
+    }
+    Err(Error::NoConvergence { iterations: 8 })
 }
 
 #[cfg(feature = "defmt")]

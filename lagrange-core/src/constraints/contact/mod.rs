@@ -11,6 +11,7 @@
 mod active_rows;
 mod contacts;
 mod impulse;
+pub(crate) mod lcp;
 mod model;
 
 pub use active_rows::{drop_dependent_contacts, ActiveRows};
