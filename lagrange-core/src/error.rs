@@ -70,6 +70,12 @@ pub enum Error {
         /// The bank's capacity.
         capacity: usize,
     },
+    /// Constraint or contact row `row` gave a value that is NaN or infinite at this state: its
+    /// gap or position residual, its Jacobian row or its tangent row.
+    NonFiniteRow {
+        /// Index of the first such row.
+        row: usize,
+    },
 }
 
 impl fmt::Display for Error {
@@ -110,6 +116,10 @@ impl fmt::Display for Error {
             Self::BankFull { capacity } => {
                 write!(f, "the bank is full ({capacity} instances)")
             }
+            Self::NonFiniteRow { row } => write!(
+                f,
+                "row {row} is not finite here (its gap, Jacobian or tangent is NaN or infinite)"
+            ),
         }
     }
 }

@@ -290,6 +290,13 @@ where
     ) -> Result<SVector<T, N>, Error> {
         self.mechanism.velocity_jump(state, impulse)
     }
+    fn velocity_jumps<const K: usize>(
+        &self,
+        state: &State<T, N>,
+        impulses: &SMatrix<T, N, K>,
+    ) -> Result<SMatrix<T, N, K>, Error> {
+        self.mechanism.velocity_jumps(state, impulses)
+    }
 }
 
 /// A forced constrained mechanism keeps its rows: what a projection reads.

@@ -234,6 +234,29 @@ pub trait Mechanism<T: Real, const N: usize>: Lagrangian<T, N> {
         finite(self.solve_mass(state, impulse)?)
     }
 
+    /// The velocity changes of `K` generalized impulses at once, the columns of `impulses`:
+    /// [`Mechanism::velocity_jump`] of each column that is not zero (a zero column stays
+    /// zero) by default. A mechanism whose mass solve can share work between right-hand sides
+    /// (its configuration's trigonometry, a factorisation) overrides it with the same result,
+    /// faster: what a contact solver builds its rows' mobilities `M^-1 J^T` with.
+    ///
+    /// # Errors
+    /// As [`Mechanism::velocity_jump`].
+    fn velocity_jumps<const K: usize>(
+        &self,
+        state: &State<T, N>,
+        impulses: &SMatrix<T, N, K>,
+    ) -> Result<SMatrix<T, N, K>, Error> {
+        let mut out = SMatrix::<T, N, K>::zeros();
+        for k in 0..K {
+            if (0..N).any(|i| impulses[(i, k)] != T::zero()) {
+                let column = SVector::<T, N>::from_fn(|i, _| impulses[(i, k)]);
+                out.set_column(k, &self.velocity_jump(state, &column)?);
+            }
+        }
+        Ok(out)
+    }
+
     /// These instances of the type side by side, as one mechanism over [`Lanes`] (lane `i`
     /// is `instances[i]`), where the type can gather its parameters (a plain struct of
     /// scalars): what lets a scene step a bank `L` instances at a time, each lane bit for bit

@@ -365,6 +365,7 @@ impl<T: Real, I: Method, K, const N: usize, const C: usize> Method
 {
     const NAME: &'static str = I::NAME;
     const ORDER: u32 = I::ORDER;
+    const POSITION_SHARE: f64 = I::POSITION_SHARE;
     /// The inner integrator's per step between events; each event adds about
     /// `log2(dt / time_tolerance)` steps of it.
     const COST: Cost = I::COST;

@@ -17,6 +17,8 @@ impl Method for ExplicitEuler {
     const NAME: &'static str = "explicit Euler";
     const ORDER: u32 = 1;
     const COST: Cost = Cost::explicit(1);
+    /// It moves by the old velocity alone.
+    const POSITION_SHARE: f64 = 0.0;
 }
 
 impl<T: Real, const N: usize, M: Mechanism<T, N>> Integrator<T, N, M> for ExplicitEuler {

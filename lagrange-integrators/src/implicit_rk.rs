@@ -234,10 +234,24 @@ impl<T: Real, const S: usize, Tab: ImplicitTableau<S>> ImplicitRungeKutta<T, S, 
     }
 }
 
+/// `sum_j b_j c_j`.
+const fn position_share<const S: usize>(b: &[f64; S], c: &[f64; S]) -> f64 {
+    let mut sum = 0.0;
+    let mut j = 0;
+    while j < S {
+        sum += b[j] * c[j];
+        j += 1;
+    }
+    sum
+}
+
 impl<T: Real, Tab: ImplicitTableau<S>, const S: usize> Method for ImplicitRungeKutta<T, S, Tab> {
     const NAME: &'static str = Tab::NAME;
     const YOSHIDA4_NAME: &'static str = "Yoshida 4 (midpoint)";
     const ORDER: u32 = Tab::ORDER;
+    /// `sum_j b_j c_j`: the stages' velocities `q'0 + h c_j a`, weighted (1 for backward
+    /// Euler, 1/2 for the others, which are exact on a constant acceleration).
+    const POSITION_SHARE: f64 = position_share(&Tab::B, &Tab::C);
     /// `S` accelerations per Newton iteration and one Jacobian (its accelerations are not
     /// counted apart: the first iteration starts from them).
     const COST: Cost = Cost {

@@ -121,6 +121,14 @@ pub trait Method {
     /// The name of its order-4 composition ([`Yoshida4`](crate::Yoshida4)) when it is a
     /// symmetric base.
     const YOSHIDA4_NAME: &'static str = "Yoshida 4";
+    /// How a step moves the coordinates under a constant acceleration `a`:
+    /// `q1 = q0 + h q'0 + POSITION_SHARE h^2 a`. One half for every method exact on it (every
+    /// method of order 2 or more, the default); one for semi-implicit and backward Euler,
+    /// which move by the new velocity; zero for explicit Euler, which moves by the old one.
+    /// A time-stepping contact solver ([`ImpulseStepper`](crate::ImpulseStepper)) moves the
+    /// coordinates by the same share of its impulses' velocity change, as if they were a
+    /// constant force over the step, so that a body held at rest does not creep.
+    const POSITION_SHARE: f64 = 0.5;
 
     /// The work of the last step ([`Work`]); by default that of [`Method::COST`] with no
     /// iterations.

@@ -64,6 +64,7 @@ impl<T: Real, const N: usize, const C: usize, I> Projected<T, N, C, I> {
 impl<T: Real, I: Method, const N: usize, const C: usize> Method for Projected<T, N, C, I> {
     const NAME: &'static str = I::NAME;
     const ORDER: u32 = I::ORDER;
+    const POSITION_SHARE: f64 = I::POSITION_SHARE;
     /// The inner integrator's (the projection solves with the mass matrix, evaluating no
     /// accelerations).
     const COST: Cost = I::COST;

@@ -19,6 +19,8 @@ impl Method for SemiImplicitEuler {
     const NAME: &'static str = "semi-implicit Euler";
     const ORDER: u32 = 1;
     const COST: Cost = Cost::explicit(1);
+    /// It moves by the new velocity, `h (q'0 + h a)`.
+    const POSITION_SHARE: f64 = 1.0;
 }
 
 impl<T: Real, const N: usize, M: Mechanism<T, N>> Integrator<T, N, M> for SemiImplicitEuler {

@@ -132,7 +132,37 @@ impl<T: Real> RagdollContacts<T> {
     /// The world positions of the floor points at `q`, m, in the order of the rows.
     #[must_use]
     pub fn floor_points(&self, q: &SVector<T, N>) -> [[T; 2]; RAGDOLL_FLOOR_POINTS] {
-        self.points.map(|m| self.ragdoll.world_point(q, m))
+        // One pose for all the points (a pose per point cost thirteen poses a residual).
+        let pose = self.ragdoll.pose(q);
+        self.points.map(|m| {
+            let [px, py] = pose.point(m.link, m.along, m.across);
+            [px + q[0], py + q[1]]
+        })
+    }
+
+    /// The Jacobian of every row (floor points' heights, then the limits) and the tangent
+    /// Jacobian (the floor points' horizontal positions; zero rows for the limits).
+    fn rows(
+        &self,
+        q: &SVector<T, N>,
+    ) -> (
+        SMatrix<T, RAGDOLL_CONTACTS, N>,
+        SMatrix<T, RAGDOLL_CONTACTS, N>,
+    ) {
+        let points = self.point_jacobians(q);
+        let (mut j, mut t) = (SMatrix::zeros(), SMatrix::zeros());
+        for (i, (dy, dx)) in points.iter().enumerate() {
+            for c in 0..N {
+                j[(i, c)] = dy[c];
+                t[(i, c)] = dx[c];
+            }
+        }
+        for joint in 0..RAGDOLL_LINKS - 1 {
+            let row = RAGDOLL_FLOOR_POINTS + 2 * joint;
+            j[(row, joint + 3)] = T::one();
+            j[(row + 1, joint + 3)] = -T::one();
+        }
+        (j, t)
     }
 
     /// Floor rows' Jacobians: `(d y_p / dq, d x_p / dq)` for each point.
@@ -178,19 +208,7 @@ impl<T: Real> Constraints<T, N, RAGDOLL_CONTACTS> for RagdollContacts<T> {
     }
 
     fn jacobian(&self, q: &SVector<T, N>) -> SMatrix<T, RAGDOLL_CONTACTS, N> {
-        let rows = self.point_jacobians(q);
-        let mut j = SMatrix::zeros();
-        for (i, (dy, _)) in rows.iter().enumerate() {
-            for (c, x) in dy.iter().enumerate() {
-                j[(i, c)] = *x;
-            }
-        }
-        for joint in 0..RAGDOLL_LINKS - 1 {
-            let row = RAGDOLL_FLOOR_POINTS + 2 * joint;
-            j[(row, joint + 3)] = T::one();
-            j[(row + 1, joint + 3)] = -T::one();
-        }
-        j
+        self.rows(q).0
     }
 
     /// `y_p''` at `q'' = 0`: `-sum w_k^2 r_k` over the links from the point to the torso,
@@ -229,13 +247,18 @@ impl<T: Real> Constraints<T, N, RAGDOLL_CONTACTS> for RagdollContacts<T> {
 impl<T: Real> Contacts<T, N, RAGDOLL_CONTACTS> for RagdollContacts<T> {
     /// The floor points' horizontal Jacobian; none for the limits.
     fn tangent_jacobian(&self, q: &SVector<T, N>) -> Option<SMatrix<T, RAGDOLL_CONTACTS, N>> {
-        let rows = self.point_jacobians(q);
-        let mut t = SMatrix::zeros();
-        for (i, (_, dx)) in rows.iter().enumerate() {
-            for (c, x) in dx.iter().enumerate() {
-                t[(i, c)] = *x;
-            }
-        }
-        Some(t)
+        Some(self.rows(q).1)
+    }
+
+    /// Both from one pose and one pass over the points.
+    fn jacobians(
+        &self,
+        q: &SVector<T, N>,
+    ) -> (
+        SMatrix<T, RAGDOLL_CONTACTS, N>,
+        Option<SMatrix<T, RAGDOLL_CONTACTS, N>>,
+    ) {
+        let (j, t) = self.rows(q);
+        (j, Some(t))
     }
 }

@@ -1,6 +1,6 @@
 //! [`Projection`]: a state moved back onto `phi = 0` and `J q' = 0`, mass-weighted.
 
-use super::contact::lcp::{Delassus, Row};
+use super::contact::{each_column, Delassus, Row};
 use super::{max_abs, Constraints, Schur};
 use crate::{validate, Error, Mechanism, Real, State};
 use nalgebra::SVector;
@@ -182,9 +182,9 @@ impl<T: Real> Projection<T> {
             if iterations == self.max_iterations {
                 return Err(Error::NoConvergence { iterations });
             }
-            let rows = Delassus::new(
+            let mut rows = Delassus::new(
                 contacts.jacobian(&s.q),
-                |b| mechanism.solve_mass(&s, b),
+                |jt| each_column(jt, |b| mechanism.solve_mass(&s, b)),
                 &[true; C],
             )?;
             let kinds: [Row; C] = core::array::from_fn(|i| match (bilateral[i], held[i]) {

@@ -804,6 +804,7 @@ fn no_error_channel<T: Real>(ctx: &mut Ctx) -> Verdict {
                 },
                 lagrange_core::Error::StepSizeUnderflow,
                 lagrange_core::Error::SingularJacobian,
+                lagrange_core::Error::NonFiniteRow { row: usize::MAX },
                 lagrange_core::Error::Singularity { what: "here" },
                 lagrange_core::Error::InvalidParameter {
                     name: "x",

@@ -2,7 +2,7 @@
 //! rows and resting contacts), which is what a contact stepper's integrator steps between
 //! events; and [`drop_dependent_contacts`], which keeps the rows in force independent.
 
-use super::lcp::{Delassus, Row};
+use super::lcp::{each_column, Delassus, Row};
 use super::{ContactModel, Contacts};
 use crate::constraints::{ConstrainedAcceleration, Schur};
 use crate::mechanism::{finite, finite_jacobian};
@@ -78,9 +78,9 @@ impl<'a, T: Real, const C: usize, M, K> ActiveRows<'a, T, C, M, K> {
         M: Mechanism<T, N>,
         K: Contacts<T, N, C>,
     {
-        let rows = Delassus::new(
+        let mut rows = Delassus::new(
             self.contacts.jacobian(&state.q),
-            |b| self.mechanism.solve_mass(state, b),
+            |jt| each_column(jt, |b| self.mechanism.solve_mass(state, b)),
             &self.active,
         )?;
         let kinds: [Row; C] = core::array::from_fn(|i| {
@@ -91,7 +91,7 @@ impl<'a, T: Real, const C: usize, M, K> ActiveRows<'a, T, C, M, K> {
             }
         });
         let velocity_product = self.contacts.velocity_product(&state.q, &state.qd);
-        let held = |free: SVector<T, N>| -> Result<_, Error> {
+        let mut held = |free: SVector<T, N>| -> Result<_, Error> {
             let b = rows.jacobian() * free + velocity_product;
             let solved = rows.complementary(&b, &kinds)?;
             let acceleration = free + rows.response(&solved.lambda);

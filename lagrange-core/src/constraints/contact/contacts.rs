@@ -21,6 +21,13 @@ pub trait Contacts<T: Real, const N: usize, const C: usize>: Constraints<T, N, C
         let _ = q;
         None
     }
+
+    /// The Jacobian and the tangent Jacobian together (as [`Constraints::jacobian`] and
+    /// [`Contacts::tangent_jacobian`]): what a contact solver asks for each step. A set whose
+    /// two share work (a ragdoll's link poses and point Jacobians) overrides it.
+    fn jacobians(&self, q: &SVector<T, N>) -> (SMatrix<T, C, N>, Option<SMatrix<T, C, N>>) {
+        (self.jacobian(q), self.tangent_jacobian(q))
+    }
 }
 
 impl<T, const N: usize, const C: usize, P> Contacts<T, N, C> for Holonomic<P>

@@ -1,7 +1,7 @@
 //! Impacts: the jump of the generalized velocities by mass-weighted impulses, and the
 //! [`Impact`] record an observer receives.
 
-use super::lcp::{Delassus, Row};
+use super::lcp::{each_column, Delassus, Row};
 use super::{ContactModel, Contacts};
 use crate::constraints::Schur;
 use crate::nalgebra::SVector;
@@ -134,7 +134,11 @@ impl<'a, T: Real, const C: usize, K> Impacts<'a, T, C, K> {
         let candidate: [bool; C] =
             core::array::from_fn(|i| self.bilateral[i] || resting[i] || approaching[i]);
         let (mut after, impulses, kept) = if approaching.iter().any(|&a| a) {
-            let rows = Delassus::new(jacobian, |b| mechanism.solve_mass(state, b), &candidate)?;
+            let mut rows = Delassus::new(
+                jacobian,
+                |jt| each_column(jt, |b| mechanism.solve_mass(state, b)),
+                &candidate,
+            )?;
             let compression = rows.complementary(&w, &Row::kinds(&self.bilateral))?;
             let impulses = compression.lambda * (T::one() + e_event);
             (
@@ -216,15 +220,10 @@ impl<'a, T: Real, const C: usize, K> Impacts<'a, T, C, K> {
 }
 
 /// `after` at `state` (which holds the velocities before), scaled down where its kinetic
-/// energy (the mechanism's own [`Lagrangian::kinetic_energy`], what an observer compares) is
-/// above the energy before in floating point, so that it is not: the last guard of every
-/// velocity jump (a jump that cannot add energy in real arithmetic can still gain a rounding).
-/// Scaling keeps the direction of the motion and every row held at zero velocity.
-///
-/// # Errors
-/// [`Error::NoConvergence`] where scaling cannot bring the energy down (a kinetic energy that
-/// is not a quadratic form of the velocities, or not finite).
-pub(crate) fn no_energy_gain<T, M, const N: usize>(
+/// energy is above the energy before in floating point, so that it is not: the last guard of
+/// every velocity jump (a jump that cannot add energy in real arithmetic can still gain a
+/// rounding).
+fn no_energy_gain<T, M, const N: usize>(
     mechanism: &M,
     state: &State<T, N>,
     after: SVector<T, N>,
@@ -233,10 +232,37 @@ where
     T: Real,
     M: Lagrangian<T, N>,
 {
+    let limit = mechanism.kinetic_energy(state);
+    within_kinetic_energy(
+        mechanism,
+        &State {
+            qd: after,
+            ..*state
+        },
+        limit,
+    )
+}
+
+/// The velocities of `state`, scaled down where their kinetic energy (the mechanism's own
+/// [`Lagrangian::kinetic_energy`], what an observer compares) is above `limit` in floating
+/// point, so that it is not; all zero for a limit that is not positive. Scaling keeps the
+/// direction of the motion and every row held at zero velocity. The square root of the
+/// ratio, then a few ulps more each time: it settles in one or two.
+///
+/// # Errors
+/// [`Error::NoConvergence`] where scaling cannot bring the energy down in eight tries (a
+/// kinetic energy that is not a quadratic form of the velocities, or not finite).
+pub fn within_kinetic_energy<T, M, const N: usize>(
+    mechanism: &M,
+    state: &State<T, N>,
+    limit: T,
+) -> Result<SVector<T, N>, Error>
+where
+    T: Real,
+    M: Lagrangian<T, N>,
+{
     let energy = |qd: SVector<T, N>| mechanism.kinetic_energy(&State { qd, ..*state });
-    let limit = energy(state.qd);
-    let mut v = after;
-    // The square root of the ratio, then a few ulps more each time: it settles in one or two.
+    let mut v = state.qd;
     for _ in 0..8 {
         let e = energy(v);
         if e <= limit {

@@ -7,14 +7,17 @@
 //!   gaps), with an optional tangent for friction.
 //! - [`ContactModel`]: restitution `e` in `[0, 1]`, the resting threshold, the event time
 //!   tolerance, Coulomb friction.
+//! - [`Delassus`]: the rows' mass-weighted geometry `J M^-1 J^T` and their complementarity
+//!   problem solved exactly, which every contact solve of the library shares.
 
 mod active_rows;
 mod contacts;
 mod impulse;
-pub(crate) mod lcp;
+mod lcp;
 mod model;
 
 pub use active_rows::{drop_dependent_contacts, ActiveRows};
 pub use contacts::Contacts;
-pub use impulse::{Impact, Impacts};
+pub use impulse::{within_kinetic_energy, Impact, Impacts};
+pub use lcp::{each_column, Complementary, Delassus, Row};
 pub use model::ContactModel;

@@ -1,0 +1,42 @@
+//! [`ImpulseReport`]: what one step of an [`ImpulseStepper`](super::ImpulseStepper) did.
+
+/// What the last step of an [`ImpulseStepper`](super::ImpulseStepper) did: the counts its
+/// work is bounded by (see the stepper's docs), and whether its solve settled.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct ImpulseReport {
+    /// Normal rows solved (in contact, bilateral or speculative): at most the contact set's
+    /// size.
+    pub rows: u32,
+    /// Of those, contacts still open that joined because the step's motion would close them.
+    pub speculative: u32,
+    /// Contacts with a tangent (friction).
+    pub frictional: u32,
+    /// Exact solves of the normal rows, each followed by a friction sweep: at most the
+    /// settings' `max_iterations` per solve, and at most four solves (the plastic one, two
+    /// more with speculative rows, the rebound).
+    pub rounds: u32,
+    /// Whether the friction sweeps settled before the cap (always without friction, and when
+    /// no row was in contact). Where they did not, the impulses are those of the last round,
+    /// the cone holds, and the step still never gains energy.
+    pub settled: bool,
+    /// Whether the drift correction moved the coordinates.
+    pub corrected: bool,
+    /// Whether the energy guard scaled the velocities down.
+    pub energy_guard: bool,
+}
+
+impl Default for ImpulseReport {
+    /// A step with no row in contact: no work, settled.
+    fn default() -> Self {
+        Self {
+            rows: 0,
+            speculative: 0,
+            frictional: 0,
+            rounds: 0,
+            settled: true,
+            corrected: false,
+            energy_guard: false,
+        }
+    }
+}

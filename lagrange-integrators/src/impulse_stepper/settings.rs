@@ -1,0 +1,107 @@
+//! [`ImpulseSettings`]: the slop and the work caps of an [`ImpulseStepper`](super::ImpulseStepper).
+
+use lagrange_core::{validate, Error, Real};
+
+/// Most sweeps a step may be allowed: beyond a thousand a projected Gauss-Seidel solve that
+/// has not settled never will, and the cap bounds the cost of a step whatever is asked.
+const MAX_ITERATIONS_CAP: u32 = 1000;
+
+/// How deep a contact may rest and how much work a step of an
+/// [`ImpulseStepper`](super::ImpulseStepper) may do.
+///
+/// ```text
+/// slop            a contact may end a step this far below zero (gap units: m for a floor,
+///                 rad for a joint limit); deeper, the position correction lifts it back to
+///                 it. A little slop keeps a resting contact in touch from step to step
+///                 (quiet, and warm-started); none makes every resting step lift it
+/// max_iterations  projected Gauss-Seidel sweeps, at most, for the impulses (and as many
+///                 for the position correction): the cap on a step's work
+/// tolerance       a sweep that changes no row's velocity by more than this (gap units per
+///                 second, plus the rounding of the row's speed) ends the solve early
+/// max_rows        rows in contact at once, at most (default: every row of the set): the
+///                 cap on a step's work in rows; more is an error naming it
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct ImpulseSettings<T> {
+    slop: T,
+    max_iterations: u32,
+    tolerance: T,
+    max_rows: Option<u32>,
+}
+
+impl<T: Real> ImpulseSettings<T> {
+    /// A slop of `slop` (gap units, >= 0, finite) and at most `max_iterations` (1 to 1000)
+    /// sweeps per solve, ending early below a tolerance of 1e-6 gap units per second.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] `slop` when negative or not finite; `max_iterations` when
+    /// zero or above 1000.
+    pub fn new(slop: T, max_iterations: u32) -> Result<Self, Error> {
+        if !(1..=MAX_ITERATIONS_CAP).contains(&max_iterations) {
+            return Err(Error::InvalidParameter {
+                name: "max_iterations",
+                reason: "must be from 1 to 1000",
+            });
+        }
+        Ok(Self {
+            slop: validate::non_negative("slop", slop)?,
+            max_iterations,
+            tolerance: T::from_f64(1e-6),
+            max_rows: None,
+        })
+    }
+
+    /// The same settings with the sweeps ending early at `tolerance` (gap units per second,
+    /// > 0, finite).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] `tolerance` when not positive and finite.
+    pub fn with_tolerance(self, tolerance: T) -> Result<Self, Error> {
+        Ok(Self {
+            tolerance: validate::positive("tolerance", tolerance)?,
+            ..self
+        })
+    }
+
+    /// The same settings with at most `max_rows` (at least 1) rows in contact at once.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] `max_rows` when zero.
+    pub fn with_max_rows(self, max_rows: u32) -> Result<Self, Error> {
+        if max_rows == 0 {
+            return Err(Error::InvalidParameter {
+                name: "max_rows",
+                reason: "must be at least 1",
+            });
+        }
+        Ok(Self {
+            max_rows: Some(max_rows),
+            ..self
+        })
+    }
+
+    /// The slop, gap units.
+    #[must_use]
+    pub fn slop(&self) -> T {
+        self.slop
+    }
+
+    /// The most sweeps per solve.
+    #[must_use]
+    pub fn max_iterations(&self) -> u32 {
+        self.max_iterations
+    }
+
+    /// The sweeps' early-end tolerance, gap units per second.
+    #[must_use]
+    pub fn tolerance(&self) -> T {
+        self.tolerance
+    }
+
+    /// The most rows in contact at once, if capped below the contact set's size.
+    #[must_use]
+    pub fn max_rows(&self) -> Option<u32> {
+        self.max_rows
+    }
+}

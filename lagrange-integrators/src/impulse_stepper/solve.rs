@@ -1,0 +1,132 @@
+//! The impulses of one step: the normal rows' complementarity problem solved exactly
+//! ([`Delassus::complementary`]), alternated with Coulomb friction sweeps, at most a capped
+//! number of times.
+
+use super::rows::Direction;
+use lagrange_core::constraints::contact::{Delassus, Row};
+use lagrange_core::nalgebra::SVector;
+use lagrange_core::{Error, Real};
+
+/// The impulses of one step per row of the contact set: along each row's normal and its
+/// tangent (zero where a row took no part).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) struct Impulses<T, const C: usize> {
+    pub(super) normal: SVector<T, C>,
+    pub(super) tangent: [T; C],
+}
+
+impl<T: Real, const C: usize> Impulses<T, C> {
+    /// None.
+    pub(super) fn zero() -> Self {
+        Self {
+            normal: SVector::zeros(),
+            tangent: [T::zero(); C],
+        }
+    }
+}
+
+/// How a solve went.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) struct Solved<T: Real, const N: usize, const C: usize> {
+    pub(super) impulses: Impulses<T, C>,
+    /// The velocities after the impulses.
+    pub(super) velocity: SVector<T, N>,
+    /// Normal solves taken (each followed by a friction sweep where there is friction).
+    pub(super) rounds: u32,
+    /// Whether the last friction sweep changed no tangent's speed by more than the tolerance
+    /// (always, without friction).
+    pub(super) settled: bool,
+}
+
+/// The rows of one step's solve.
+pub(super) struct Problem<'a, T: Real, const N: usize, const C: usize> {
+    /// The normal rows (the candidates: in contact, or speculative).
+    pub(super) normal: &'a mut Delassus<T, N, C>,
+    /// How each normal row holds.
+    pub(super) kinds: &'a [Row; C],
+    /// The tangents of the contacts with friction.
+    pub(super) tangent: &'a [Option<Direction<T, N>>; C],
+    /// The Coulomb coefficient.
+    pub(super) friction: T,
+    /// The rows that pushed last: the first guess of each normal solve's active rows.
+    pub(super) pushed: &'a [bool; C],
+}
+
+impl<T: Real, const N: usize, const C: usize> Problem<'_, T, N, C> {
+    /// The impulses that give every normal row at least its `target` speed from the
+    /// velocities `v0` (exactly its target where it pushes; a bilateral row exactly), with
+    /// Coulomb friction `|tangent| <= mu normal` stopping the sliding where it can: the
+    /// normal rows solved exactly with the tangents' impulses held, then one projected
+    /// Gauss-Seidel sweep of the tangents with the normals held, from the tangents' impulses
+    /// `warm`, at most `rounds` times, ending early once a sweep changes no tangent's speed
+    /// by more than `tolerance` (plus the rounding of its speed). The cone holds exactly at
+    /// the end. The velocities returned are `v0` plus the response of the final impulses.
+    ///
+    /// # Errors
+    /// As [`Delassus::complementary`].
+    pub(super) fn solve(
+        self,
+        v0: &SVector<T, N>,
+        target: &SVector<T, C>,
+        warm: &[T; C],
+        rounds: u32,
+        tolerance: T,
+    ) -> Result<Solved<T, N, C>, Error> {
+        let mut p = Impulses::zero();
+        for (i, t) in self.tangent.iter().enumerate() {
+            if t.is_some() {
+                p.tangent[i] = warm[i];
+            }
+        }
+        let frictional = self.friction > T::zero() && self.tangent.iter().any(Option::is_some);
+        let rounding = T::from_f64(16.0) * T::EPSILON;
+        let (mut taken, mut settled) = (0, false);
+        let mut guess = *self.pushed;
+        while taken < rounds.max(1) && !settled {
+            taken += 1;
+            let sliding = self.tangent_response(v0, &p.tangent);
+            let b = self.normal.jacobian() * sliding - target;
+            let solved = self.normal.complementary_from(&b, self.kinds, &guess)?;
+            (p.normal, guess) = (solved.lambda, solved.active);
+            if !frictional {
+                settled = true;
+                break;
+            }
+            let mut v = sliding + self.normal.response(&p.normal);
+            let (mut change, mut allowed) = (T::zero(), tolerance);
+            for (i, t) in self.tangent.iter().enumerate() {
+                let Some(t) = t else { continue };
+                let u = t.j.dot(&v);
+                let bound = self.friction * p.normal[i];
+                let next = (p.tangent[i] - u * t.inverse).max(-bound).min(bound);
+                let dp = next - p.tangent[i];
+                v += t.b * dp;
+                p.tangent[i] = next;
+                change = change.max((dp / t.inverse).abs());
+                allowed = allowed.max(tolerance + rounding * u.abs());
+            }
+            settled = change <= allowed;
+        }
+        if !frictional {
+            p.tangent = [T::zero(); C];
+        }
+        let velocity = self.tangent_response(v0, &p.tangent) + self.normal.response(&p.normal);
+        Ok(Solved {
+            impulses: p,
+            velocity,
+            rounds: taken,
+            settled,
+        })
+    }
+
+    /// `v` plus the velocity change of the tangents' impulses.
+    fn tangent_response(&self, v: &SVector<T, N>, tangent: &[T; C]) -> SVector<T, N> {
+        let mut out = *v;
+        for (t, p) in self.tangent.iter().zip(tangent) {
+            if let Some(t) = t {
+                out += t.b * *p;
+            }
+        }
+        out
+    }
+}
