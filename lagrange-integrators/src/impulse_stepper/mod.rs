@@ -469,8 +469,8 @@ const SPECULATIVE_ROUNDS: u32 = 2;
 /// The energy guard of a step from `start` (whose energy `T + V` is `known`, when the step
 /// continues the last one) whose free step reached `free` and whose impulses and drift
 /// correction reached `end`: the end state, its energy, and whether the guard acted.
-/// Allowed: the larger of the start's energy and the free step's, to rounding (16 ulps of the
-/// energies' sizes: a body at rest computes the same energy to within it). Above it, the velocities
+/// Allowed: the larger of the start's energy and the free step's, plus the free step's own
+/// energy error, to rounding. Above it, the velocities
 /// are scaled down to the kinetic energy the allowance leaves; where the contacts' move of
 /// the coordinates alone takes the potential energy above it (a body lifted out of the floor
 /// with no kinetic energy to pay for it), the velocities are zeroed and the move shortened
@@ -490,15 +490,21 @@ fn guard<T: Real, M: Mechanism<T, N>, const N: usize>(
         Some(e) if e.is_finite() => e,
         _ => mechanism.energy(start),
     };
-    let allowed = before.max(mechanism.energy(free));
+    let after_free = mechanism.energy(free);
+    // Allowed: the larger of the start's energy and the free step's, plus the free step's
+    // own energy error (the motion the contacts allow is integrated no better than the free
+    // motion: a sliding or rotating contact gains or loses as the free step does), plus the
+    // rounding of the energies compared (16 ulps of the sizes of their terms: T + V may be
+    // near zero while T and V are not).
+    let allowed = before.max(after_free) + (after_free - before).abs();
     let energy = mechanism.energy(&end);
-    // The rounding of the energies compared (16 ulps of their sizes) is no gain: a body at
-    // rest computes the same energy to within it step after step.
-    let rounding = T::from_f64(16.0) * T::EPSILON * (allowed.abs() + energy.abs());
+    let potential = mechanism.potential_energy(&end);
+    let rounding =
+        T::from_f64(16.0) * T::EPSILON * (allowed.abs() + energy.abs() + T::TWO * potential.abs());
     if energy <= allowed + rounding {
         return Ok((end, energy, false));
     }
-    let kinetic = allowed - mechanism.potential_energy(&end);
+    let kinetic = allowed - potential;
     if kinetic > T::zero() {
         end.qd = within_kinetic_energy(mechanism, &end, kinetic)?;
     } else {

@@ -13,7 +13,8 @@ const MAX_ITERATIONS_CAP: u32 = 1000;
 /// slop            a contact may end a step this far below zero (gap units: m for a floor,
 ///                 rad for a joint limit); deeper, the position correction lifts it back to
 ///                 it. A little slop keeps a resting contact in touch from step to step
-///                 (quiet, and warm-started); none makes every resting step lift it
+///                 (quiet, and warm-started); none makes every resting step lift it. Choose
+///                 it above a step's free fall, dt^2 g (0.17 mm at 240 Hz, 2.7 mm at 60 Hz)
 /// max_iterations  projected Gauss-Seidel sweeps, at most, for the impulses (and as many
 ///                 for the position correction): the cap on a step's work
 /// tolerance       a sweep that changes no row's velocity by more than this (gap units per
