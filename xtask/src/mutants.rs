@@ -561,6 +561,8 @@ const AREAS: [Area; 22] = [
         only: None,
         tests: &[
             "--test",
+            "clocks",
+            "--test",
             "fixed_timestep",
             "--test",
             "issue15",
