@@ -118,6 +118,20 @@ fn huge_steps_across_zero<T: Real>() -> Result<(), Error> {
     let exact = exact.plus(3, sixteenth(small));
     let e = ulps_of::<T>(sixteenth(clock.time()), exact);
     assert!(e <= BOUND_ULPS, "{e} ulps after the change of step");
+    // A change of step at a time whose pair has a low part (-0.9 MAX + 0.3 MAX rounds), then
+    // huge steps again: two of 0.7 MAX overflow as a product, and the time takes the low
+    // part at half scale.
+    let mut clock = Clock::new(t0);
+    let third = T::from_f64(0.3 * max);
+    clock.tick(third);
+    let wide = T::from_f64(0.7 * max);
+    clock.tick(wide);
+    clock.tick(wide);
+    let exact = Exact(sixteenth(t0), 0.0)
+        .plus(1, sixteenth(third))
+        .plus(2, sixteenth(wide));
+    let e = ulps_of::<T>(sixteenth(clock.time()), exact);
+    assert!(e <= BOUND_ULPS, "{e} ulps after huge steps from a restart");
     // From -MAX by MAX / 4100 (small enough to split in f32): at 8192 ticks, a block's
     // base, n dt is nearly 2 MAX. (In f64 a block is 2^26 ticks, and a step small enough to
     // split, below MAX / 2^26, takes as many to overflow: the f32 run covers the same code.)
