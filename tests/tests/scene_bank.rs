@@ -112,6 +112,8 @@ fn a_new_scene_restarts_the_clock<T: Real>() -> Result<(), Error> {
     assert_eq!(bank.state(a)?.t, ten);
     let mut second = Scene::new([&mut bank], dt, 4)?;
     assert_eq!(second.time(), T::zero());
+    assert_eq!(second.banks()[0].time(), T::zero());
+    assert_eq!(second.banks()[0].state(a)?.t, T::zero());
     let frame = second.advance(dt)?;
     assert_eq!((frame.steps, frame.failed), (1, 0));
     assert_eq!(second.banks()[0].time(), second.time());
