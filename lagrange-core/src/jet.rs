@@ -760,6 +760,55 @@ mod tests {
         assert!(close(j.d, r.re.eps[0] * rate[0] + r.re.eps[1] * rate[1]));
     }
 
+    /// The forms `f` leaves out: a constant on the left of a product, a quotient or an
+    /// assignment whose right side has every part (the mixed `dp` and the Hessian), and
+    /// functions of two variables whose second argument has them too.
+    fn g<S: Scalar<Real = f64>>([q0, q1, p0, p1, t]: [S; 5]) -> S {
+        let mixed = (q0 - q1).cos() * p0 * p1 + p0 * p0 * q1;
+        let mut a = S::from_f64(1.5);
+        a *= mixed;
+        let mut b = S::from_f64(0.5);
+        b /= mixed + 3.0;
+        let mut c = S::from_f64(2.0);
+        c -= mixed * t;
+        c += p1 * p1 * q0.sin();
+        let e = (p1 * q0).atan2(mixed + 4.0) + (q1 * p0).atan2(p1 * p1 * q0 + 2.0);
+        let h =
+            S::from_f64(0.25) * (mixed * p1 * q0.cos()) - S::from_f64(3.0) / (mixed * mixed + 1.0);
+        a + b + c * 0.5 + e + h
+    }
+
+    /// Every part of the jet of `g` equals the nested duals' derivatives to rounding, with
+    /// time seeded in the direction (the duals' fifth variable at unit rate).
+    #[test]
+    fn every_form_agrees_with_nested_duals() {
+        type D5 = Dual<Dual<f64, 5>, 5>;
+        let x = [0.4, -1.1, 0.8, -0.3, 2.0];
+        let rate = [0.3, -0.7, 0.0, 0.0, 1.0];
+        let j = g(jets(x));
+        let v = |k: usize| D5::variable(Dual::variable(x[k], k), k);
+        let r = g([v(0), v(1), v(2), v(3), v(4)]);
+        let direction = |d: &[f64; 5]| (0..5).map(|k| d[k] * rate[k]).sum::<f64>();
+        // The two evaluations round differently: a few ulps of the largest term.
+        let close = |a: f64, b: f64| (a - b).abs() <= 1e-13 * (1.0 + b.abs());
+        assert!(close(j.v, r.re.re));
+        assert!(
+            close(j.d, direction(&r.re.eps)),
+            "d {} {}",
+            j.d,
+            direction(&r.re.eps)
+        );
+        for i in 0..2 {
+            assert!(close(j.gq[i], r.re.eps[i]), "gq {i}");
+            assert!(close(j.gp[i], r.re.eps[2 + i]), "gp {i}");
+            for k in 0..2 {
+                assert!(close(j.hessian(i, k), r.eps[2 + i].eps[2 + k]), "h {i} {k}");
+            }
+            let dp = direction(&r.eps[2 + i].eps);
+            assert!(close(j.dp[i], dp), "dp {i}: {} {dp}", j.dp[i]);
+        }
+    }
+
     /// A chain-like function of six coordinates: every part agrees with nested duals over all
     /// twelve variables.
     #[test]
@@ -814,6 +863,47 @@ mod tests {
         let x = p0 * p0 * t;
         // d/dt = p0^2 = 0.25; d/dt d/dp0 = 2 p0 = 1.
         assert_eq!((x.d, x.dp[0]), (0.25, 1.0));
+    }
+
+    /// A function of the coordinates alone leaves the velocity parts alone: near zero the
+    /// square root's second derivative overflows (here -inf), and a value without a velocity
+    /// gradient does not take it in, so `p0^2 (1 + sqrt(q0^2 + 1e-250))` keeps its finite
+    /// Hessian `2 (1 + 1e-125)`.
+    #[test]
+    fn coordinates_alone_touch_no_velocity_part() {
+        let [q0, _, p0, _, _] = jets([0.0, 0.0, 1.0, 0.0, 0.0]);
+        let root = (q0 * q0 + 1e-250).sqrt();
+        let x = p0 * p0 * (root + 1.0);
+        assert_eq!(x.hessian(0, 0), 2.0);
+        assert_eq!(x.dp, [0.0, 0.0]);
+    }
+
+    /// A Lagrangian may ask a value for its plain number or whether it is zero: a jet is
+    /// zero only when its value and every part are (each part alone makes it non-zero).
+    #[test]
+    fn zero_means_every_part_zero() {
+        let [q0, _, p0, _, t] = jets([0.0, 0.0, 0.0, 0.0, 0.0]);
+        assert_eq!((q0 + 0.25).value(), 0.25);
+        assert!(J::zero().is_zero() && (q0 * 0.0).is_zero());
+        assert!(!J::constant(1e-300).is_zero());
+        // q0 moves at 0.3: gq and d non-zero; t alone: d; p0: gp; p0 p0: h; p0 t: dp.
+        let mut only_gq = q0;
+        only_gq.d = 0.0;
+        let parts = [only_gq, t, p0, p0 * p0, p0 * t];
+        let flat = |x: &[f64; 2]| x.iter().all(|&e| e == 0.0);
+        for (k, x) in parts.into_iter().enumerate() {
+            let mut x = x;
+            x.v = 0.0;
+            let nonzero = [
+                x.d != 0.0,
+                !flat(&x.gq),
+                !flat(&x.gp),
+                !flat(&x.dp),
+                !x.h.iter().all(flat),
+            ];
+            assert_eq!(nonzero.iter().filter(|&&n| n).count(), 1, "part {k}: {x:?}");
+            assert!(!x.is_zero(), "part {k}: {x:?}");
+        }
     }
 
     /// A constant touches no derivative, and division by one is exact.

@@ -494,6 +494,86 @@ mod tests {
         Ok(())
     }
 
+    /// The bead of [`TimeShifted`] claiming a constant mass matrix (it is 1): the time term
+    /// still enters, and `dV/dq` with its sign, on the path that skips `T` but for that term.
+    struct TimeShiftedConstantMass;
+    impl Lagrangian<f64, 1> for TimeShiftedConstantMass {
+        const EXPLICIT_TIME: bool = true;
+        const CONSTANT_MASS: bool = true;
+        fn kinetic<S: Scalar<Real = f64>>(&self, t: S, q: &SVector<S, 1>, qd: &SVector<S, 1>) -> S {
+            TimeShifted.kinetic(t, q, qd)
+        }
+        fn potential<S: Scalar<Real = f64>>(&self, t: S, q: &SVector<S, 1>) -> S {
+            TimeShifted.potential(t, q)
+        }
+    }
+
+    #[test]
+    fn explicit_time_term_enters_with_a_constant_mass() -> Result<(), Error> {
+        let m = EulerLagrange::new(TimeShiftedConstantMass);
+        let a = m.acceleration(&State::new(3.0, [2.0], [0.5]))?;
+        // q'' = -1 - q, exactly in f64 at q = 2.
+        assert_eq!(a[0], -3.0);
+        Ok(())
+    }
+
+    /// Two coupled coordinates with a mass matrix that depends on `q`, a non-conservative
+    /// force of their own, and energies through the trait's defaults.
+    struct Coupled;
+    impl Lagrangian<f64, 2> for Coupled {
+        fn kinetic<S: Scalar<Real = f64>>(
+            &self,
+            _t: S,
+            q: &SVector<S, 2>,
+            qd: &SVector<S, 2>,
+        ) -> S {
+            // M = [[2 + cos q1, 0.5], [0.5, 1]].
+            let m00 = q[1].cos() + 2.0;
+            (m00 * qd[0] * qd[0] + qd[1] * qd[1]) * 0.5 + qd[0] * qd[1] * 0.5
+        }
+        fn potential<S: Scalar<Real = f64>>(&self, _t: S, q: &SVector<S, 2>) -> S {
+            q[0] * q[0] + q[0] * q[1] * 0.5 + q[1] * q[1] * 1.5
+        }
+        fn non_conservative_force(&self, s: &State<f64, 2>) -> SVector<f64, 2> {
+            SVector::<f64, 2>::new(-0.4 * s.qd[0] * s.q[1], -0.2 * s.qd[1].powi(3))
+        }
+    }
+
+    /// The defaults: `T`, `V` and their sum at a state, against the formulas.
+    #[test]
+    fn default_energies_are_the_formulas() {
+        let s = State::new(0.0, [0.3, -0.8], [1.5, -2.0]);
+        let t = 0.5 * ((2.0 + libm::cos(-0.8)) * 2.25 + 4.0) + 0.5 * 1.5 * -2.0;
+        let v = 0.09 + 0.5 * 0.3 * -0.8 + 1.5 * 0.64;
+        // The same operations in another order: a few ulps.
+        let close = |a: f64, b: f64| (a - b).abs() <= 1e-15 * (1.0 + b.abs());
+        assert!(close(Coupled.kinetic_energy(&s), t));
+        assert!(close(Coupled.potential_energy(&s), v));
+        assert!(close(Coupled.energy(&s), t + v));
+    }
+
+    /// The exact law Jacobian with the mechanism's own force and an extra force against
+    /// central differences of the law: both forces enter, each with its sign.
+    #[test]
+    fn law_jacobian_takes_both_forces() -> Result<(), Error> {
+        let m = EulerLagrange::new(Coupled);
+        let extra = |s: &State<f64, 2>| SVector::<f64, 2>::new(libm::sin(s.q[1]), s.qd[0] * s.q[0]);
+        let s = State::new(0.0, [0.3, -0.8], [1.5, -2.0]);
+        let (a, j) = m.law_jacobian(&s, &extra)?;
+        assert_eq!(a, m.law(&s, &extra)?);
+        let differences = central_difference_jacobian(&s, |x| {
+            m.law(x, &extra)
+                .unwrap_or_else(|_| SVector::from_element(f64::NAN))
+        });
+        // Central differences are good to about EPSILON^(2/3) ~ 4e-11 of the scale (entries
+        // of order one here); each force's Jacobian is of order 0.5 to 4.
+        for (exact, near) in [(j.wrt_q, differences.wrt_q), (j.wrt_qd, differences.wrt_qd)] {
+            let worst = (exact - near).abs().max();
+            assert!(worst < 1e-7, "{exact} {near}");
+        }
+        Ok(())
+    }
+
     /// `Error` must not be constructed out of nothing: a zero kinetic energy is singular.
     struct Massless;
     impl Lagrangian<f64, 2> for Massless {

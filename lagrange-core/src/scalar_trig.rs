@@ -39,6 +39,31 @@ pub(crate) fn sin_cos_lanesf<const L: usize>(x: [f32; L]) -> ([f32; L], [f32; L]
 
 #[cfg(test)]
 mod tests {
+    /// With `libm-trig`, the `f32` sines and cosines, alone and by lanes, are libm's bit for
+    /// bit, and so within an ulp of the `f64` ones rounded (libm's `sinf` computes in `f64`).
+    #[cfg(feature = "libm-trig")]
+    #[test]
+    fn libm_trig_f32_is_libm_bit_for_bit() {
+        let xs = [0.0f32, -0.0, 0.5, -1.25, 3.0, 100.0, -1e4, 1e-3];
+        let near = |got: f32, exact: f64| {
+            // One ulp of the f32 result: libm's f32 functions are within it.
+            let ulp = f64::from(f32::EPSILON) * exact.abs().max(f64::from(f32::MIN_POSITIVE));
+            (f64::from(got) - exact).abs() <= ulp
+        };
+        for x in xs {
+            let (s, c) = super::sin_cosf(x);
+            assert_eq!(s.to_bits(), libm::sinf(x).to_bits(), "sin({x:e})");
+            assert_eq!(c.to_bits(), libm::cosf(x).to_bits(), "cos({x:e})");
+            assert!(near(s, libm::sin(f64::from(x))), "sin({x:e}) = {s:e}");
+            assert!(near(c, libm::cos(f64::from(x))), "cos({x:e}) = {c:e}");
+        }
+        let (s, c) = super::sin_cos_lanesf(xs);
+        for (i, x) in xs.into_iter().enumerate() {
+            assert_eq!(s[i].to_bits(), libm::sinf(x).to_bits(), "lane sin({x:e})");
+            assert_eq!(c[i].to_bits(), libm::cosf(x).to_bits(), "lane cos({x:e})");
+        }
+    }
+
     /// `sin_cos` must be bit for bit `libm`'s `sin` and `cos`: the hand-derived laws, the
     /// automatic path and users' own code mix the two forms, and results are compared bit for
     /// bit across them. Swept: a few hundred arguments in every binade from the subnormals to

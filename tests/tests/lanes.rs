@@ -5,7 +5,7 @@
 //! `lagrange-core/tests/fast_trig.rs`.)
 
 use lagrange_core::nalgebra::SVector;
-use lagrange_core::{check_finite, divergences, Error, Lanes, Mechanism, Real, State};
+use lagrange_core::{check_finite, divergences, Error, Lanes, Mechanism, Real, Scalar, State};
 use lagrange_integrators::scene::{Bank, NeverSleeps, Scene};
 use lagrange_integrators::{
     ExplicitEuler, FixedTimestep, Integrator, Rk4, SemiImplicitEuler, VelocityVerlet,
@@ -284,7 +284,123 @@ fn a_lane_that_blows_up_fails_the_group<T: Real>() -> Result<(), Error> {
     Ok(())
 }
 
+/// Zero and one, and whether a number is zero, through the bound (`Scalar` asks for
+/// `num_traits`' `Zero` and `One`).
+fn zero<S: Scalar>() -> S {
+    S::zero()
+}
+fn one<S: Scalar>() -> S {
+    S::one()
+}
+fn is_zero<S: Scalar>(x: &S) -> bool {
+    x.is_zero()
+}
+
+/// Every lane of `got` is `f` of its index, bit for bit (the operands are finite and so are
+/// the results: `==` is bitwise there, but for the sign of zero, which none has).
+fn lane_by_lane<T: Real>(got: Lanes<T, L>, f: impl Fn(usize) -> T, what: &str) {
+    for i in 0..L {
+        assert!(got.0[i] == f(i), "{what}, lane {i}: {got:?}");
+    }
+}
+
+/// Every operation of `Lanes` is the scalar one in each lane, bit for bit, and comparisons
+/// that hold in every lane or in none answer as the scalar ones would, counting nothing; the
+/// numbers print lane by lane.
+fn every_operation_lane_by_lane<T: Real>() -> Result<(), Error> {
+    let before = divergences();
+    let at = |i: usize, a: f64, b: f64| T::from_f64(a + b * i as f64);
+    let x = Lanes::<T, L>::from_fn(|i| at(i, 0.3, 0.25));
+    let y = Lanes::<T, L>::from_fn(|i| at(i, -1.1, 0.45));
+    let z = Lanes::<T, L>::from_fn(|i| at(i, -0.9, 0.25));
+    let c = T::from_f64(1.75);
+    let (xs, ys, zs) = (x.0, y.0, z.0);
+    lane_by_lane(x + y, |i| xs[i] + ys[i], "+");
+    lane_by_lane(x - y, |i| xs[i] - ys[i], "-");
+    lane_by_lane(x * y, |i| xs[i] * ys[i], "*");
+    lane_by_lane(x / y, |i| xs[i] / ys[i], "/");
+    lane_by_lane(x + c, |i| xs[i] + c, "+ c");
+    lane_by_lane(x / c, |i| xs[i] / c, "/ c");
+    let mut w = x;
+    w *= y;
+    w -= c;
+    lane_by_lane(w, |i| xs[i] * ys[i] - c, "*= -=");
+    lane_by_lane(-y, |i| -ys[i], "neg");
+    lane_by_lane(x.sin(), |i| xs[i].sin(), "sin");
+    lane_by_lane(x.cos(), |i| xs[i].cos(), "cos");
+    let (s, co) = y.sin_cos();
+    lane_by_lane(s, |i| ys[i].sin(), "sin_cos.0");
+    lane_by_lane(co, |i| ys[i].cos(), "sin_cos.1");
+    let ([s2], [c2]) = <Lanes<T, L> as Real>::sin_cos_lanes([y]);
+    lane_by_lane(s2, |i| ys[i].sin(), "sin_cos_lanes.0");
+    lane_by_lane(c2, |i| ys[i].cos(), "sin_cos_lanes.1");
+    lane_by_lane(z.tan(), |i| zs[i].tan(), "tan");
+    lane_by_lane(x.sqrt(), |i| xs[i].sqrt(), "sqrt");
+    lane_by_lane(y.exp(), |i| ys[i].exp(), "exp");
+    lane_by_lane(x.ln(), |i| xs[i].ln(), "ln");
+    lane_by_lane(y.abs(), |i| ys[i].abs(), "abs");
+    lane_by_lane(y.recip(), |i| ys[i].recip(), "recip");
+    lane_by_lane(y.powi(3), |i| ys[i].powi(3), "powi 3");
+    lane_by_lane(x.powi(-2), |i| xs[i].powi(-2), "powi -2");
+    lane_by_lane(y.atan2(x), |i| ys[i].atan2(xs[i]), "atan2");
+    lane_by_lane(x.powf(y), |i| xs[i].powf(ys[i]), "powf");
+    lane_by_lane(x.max(y), |i| xs[i].max(ys[i]), "max");
+    lane_by_lane(x.min(y), |i| xs[i].min(ys[i]), "min");
+    lane_by_lane(
+        (y * T::from_f64(3.0)).floor(),
+        |i| (ys[i] * T::from_f64(3.0)).floor(),
+        "floor",
+    );
+    lane_by_lane(
+        (y * T::from_f64(3.0)).round(),
+        |i| (ys[i] * T::from_f64(3.0)).round(),
+        "round",
+    );
+    lane_by_lane(z.asin(), |i| zs[i].asin(), "asin");
+    lane_by_lane(z.acos(), |i| zs[i].acos(), "acos");
+    lane_by_lane(y.atan(), |i| ys[i].atan(), "atan");
+    lane_by_lane(Scalar::value(x), |i| xs[i], "value");
+    lane_by_lane(
+        <Lanes<T, L> as Scalar>::from_real(y),
+        |i| ys[i],
+        "from_real",
+    );
+    lane_by_lane(
+        Lanes::<T, L>::from_f64(2.5),
+        |_| T::from_f64(2.5),
+        "from_f64",
+    );
+    lane_by_lane(
+        Lanes::<T, L>::from_f32(2.5),
+        |_| T::from_f64(2.5),
+        "from_f32",
+    );
+    lane_by_lane(zero(), |_| T::zero(), "zero");
+    lane_by_lane(one(), |_| T::one(), "one");
+    assert!(is_zero(&zero::<Lanes<T, L>>()) && !is_zero(&x));
+    // A uniform value reads as a plain number.
+    assert_eq!(Lanes::<T, L>::splat(c).to_f64(), c.to_f64());
+    assert_eq!(Lanes::<T, L>::splat(c).to_f32(), c.to_f32());
+    assert!(x.is_finite());
+    // Comparisons that hold in every lane or in none.
+    let x1 = x + T::one();
+    let answers = |a: &Lanes<T, L>, b: &Lanes<T, L>| [a < b, a <= b, a > b, a >= b, a == b, a != b];
+    assert_eq!(answers(&x, &x1), [true, true, false, false, false, true]);
+    assert_eq!(answers(&x, &x), [false, true, false, true, true, false]);
+    assert_eq!(answers(&x1, &x), [false, false, true, true, false, true]);
+    assert_eq!(x.partial_cmp(&x1), Some(core::cmp::Ordering::Less));
+    assert_eq!(x.partial_cmp(&x), Some(core::cmp::Ordering::Equal));
+    assert_eq!(x1.partial_cmp(&x), Some(core::cmp::Ordering::Greater));
+    assert_eq!(divergences(), before);
+    // Printed lane by lane.
+    let two = Lanes([T::from_f64(1.5), T::from_f64(-2.0), T::from_f64(0.25)]);
+    assert_eq!(format!("{two}"), "[1.5, -2, 0.25]");
+    assert_eq!(format!("{two:e}"), "[1.5e0, -2e0, 2.5e-1]");
+    Ok(())
+}
+
 for_f32_and_f64!(
+    every_operation_lane_by_lane,
     every_gathering_mechanism,
     a_bank_in_lanes_equals_its_instances_alone,
     result_tests_hold_in_every_lane_and_count_nothing,

@@ -107,4 +107,36 @@ fn a_branch_on_finiteness_counts<T: Real>() -> Result<(), Error> {
     Ok(())
 }
 
-for_f32_and_f64!(diverging_lanes_fall_back, a_branch_on_finiteness_counts);
+/// A comparison the lanes disagree on is false (an ordering, none) and counts a divergence,
+/// each; so does reading lanes that differ as one plain number (the first lane's).
+fn a_split_comparison_is_false_and_counts<T: Real>() -> Result<(), Error> {
+    let x = Lanes::<T, L>::from_fn(|i| T::from_f64(i as f64));
+    let mid = Lanes::<T, L>::splat(T::from_f64(3.5));
+    let counting = cfg!(target_has_atomic = "32");
+    let mut count = divergences().unwrap_or(0);
+    let mut check = |answer: bool, what: &str| {
+        assert!(!answer, "{what}");
+        let now = divergences().unwrap_or(0);
+        if counting {
+            assert!(now > count, "{what} went uncounted");
+        }
+        count = now;
+    };
+    check(x < mid, "<");
+    check(x <= mid, "<=");
+    check(x > mid, ">");
+    check(x >= mid, ">=");
+    check(
+        x == Lanes::from_fn(|i| T::from_f64(if i == 2 { 9.0 } else { i as f64 })),
+        "==",
+    );
+    check(x.partial_cmp(&mid).is_some(), "partial_cmp");
+    check(x.to_f64() != 0.0, "to_f64 (the first lane)");
+    Ok(())
+}
+
+for_f32_and_f64!(
+    diverging_lanes_fall_back,
+    a_branch_on_finiteness_counts,
+    a_split_comparison_is_false_and_counts
+);
