@@ -73,7 +73,7 @@ fn along<T: Real>(s: &State<T, 2>) -> f64 {
 /// is along the slope at the end.
 fn slide<T: Real, I>(inner: I, mu: f64, dt: f64, seconds: f64) -> Result<f64, Error>
 where
-    I: Integrator<T, 2, EulerLagrange<T, 2, Point>> + Method,
+    I: Integrator<T, 2, EulerLagrange<T, 2, Point>> + Method + Clone,
 {
     let point = EulerLagrange::new(Point);
     let model =
@@ -141,7 +141,7 @@ struct Bounces {
 /// height between two impacts), and the first time it rests (speed zero in contact).
 fn bounce<T: Real, I>(inner: I, dt: f64) -> Result<Bounces, Error>
 where
-    I: Integrator<T, 1, FallingParticle<T>> + Method,
+    I: Integrator<T, 1, FallingParticle<T>> + Method + Clone,
 {
     let ball = FallingParticle::new(T::one(), T::from_f64(G))?;
     let model = ContactModel::new(T::from_f64(0.5), T::from_f64(0.05), T::one())?;

@@ -120,7 +120,7 @@ function buildPanels(names) {
     const error = el('div', { className: 'error' }, box);
     const ui = { canvas, plot, method, dtRange, dtText, info, error, errorUntil: 0,
       samples: [], view: { ...VIEWS[p] }, status: 0,
-      cost: { ms: 0, steps: 0, since: 0, shown: '' } };
+      cost: { ms: 0, steps: 0, since: 0, shown: '' }, slowest: 0 };
     state.panels.push(ui);
     method.addEventListener('change', () => {
       if (ex().lg_set_method(p, Number(method.value)) !== 0) showError(p, text());
@@ -391,7 +391,11 @@ function frame(now) {
       ui.status = ex().lg_advance(p, elapsed);
       ui.cost.ms += performance.now() - start;
       const steps = Math.round((ex().lg_time(p) - before) / ex().lg_dt(p));
-      if (steps > 0) ui.cost.steps += steps;
+      if (steps > 0) {
+        ui.cost.steps += steps;
+        // The frame's time per step: the slowest step's, where a frame takes one.
+        ui.slowest = Math.max(ui.slowest, (performance.now() - start) / steps);
+      }
       if (now - ui.cost.since > 5000) {
         ui.cost.shown = ui.cost.steps > 0 ? `, ${(1000 * ui.cost.ms / ui.cost.steps).toFixed(1)} µs/step` : '';
         Object.assign(ui.cost, { ms: 0, steps: 0, since: now });
@@ -468,6 +472,14 @@ window.lagrangeScreenPoint = function screenPoint(p, k) {
     r.top + t.y(at[1]) * r.height / ui.canvas.height]);
 };
 
+// Back to the start (a mechanism thrown again), as the reset button does.
+window.lagrangeReset = function reset(p) {
+  if (!ready()) return NOT_READY;
+  ex().lg_reset(p);
+  refreshDt(p);
+  return 'ok';
+};
+
 // Chooses as a user would: `select` (an id, or panel p's integrator picker) set to `value`.
 window.lagrangeChoose = function choose(p, value) {
   if (!ready()) return NOT_READY;
@@ -489,6 +501,9 @@ window.lagrangeProbe = function probe() {
     cartX: points(4).main[0]?.[0] ?? null,
     double: state.double,
     methods: state.panels.map((ui) => Number(ui.method.value)),
+    slowest: state.panels.map((ui) => ui.slowest),
+    work: state.panels.map((_, p) => [ex().lg_work(p, 0), ex().lg_work(p, 1)]),
+    roundsCap: ex().lg_rounds_cap(),
     scenario: state.scenario,
     nonFinite: state.nonFinite,
   });
@@ -503,8 +518,8 @@ async function main() {
   state.wasm = instance;
   const names = ['origin\'s pendulum (orange) beside its exact solution (blue, dashed)',
     'chaotic double pendulum, a faint twin 1e-9 rad away', 'chain of 8 links', 'four-bar linkage',
-    'cart-pole: balance it with ← →', 'double pendulum falling onto a floor (ContactStepper)',
-    'ragdoll thrown onto the floor (ContactStepper)'];
+    'cart-pole: balance it with ← →', 'double pendulum falling onto a floor (ImpulseStepper)',
+    'ragdoll thrown onto the floor (ImpulseStepper)'];
   buildPanels(names.slice(0, ex().lg_panels()));
   const precision = document.getElementById('precision');
   precision.addEventListener('change', () => init(precision.value === '1'));

@@ -164,6 +164,21 @@ pub extern "C" fn lg_input(panel: u32, value: f64) -> u32 {
     with_panel(panel, 1, |p| code(p.set_input(value)))
 }
 
+/// The worst work of any contact step of panel `panel` since the page loaded: `which` 0 the
+/// rows solved, 1 the rounds of the solves (0 for a panel without contacts).
+#[no_mangle]
+pub extern "C" fn lg_work(panel: u32, which: u32) -> u32 {
+    with_panel(panel, 0, |p| {
+        p.work().get(which as usize).copied().unwrap_or(0)
+    })
+}
+
+/// The cap on the rounds of a contact step on the page (see `ImpulseStepper`'s work).
+#[no_mangle]
+pub extern "C" fn lg_rounds_cap() -> u32 {
+    crate::setups::CONTACT_ROUNDS_CAP
+}
+
 /// Resets panel `panel` to its start.
 #[no_mangle]
 pub extern "C" fn lg_reset(panel: u32) {

@@ -9,7 +9,8 @@ use lagrange_core::{
 };
 use lagrange_integrators::scene::{Bank, Id, Sleeps};
 use lagrange_integrators::{
-    ContactModel, ContactStepper, Integrator, Projected, Rk4, SemiImplicitEuler, StormerVerlet,
+    ContactModel, ImpulseSettings, ImpulseStepper, Integrator, Projected, Rk4, SemiImplicitEuler,
+    StormerVerlet,
 };
 use lagrange_systems::exact::pendulum_from_rest;
 use lagrange_systems::{
@@ -220,6 +221,30 @@ where
     bank.set_input(id, T::from_f64(force))
 }
 
+/// The contact solver's settings on the page: 2 mm (or 2 mrad) of slop, above a step's free
+/// fall at 120 Hz (0.7 mm), and at most 4 rounds a solve.
+fn impulse_settings<T: Real>() -> Result<ImpulseSettings<T>, Error> {
+    ImpulseSettings::new(T::from_f64(CONTACT_SLOP), CONTACT_ITERATIONS)
+}
+
+/// The contact solver's slop on the page, m (or rad).
+const CONTACT_SLOP: f64 = 2e-3;
+
+/// The contact solver's cap on rounds per solve on the page.
+pub const CONTACT_ITERATIONS: u32 = 4;
+
+/// The most rounds a step of the page's contact solver may take: four solves (the plastic
+/// one, two more with speculative rows, the rebound), each capped.
+pub const CONTACT_ROUNDS_CAP: u32 = 4 * CONTACT_ITERATIONS;
+
+/// The worst `[rows, rounds]` of an impulse stepper's steps.
+fn peak_work<T: Real, const N: usize, const C: usize, I, K>(
+    stepper: &ImpulseStepper<T, N, C, I, K>,
+) -> [u32; 2] {
+    let peak = stepper.peak_report();
+    [peak.rows, peak.rounds]
+}
+
 /// Mechanism `kind` (an index of [`KINDS`]) in `T`, stepped by `method` (an index of
 /// [`METHODS`]).
 ///
@@ -241,6 +266,7 @@ pub fn make<T: Real>(kind: usize, method: usize) -> Result<Box<dyn Panel>, Error
                 points: pendulum_points,
                 exact: Some(exact_pendulum),
                 input: None,
+                work: None,
             }))
         }
         1 => {
@@ -259,6 +285,7 @@ pub fn make<T: Real>(kind: usize, method: usize) -> Result<Box<dyn Panel>, Error
                 points: double_points,
                 exact: None,
                 input: None,
+                work: None,
             }))
         }
         2 => {
@@ -279,6 +306,7 @@ pub fn make<T: Real>(kind: usize, method: usize) -> Result<Box<dyn Panel>, Error
                 points: chain_points,
                 exact: None,
                 input: None,
+                work: None,
             }))
         }
         3 => {
@@ -305,6 +333,7 @@ pub fn make<T: Real>(kind: usize, method: usize) -> Result<Box<dyn Panel>, Error
                 points: four_bar_points,
                 exact: None,
                 input: None,
+                work: None,
             }))
         }
         4 => {
@@ -326,6 +355,7 @@ pub fn make<T: Real>(kind: usize, method: usize) -> Result<Box<dyn Panel>, Error
                 points: cart_points,
                 exact: None,
                 input: Some(push),
+                work: None,
             }))
         }
         5 => {
@@ -336,41 +366,39 @@ pub fn make<T: Real>(kind: usize, method: usize) -> Result<Box<dyn Panel>, Error
                 [T::from_f64(1.6), T::from_f64(2.2)],
                 [T::from_f64(2.0), T::from_f64(-6.0)],
             );
-            let model =
-                ContactModel::new(T::from_f64(0.5), T::from_f64(0.1), pick::<T>(1e-5, 1e-9))?;
-            let projection = Projection::new(pick::<T>(1e-5, 1e-10), 6)?;
+            let model = ContactModel::new(T::from_f64(0.5), T::from_f64(0.1), T::one())?;
             let contacts = Holonomic::new(FloorAndLimits);
             by_method!(method, T, 2, |i| boxed(Recipe {
                 mechanism,
                 start,
                 twin: None,
-                integrator: ContactStepper::new(i, contacts, model, projection),
+                integrator: ImpulseStepper::new(i, contacts, model, impulse_settings()?),
                 sleep: sleeps(1e-4, 1e-2)?,
                 dt: 1.0 / 240.0,
                 energy_scale: 3.0 * G,
                 points: double_points,
                 exact: None,
                 input: None,
+                work: Some(peak_work),
             }))
         }
         6 => {
             let mechanism = Ragdoll::new(RagdollBody::adult())?;
-            let model =
-                ContactModel::new(T::from_f64(0.3), T::from_f64(0.3), pick::<T>(1e-4, 1e-5))?
-                    .with_friction(T::from_f64(0.8))?;
-            let projection = Projection::new(pick::<T>(1e-4, 1e-9), 8)?;
+            let model = ContactModel::new(T::from_f64(0.3), T::from_f64(0.3), T::one())?
+                .with_friction(T::from_f64(0.8))?;
             let contacts = RagdollContacts::adult(&mechanism, T::zero())?;
             by_method!(method, T, RAGDOLL_COORDINATES, |i| boxed(Recipe {
                 mechanism,
                 start: thrown(),
                 twin: None,
-                integrator: ContactStepper::new(i, contacts, model, projection),
+                integrator: ImpulseStepper::new(i, contacts, model, impulse_settings()?),
                 sleep: sleeps(1e-3, 1e-2)?,
                 dt: 1.0 / 120.0,
                 energy_scale: 70.0 * G,
                 points: ragdoll_points,
                 exact: None,
                 input: None,
+                work: Some(peak_work),
             }))
         }
         _ => Err(Error::InvalidParameter {

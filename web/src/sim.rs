@@ -52,6 +52,9 @@ pub trait Panel {
     fn reset(&mut self);
     /// The last error, once: taken by the call.
     fn take_error(&mut self) -> Option<Error>;
+    /// The worst work of any step since the page loaded, `[rows, rounds]` (zero for
+    /// integrators that do not report it).
+    fn work(&self) -> [u32; 2];
 }
 
 /// How many points of each group [`Panel::points`] wrote.
@@ -103,6 +106,9 @@ pub struct Recipe<T: Real, const N: usize, M, I> {
     pub exact: Option<ExactFn>,
     /// The input, for a mechanism that has one.
     pub input: Option<InputFn<T, N, M, I>>,
+    /// The worst work of the integrator's steps so far, `[rows, rounds]`, for one that
+    /// reports it (a time-stepping contact solver).
+    pub work: Option<fn(&I) -> [u32; 2]>,
 }
 
 /// One mechanism in its scene.
@@ -114,6 +120,8 @@ pub struct Sim<T: Real, const N: usize, M, I> {
     e0: f64,
     exact_valid: bool,
     error: Option<Error>,
+    /// The worst work of any step since the page loaded (resets and rebuilds included).
+    peak: [u32; 2],
 }
 
 /// A scene over a new bank of the recipe's instances at `states`, stepped by `dt`.
@@ -159,6 +167,7 @@ where
             e0,
             exact_valid,
             error: None,
+            peak: [0; 2],
         })
     }
 
@@ -228,6 +237,18 @@ where
         if let Some(e) = failure {
             self.fail(e);
         }
+        if let Some(work) = self.recipe.work {
+            for &id in &self.ids {
+                if let Ok(i) = self.scene.banks().integrator(id) {
+                    let [rows, rounds] = work(i);
+                    self.peak = [self.peak[0].max(rows), self.peak[1].max(rounds)];
+                }
+            }
+        }
+    }
+
+    fn work(&self) -> [u32; 2] {
+        self.peak
     }
 
     fn points(&self, out: &mut Vec<f64>) -> PointCounts {

@@ -404,6 +404,7 @@ fn drive(
         times(&second)
     );
     failures.extend(interact(browser, site)?);
+    failures.extend(throws(browser)?);
 
     // Bad input: the library's errors shown, the instances reset, nothing non-finite drawn,
     // and the page still running.
@@ -583,6 +584,56 @@ fn interact(browser: &mut Browser, site: &Path) -> Result<Vec<String>, String> {
             "switching precision or integrator failed: {after:?}"
         )),
         Err(e) => failures.push(format!("the page froze after switching precision: {e}")),
+    }
+    Ok(failures)
+}
+
+/// The panels with contacts (the double pendulum on the floor, the ragdoll) and their rows.
+const CONTACT_PANELS: [(usize, u32); 2] = [(5, 4), (RAGDOLL_PANEL, 31)];
+
+/// How long the contact panels are thrown again and again, and how often.
+const THROWS_FOR: Duration = Duration::from_secs(10);
+const THROW_EVERY: Duration = Duration::from_millis(1250);
+
+/// The contact panels thrown again (reset to their thrown start) every 1.25 s for 10 s: the
+/// slowest step each took in WebAssembly, reported (a time, which depends on the machine), and
+/// the worst work of any of their steps, checked against the contact solver's documented
+/// cap (counts, which do not): rows at most the contact set's, rounds at most the page's cap.
+fn throws(browser: &mut Browser) -> Result<Vec<String>, String> {
+    let mut failures = Vec::new();
+    let clock = Instant::now();
+    let mut thrown = 0;
+    while clock.elapsed() < THROWS_FOR {
+        for (panel, _) in CONTACT_PANELS {
+            browser.eval(&format!("window.lagrangeReset({panel})"))?;
+        }
+        thrown += 1;
+        browser.idle(THROW_EVERY);
+    }
+    let state = probe(browser)?;
+    let cap = state.get("roundsCap").num().unwrap_or(0.0);
+    for (panel, rows_cap) in CONTACT_PANELS {
+        let slowest = state
+            .get("slowest")
+            .items()
+            .get(panel)
+            .and_then(Json::num)
+            .unwrap_or(f64::NAN);
+        let work = state.get("work").items().get(panel).map(Json::items);
+        let count = |k: usize| work.and_then(|w| w.get(k)).and_then(Json::num);
+        let (rows, rounds) = (count(0), count(1));
+        println!(
+            "page: panel {panel} thrown {thrown} times in {} s: slowest step {slowest:.3} ms in \
+             WebAssembly; worst work {rows:?} rows, {rounds:?} rounds (caps {rows_cap}, {cap})",
+            THROWS_FOR.as_secs()
+        );
+        match (rows, rounds) {
+            (Some(r), Some(k)) if r <= f64::from(rows_cap) && k <= cap && r > 0.0 => {}
+            _ => failures.push(format!(
+                "panel {panel}: a contact step did more work than its cap, or none: rows \
+                 {rows:?} (cap {rows_cap}), rounds {rounds:?} (cap {cap})"
+            )),
+        }
     }
     Ok(failures)
 }

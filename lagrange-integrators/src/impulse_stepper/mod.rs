@@ -12,7 +12,7 @@ pub use settings::ImpulseSettings;
 use crate::integrator::{check_run_step, check_step, continues, step_loop};
 use crate::{Cost, Failure, Integrator, Method, Work};
 use lagrange_core::constraints::contact::{
-    within_kinetic_energy, ActiveRows, ContactModel, Contacts, Delassus, Row,
+    within_kinetic_energy, ContactModel, Contacts, Delassus, Row,
 };
 use lagrange_core::nalgebra::{SMatrix, SVector};
 use lagrange_core::{Error, Mechanism, Real, State};
@@ -120,15 +120,36 @@ pub struct ImpulseStepper<T: Real, const N: usize, const C: usize, I, K> {
     model: ContactModel<T>,
     settings: ImpulseSettings<T>,
     bilateral: [bool; C],
+    memory: Memory<T, N, C>,
+}
+
+/// What an [`ImpulseStepper`] keeps between steps.
+#[derive(Debug, Clone, Copy)]
+struct Memory<T: Real, const N: usize, const C: usize> {
     /// The last step's impulses, its end state and that state's energy `T + V`.
     last: Option<(Impulses<T, C>, State<T, N>, T)>,
     /// The rows that pushed in the last step (or were bilateral): the contacts resting at its
     /// end, which a body the scheme brought to rest may touch from up to `dt^2 g` above.
     pushed: [bool; C],
     report: ImpulseReport,
-    /// The normal rows of a step, rebuilt in place each step (so that a step does not clear
-    /// and move their `C x C` storage).
-    work: Delassus<T, N, C>,
+    /// The largest counts of any step since the stepper was made or
+    /// [`ImpulseStepper::clear_peak`].
+    peak: ImpulseReport,
+    /// The last step's size, for the sleep test's trial step.
+    dt: Option<T>,
+}
+
+impl<T: Real, const N: usize, const C: usize> Memory<T, N, C> {
+    /// Nothing yet.
+    fn fresh() -> Self {
+        Self {
+            last: None,
+            pushed: [false; C],
+            report: ImpulseReport::default(),
+            peak: ImpulseReport::default(),
+            dt: None,
+        }
+    }
 }
 
 impl<T: Real, const N: usize, const C: usize, I, K> ImpulseStepper<T, N, C, I, K> {
@@ -146,10 +167,7 @@ impl<T: Real, const N: usize, const C: usize, I, K> ImpulseStepper<T, N, C, I, K
             model,
             settings,
             bilateral: [false; C],
-            last: None,
-            pushed: [false; C],
-            report: ImpulseReport::default(),
-            work: Delassus::empty(),
+            memory: Memory::fresh(),
         }
     }
 
@@ -159,23 +177,37 @@ impl<T: Real, const N: usize, const C: usize, I, K> ImpulseStepper<T, N, C, I, K
     pub fn with_bilateral(self, rows: [bool; C]) -> Self {
         Self {
             bilateral: rows,
-            last: None,
+            memory: Memory::fresh(),
             ..self
         }
     }
 
-    /// What the last step did: rows in contact, sweeps, whether the solve settled, whether
+    /// What the last step did: rows in contact, rounds, whether the solve settled, whether
     /// the energy guard acted.
     #[must_use]
     pub fn last_report(&self) -> ImpulseReport {
-        self.report
+        self.memory.report
+    }
+
+    /// The worst of the steps since the stepper was made or [`ImpulseStepper::clear_peak`]:
+    /// the largest counts of any step, and the flags of any (`settled` when every step
+    /// settled). What a firmware budget is checked against.
+    #[must_use]
+    pub fn peak_report(&self) -> ImpulseReport {
+        self.memory.peak
+    }
+
+    /// Starts [`ImpulseStepper::peak_report`] afresh.
+    pub fn clear_peak(&mut self) {
+        self.memory.peak = ImpulseReport::default();
     }
 
     /// The impulses of the last step along each row's normal and its tangent (zero where a
     /// row took no part): `|tangent_i| <= mu normal_i` for every contact.
     #[must_use]
     pub fn impulses(&self) -> ([T; C], [T; C]) {
-        self.last
+        self.memory
+            .last
             .map_or(([T::zero(); C], [T::zero(); C]), |(p, _, _)| {
                 (p.normal.into(), p.tangent)
             })
@@ -201,10 +233,10 @@ impl<T: Real, const N: usize, const C: usize, I, K> ImpulseStepper<T, N, C, I, K
 
     /// `f`, and the stepper as it was (warm start, report) when `f` fails.
     fn transaction<V, E>(&mut self, f: impl FnOnce(&mut Self) -> Result<V, E>) -> Result<V, E> {
-        let saved = (self.last, self.pushed, self.report);
+        let saved = self.memory;
         let result = f(self);
         if result.is_err() {
-            (self.last, self.pushed, self.report) = saved;
+            self.memory = saved;
         }
         result
     }
@@ -222,21 +254,42 @@ where
         M: Mechanism<T, N>,
         I: Integrator<T, N, M>,
     {
-        let (warm, start_energy) = match self.last {
+        let free = self.integrator.run_step(mechanism, s, dt)?;
+        let (end, memory) = self.contacts_of(mechanism, s, free, dt, &self.memory)?;
+        self.memory = memory;
+        Ok(end)
+    }
+
+    /// The contacts' part of a step from `s` whose free step reached `free`, with `memory` of
+    /// the steps before: the end state, and the memory after.
+    fn contacts_of<M>(
+        &self,
+        mechanism: &M,
+        s: &State<T, N>,
+        free: State<T, N>,
+        dt: T,
+        memory: &Memory<T, N, C>,
+    ) -> Result<(State<T, N>, Memory<T, N, C>), Error>
+    where
+        M: Mechanism<T, N>,
+    {
+        let (warm, start_energy) = match memory.last {
             Some((p, last, e)) if continues(&last, s) => (p.tangent, Some(e)),
             _ => ([T::zero(); C], None),
         };
-        let free = self.integrator.run_step(mechanism, s, dt)?;
+        let mut next = *memory;
+        next.dt = Some(dt);
         let gaps = finite_gaps(self.contacts.position_residual(&free.q))?;
         let touching: [bool; C] =
             core::array::from_fn(|i| self.bilateral[i] || gaps[i] <= T::zero());
         let in_contact = touching.iter().filter(|&&t| t).count();
         if in_contact == 0 {
-            self.report = ImpulseReport::default();
+            next.report = ImpulseReport::default();
             // The energy of a state no row touches is not needed: marked unknown.
-            self.last = Some((Impulses::zero(), free, T::INFINITY));
-            self.pushed = [false; C];
-            return Ok(free);
+            next.last = Some((Impulses::zero(), free, T::INFINITY));
+            next.pushed = [false; C];
+            next.peak = next.peak.worst(&next.report);
+            return Ok((free, next));
         }
         if self
             .settings
@@ -250,11 +303,12 @@ where
         }
         let (jacobian, tangent_rows) = self.contacts.jacobians(&free.q);
         let jacobian = finite_rows(jacobian, &[true; C])?;
-        let tangent = self.mobilities(mechanism, &free, &jacobian, tangent_rows, &touching)?;
+        let (mut normal, tangent) =
+            self.mobilities(mechanism, &free, &jacobian, tangent_rows, &touching)?;
         let kinds = Row::kinds(&self.bilateral);
         // The rows that pushed in the last step: the first guess of each solve's active rows.
         let guess = if start_energy.is_some() {
-            self.pushed
+            memory.pushed
         } else {
             touching
         };
@@ -279,27 +333,27 @@ where
             }
             .solve(&free.qd, target, warm, rounds, tolerance)
         };
-        let mut plastic = solve(&mut self.work, &target, &warm)?;
+        let mut plastic = solve(&mut normal, &target, &warm)?;
         let (mut taken, mut speculative) = (plastic.rounds, 0u32);
         for _ in 0..SPECULATIVE_ROUNDS {
             let reach = jacobian * ((plastic.velocity - free.qd) * share) + gaps;
             let joining: [bool; C] =
-                core::array::from_fn(|i| !self.work.candidates()[i] && reach[i] < -slop);
+                core::array::from_fn(|i| !normal.candidates()[i] && reach[i] < -slop);
             if share <= T::zero() || !joining.iter().any(|&j| j) {
                 break;
             }
-            self.work.extend(&jacobian, jump, &joining)?;
+            normal.extend(&jacobian, jump, &joining)?;
             for i in (0..C).filter(|&i| joining[i]) {
                 target[i] = w[i] - gaps[i] / share;
                 speculative += 1;
             }
-            plastic = solve(&mut self.work, &target, &plastic.impulses.tangent)?;
+            plastic = solve(&mut normal, &target, &plastic.impulses.tangent)?;
             taken += plastic.rounds;
         }
         let rebound = self.rebounds(&gaps, &w);
         let solved = if rebound.iter().any(|&r| r > T::zero()) {
             let bounce = target.zip_map(&rebound, |t, r| t.max(r));
-            let bounced = solve(&mut self.work, &bounce, &plastic.impulses.tangent)?;
+            let bounced = solve(&mut normal, &bounce, &plastic.impulses.tangent)?;
             taken += bounced.rounds;
             Solved {
                 settled: plastic.settled && bounced.settled,
@@ -309,7 +363,13 @@ where
             plastic
         };
         let shift = (plastic.velocity - free.qd) * share;
-        let (dq, corrected) = self.drift(&jacobian, jacobian * shift + gaps, &kinds, jump)?;
+        let (dq, corrected) = self.drift(
+            &mut normal,
+            &jacobian,
+            jacobian * shift + gaps,
+            &kinds,
+            jump,
+        )?;
         let end = State {
             t: free.t,
             q: free.q + shift + dq,
@@ -319,8 +379,8 @@ where
         let count = |rows: &[bool; C]| {
             u32::try_from(rows.iter().filter(|&&r| r).count()).unwrap_or(u32::MAX)
         };
-        self.report = ImpulseReport {
-            rows: count(self.work.candidates()),
+        next.report = ImpulseReport {
+            rows: count(normal.candidates()),
             speculative,
             frictional: count(&core::array::from_fn(|i| tangent[i].is_some())),
             rounds: taken,
@@ -328,25 +388,27 @@ where
             corrected,
             energy_guard: guarded,
         };
-        self.pushed =
+        next.pushed =
             core::array::from_fn(|i| self.bilateral[i] || solved.impulses.normal[i] > T::zero());
-        self.last = Some((solved.impulses, end, energy));
-        Ok(end)
+        next.last = Some((solved.impulses, end, energy));
+        next.peak = next.peak.worst(&next.report);
+        Ok((end, next))
     }
 
-    /// The rows of a step at `state`: the normal rows in `touching` into the work's
-    /// [`Delassus`], and the tangents of those contacts (where the model has friction and
+    /// The rows of a step at `state`: the normal rows in `touching` (their [`Delassus`]), and
+    /// the tangents of those contacts (where the model has friction and
     /// the set gives them), their mobilities from one call of
     /// [`Mechanism::velocity_jumps`] where the tangents fit in the columns the normal rows
     /// leave free (two calls where they do not).
+    #[allow(clippy::type_complexity)]
     fn mobilities<M: Mechanism<T, N>>(
-        &mut self,
+        &self,
         mechanism: &M,
         state: &State<T, N>,
         jacobian: &SMatrix<T, C, N>,
         tangent_rows: Option<SMatrix<T, C, N>>,
         touching: &[bool; C],
-    ) -> Result<[Option<Direction<T, N>>; C], Error> {
+    ) -> Result<(Delassus<T, N, C>, [Option<Direction<T, N>>; C]), Error> {
         let frictional: [bool; C] = core::array::from_fn(|i| touching[i] && !self.bilateral[i]);
         let tangent_rows = match tangent_rows {
             Some(t) if self.model.friction() > T::zero() => Some(finite_rows(t, &frictional)?),
@@ -376,10 +438,10 @@ where
         for k in (0..C).filter(|&k| !touching[k]) {
             normal.column_mut(k).fill(T::zero());
         }
-        self.work.rebuild(*jacobian, |_| Ok(normal), touching)?;
+        let rows = Delassus::new(*jacobian, |_| Ok(normal), touching)?;
         let mut out = [None; C];
         let Some(t) = tangent_rows else {
-            return Ok(out);
+            return Ok((rows, out));
         };
         let rest = if overflow {
             let mut columns = SMatrix::<T, N, C>::zeros();
@@ -398,7 +460,7 @@ where
             };
             out[i] = Direction::new(t.row(i).transpose(), b);
         }
-        Ok(out)
+        Ok((rows, out))
     }
 
     /// The drift correction of coordinates whose rows' gaps would be `reach`: split impulses
@@ -407,7 +469,8 @@ where
     /// slop joins and it is solved again (at most [`SPECULATIVE_ROUNDS`] times). The
     /// displacement, and whether there was one.
     fn drift<F>(
-        &mut self,
+        &self,
+        normal: &mut Delassus<T, N, C>,
         jacobian: &SMatrix<T, C, N>,
         reach: SVector<T, C>,
         kinds: &[Row; C],
@@ -430,18 +493,18 @@ where
         for _ in 0..=SPECULATIVE_ROUNDS {
             let after = jacobian * dq + off;
             let joining: [bool; C] = core::array::from_fn(|i| {
-                !self.work.candidates()[i] && !self.bilateral[i] && after[i] < T::zero()
+                !normal.candidates()[i] && !self.bilateral[i] && after[i] < T::zero()
             });
             let deep = (0..C).any(|i| {
-                (self.work.candidates()[i] || joining[i])
+                (normal.candidates()[i] || joining[i])
                     && (after[i] < T::zero() || (self.bilateral[i] && after[i] != T::zero()))
             });
             if !deep {
                 break;
             }
-            self.work.extend(jacobian, &mut jump, &joining)?;
-            let push = self.work.complementary(&off, kinds)?.lambda;
-            dq = self.work.response(&push);
+            normal.extend(jacobian, &mut jump, &joining)?;
+            let push = normal.complementary(&off, kinds)?.lambda;
+            dq = normal.response(&push);
             corrected = true;
         }
         Ok((dq, corrected))
@@ -553,7 +616,7 @@ impl<T, M, I, K, const N: usize, const C: usize> Integrator<T, N, M>
 where
     T: Real,
     M: Mechanism<T, N>,
-    I: Integrator<T, N, M>,
+    I: Integrator<T, N, M> + Clone,
     K: Contacts<T, N, C>,
 {
     /// One step with contacts; see [`ImpulseStepper`].
@@ -568,31 +631,27 @@ where
         self.transaction(|c| c.advance(mechanism, state, dt))
     }
 
-    /// The law of the contacts resting at `state` held as constraints, their forces the
-    /// exact complementarity solution (see [`ActiveRows`]): a body resting on the floor does
-    /// not accelerate. What a scene's sleep test reads. Resting: at the coordinates of the
-    /// last step's end, the contacts that pushed in it (the scheme may bring a body to rest a
-    /// little above the floor, which its free motion reaches within a step); at any other
-    /// coordinates, the contacts within the slop of zero.
+    /// What one step of the stepper does to `state` from rest: the velocity change of a step
+    /// of the last step's size from `state` with its velocities zeroed (the integrator's own
+    /// step and the contacts' impulses, static friction included), divided by the step; the
+    /// mechanism's own acceleration before any step. What a scene's sleep test reads: a body
+    /// resting on the floor, or held on a slope by friction, does not accelerate.
     fn law_acceleration(&self, mechanism: &M, state: &State<T, N>) -> Result<SVector<T, N>, Error> {
-        let touching: [bool; C] = match &self.last {
-            Some((_, last, _)) if last.q == state.q => {
-                core::array::from_fn(|i| self.pushed[i] && !self.bilateral[i])
-            }
-            _ => {
-                let gaps = self.contacts.position_residual(&state.q);
-                let slop = self.settings.slop();
-                core::array::from_fn(|i| !self.bilateral[i] && gaps[i] <= slop)
-            }
+        let Some(dt) = self.memory.dt else {
+            return mechanism.acceleration(state);
         };
-        let rows = ActiveRows::new(
-            mechanism,
-            &self.contacts,
-            &self.model,
-            &self.bilateral,
-            &touching,
-        );
-        rows.acceleration(state)
+        let rest = State {
+            qd: SVector::zeros(),
+            ..*state
+        };
+        // Warm-started from the last step's impulses, as the next step would be.
+        let mut memory = self.memory;
+        memory.last = memory
+            .last
+            .map(|(p, _, _)| (p, rest, mechanism.energy(&rest)));
+        let free = self.integrator.clone().run_step(mechanism, &rest, dt)?;
+        let (next, _) = self.contacts_of(mechanism, &rest, free, dt, &memory)?;
+        Ok(next.qd / dt)
     }
 
     /// A step of a run; see [`ImpulseStepper`].

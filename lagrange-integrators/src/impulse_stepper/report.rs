@@ -26,6 +26,22 @@ pub struct ImpulseReport {
     pub energy_guard: bool,
 }
 
+impl ImpulseReport {
+    /// The worse of the two, count by count and flag by flag.
+    #[must_use]
+    pub fn worst(&self, other: &Self) -> Self {
+        Self {
+            rows: self.rows.max(other.rows),
+            speculative: self.speculative.max(other.speculative),
+            frictional: self.frictional.max(other.frictional),
+            rounds: self.rounds.max(other.rounds),
+            settled: self.settled && other.settled,
+            corrected: self.corrected || other.corrected,
+            energy_guard: self.energy_guard || other.energy_guard,
+        }
+    }
+}
+
 impl Default for ImpulseReport {
     /// A step with no row in contact: no work, settled.
     fn default() -> Self {

@@ -56,10 +56,11 @@ impl<T: Real, const N: usize, const C: usize> Problem<'_, T, N, C> {
     /// The impulses that give every normal row at least its `target` speed from the
     /// velocities `v0` (exactly its target where it pushes; a bilateral row exactly), with
     /// Coulomb friction `|tangent| <= mu normal` stopping the sliding where it can: the
-    /// normal rows solved exactly with the tangents' impulses held, then one projected
-    /// Gauss-Seidel sweep of the tangents with the normals held, from the tangents' impulses
-    /// `warm`, at most `rounds` times, ending early once a sweep changes no tangent's speed
-    /// by more than `tolerance` (plus the rounding of its speed). The cone holds exactly at
+    /// normal rows solved exactly with the tangents' impulses held, then projected
+    /// Gauss-Seidel sweeps of the tangents with the normals held until they settle (at most
+    /// `rounds` sweeps), from the tangents' impulses `warm`, at most `rounds` times, ending
+    /// early once a round's first sweep changes no tangent's speed by more than `tolerance`
+    /// (plus the rounding of its speed). The cone holds exactly at
     /// the end. The velocities returned are `v0` plus the response of the final impulses.
     ///
     /// # Errors
@@ -92,20 +93,31 @@ impl<T: Real, const N: usize, const C: usize> Problem<'_, T, N, C> {
                 settled = true;
                 break;
             }
+            // The tangents swept until they settle (each sweep is cheap beside a normal
+            // solve: two dot products a tangent), at most `rounds` sweeps; the round settles
+            // when its first sweep changed nothing.
             let mut v = sliding + self.normal.response(&p.normal);
-            let (mut change, mut allowed) = (T::zero(), tolerance);
-            for (i, t) in self.tangent.iter().enumerate() {
-                let Some(t) = t else { continue };
-                let u = t.j.dot(&v);
-                let bound = self.friction * p.normal[i];
-                let next = (p.tangent[i] - u * t.inverse).max(-bound).min(bound);
-                let dp = next - p.tangent[i];
-                v += t.b * dp;
-                p.tangent[i] = next;
-                change = change.max((dp / t.inverse).abs());
-                allowed = allowed.max(tolerance + rounding * u.abs());
+            for sweep in 0..rounds.max(1) {
+                let (mut change, mut allowed) = (T::zero(), tolerance);
+                for (i, t) in self.tangent.iter().enumerate() {
+                    let Some(t) = t else { continue };
+                    let u = t.j.dot(&v);
+                    let bound = self.friction * p.normal[i];
+                    let next = (p.tangent[i] - u * t.inverse).max(-bound).min(bound);
+                    let dp = next - p.tangent[i];
+                    v += t.b * dp;
+                    p.tangent[i] = next;
+                    change = change.max((dp / t.inverse).abs());
+                    allowed = allowed.max(tolerance + rounding * u.abs());
+                }
+                let quiet = change <= allowed;
+                if sweep == 0 {
+                    settled = quiet;
+                }
+                if quiet {
+                    break;
+                }
             }
-            settled = change <= allowed;
         }
         if !frictional {
             p.tangent = [T::zero(); C];

@@ -443,6 +443,15 @@ where
         Ok(&self.slot(id)?.mechanism)
     }
 
+    /// The instance's integrator, to read what it keeps of its steps (an
+    /// [`ImpulseStepper`](crate::ImpulseStepper)'s report of its work).
+    ///
+    /// # Errors
+    /// [`Error::NoSuchInstance`].
+    pub fn integrator(&self, id: Id) -> Result<&I, Error> {
+        Ok(&self.slot(id)?.integrator)
+    }
+
     /// Awake, asleep, or failed.
     ///
     /// # Errors
