@@ -9,10 +9,11 @@ use crate::harness::{lit, ty, Ctx, Entry, Family, Verdict};
 use crate::values::Kind;
 use crate::{entries, say, tryv};
 use lagrange_core::constraints::{Constraints, Holonomic};
-use lagrange_core::{EulerLagrange, Mechanism, Projection, Real, State};
+use lagrange_core::{EulerLagrange, Lagrangian, Mechanism, Projection, Real, State};
 use lagrange_integrators::StormerVerlet;
 use lagrange_integrators::{
-    ContactModel, ContactStepper, DormandPrince54, FixedTimestep, Integrator, Projected,
+    ContactModel, ContactStepper, DormandPrince54, FixedTimestep, ImpulseSettings, ImpulseStepper,
+    Integrator, Projected, SemiImplicitEuler,
 };
 use lagrange_systems::FallingParticle;
 
@@ -167,6 +168,175 @@ fn projected<T: Real>(ctx: &mut Ctx) -> Verdict {
             &["dt", "state", "steps"],
         )
     }
+}
+
+/// What a caller can see of a time-stepping contact stepper.
+fn observe_impulses<T: Real, const N: usize, const C: usize, I, K>(
+    c: &ImpulseStepper<T, N, C, I, K>,
+) -> String {
+    format!(
+        "{:?} {:?} {:?}",
+        c.last_report(),
+        c.peak_report(),
+        c.impulses()
+    )
+}
+
+/// A ball on drawn ground (or held to it, bilateral) by an `ImpulseStepper` over
+/// semi-implicit Euler, every parameter drawn (restitution, friction, slop, cap, tolerance,
+/// `max_rows`): each setting refused by its name or accepted; after a step that succeeds the
+/// promises hold: the ball at most the slop below the ground (drift corrected; the guard may
+/// leave it deeper only where no kinetic energy pays for the lift, which a ball resting on
+/// its own ground never needs beyond 1%), every impulse within the cone, the energy at most
+/// the larger of the start's and the free step's plus the free step's own error, to 18
+/// ulps of the terms; after a failure the stepper as it was.
+fn impulse_stepper<T: Real>(ctx: &mut Ctx) -> Verdict {
+    let [mass, g] = ctx.values::<T, 2>(Kind::Param);
+    say!(
+        ctx,
+        "let m = FallingParticle::<{}>::new({}, {})?;",
+        ty::<T>(),
+        lit(mass),
+        lit(g)
+    );
+    let m = tryv!(setup(FallingParticle::new(mass, g), &["mass", "gravity"]));
+    let h = ctx.value::<T>(Kind::Signed);
+    let [e, rest, mu] = [
+        ctx.value::<T>(Kind::Tolerance),
+        ctx.value::<T>(Kind::Step),
+        ctx.value::<T>(Kind::Param),
+    ];
+    say!(
+        ctx,
+        "let model = ContactModel::<{}>::new({}, {}, 1.0)?.with_friction({})?;",
+        ty::<T>(),
+        lit(e),
+        lit(rest),
+        lit(mu)
+    );
+    let model = tryv!(setup(
+        ContactModel::new(e, rest, T::one()).and_then(|m| m.with_friction(mu)),
+        &["restitution", "rest_speed", "friction"]
+    ));
+    let slop = ctx.value::<T>(Kind::Tolerance);
+    let iterations = u32::try_from(ctx.count()).unwrap_or(u32::MAX);
+    say!(
+        ctx,
+        "let settings = ImpulseSettings::<{}>::new({}, {iterations})?;",
+        ty::<T>(),
+        lit(slop)
+    );
+    let mut settings = tryv!(setup(
+        ImpulseSettings::new(slop, iterations),
+        &["slop", "max_iterations"]
+    ));
+    if ctx.pick(4) == 0 {
+        let tolerance = ctx.value::<T>(Kind::Tolerance);
+        say!(
+            ctx,
+            "let settings = settings.with_tolerance({})?;",
+            lit(tolerance)
+        );
+        settings = tryv!(setup(settings.with_tolerance(tolerance), &["tolerance"]));
+    }
+    if ctx.pick(4) == 0 {
+        let rows = u32::try_from(ctx.count()).unwrap_or(u32::MAX);
+        say!(ctx, "let settings = settings.with_max_rows({rows})?;");
+        settings = tryv!(setup(settings.with_max_rows(rows), &["max_rows"]));
+    }
+    let bilateral = ctx.pick(4) == 0;
+    say!(ctx, "let mut c = ImpulseStepper::new(SemiImplicitEuler, Holonomic::new(Ground {{ h: {} }}), model, settings).with_bilateral([{bilateral}]);", lit(h));
+    let rows = Holonomic::new(Ground { h });
+    let mut c = ImpulseStepper::<T, 1, 1, _, _>::new(SemiImplicitEuler, rows, model, settings)
+        .with_bilateral([bilateral]);
+    let start = state::<T, 1>(ctx, "s0");
+    let mut last: Option<State<T, 1>> = None;
+    for call in 0..=ctx.pick(5) {
+        let from = match (ctx.pick(3), last) {
+            (0, Some(l)) => {
+                say!(ctx, "let s = last;");
+                l
+            }
+            (1, _) => {
+                say!(ctx, "let s = s0;");
+                start
+            }
+            _ => state::<T, 1>(ctx, "s"),
+        };
+        let dt = ctx.value::<T>(Kind::Step);
+        let before = observe_impulses(&c);
+        say!(ctx, "let last = c.step(&m, &s, {})?;", lit(dt));
+        let r = c.step(&m, &from, dt);
+        let v = verdict(&r, &["dt", "state", "max_rows"]);
+        if v.class().is_finding() {
+            return v;
+        }
+        match r {
+            Ok(next) => {
+                if let Some(broken) =
+                    impulse_promises(&c, &m, &rows, &from, &next, dt, mu, slop, bilateral)
+                {
+                    return Verdict::Broken(format!("call {call}: {broken}"));
+                }
+                last = Some(next);
+            }
+            Err(e) => {
+                let after = observe_impulses(&c);
+                if after != before {
+                    return Verdict::Changed(format!(
+                        "call {call} failed with {e:?}: {before} -> {after}"
+                    ));
+                }
+            }
+        }
+    }
+    Verdict::Ok
+}
+
+/// What an `ImpulseStepper`'s step from `from` to `next` broke of its promises (see
+/// [`impulse_stepper`]), if anything. Only for a start the ground's row can hold: a start
+/// deeper than the slop is the caller's (lifting it out adds energy the step has none of).
+#[allow(clippy::too_many_arguments)]
+fn impulse_promises<T: Real>(
+    c: &ImpulseStepper<T, 1, 1, SemiImplicitEuler, Holonomic<Ground<T>>>,
+    m: &FallingParticle<T>,
+    rows: &Holonomic<Ground<T>>,
+    from: &State<T, 1>,
+    next: &State<T, 1>,
+    dt: T,
+    mu: T,
+    slop: T,
+    bilateral: bool,
+) -> Option<String> {
+    let (normal, tangent) = c.impulses();
+    if !(tangent[0].abs() <= mu * normal[0] || tangent[0] == T::zero()) {
+        return Some(format!(
+            "friction {:?} outside the cone of {:?}",
+            tangent[0], normal[0]
+        ));
+    }
+    let g0 = rows.position_residual(&from.q)[0];
+    let free = SemiImplicitEuler.step(m, from, dt).ok()?;
+    let (e0, ef, e1) = (
+        m.energy(from).to_f64(),
+        m.energy(&free).to_f64(),
+        m.energy(next).to_f64(),
+    );
+    let sizes = e0.abs() + ef.abs() + e1.abs() + 2.0 * m.potential_energy(next).to_f64().abs();
+    let allowed = e0.max(ef) + (ef - e0).abs() + 18.0 * T::EPSILON.to_f64() * sizes;
+    let finite = [e0, ef, e1, sizes]
+        .iter()
+        .all(|x| x.is_finite() && x.abs() < 1e30);
+    if finite && e1 > allowed {
+        return Some(format!("energy {e0:e} -> {e1:e} (free step {ef:e})"));
+    }
+    let g1 = rows.position_residual(&next.q)[0].to_f64();
+    let depth = -g1;
+    let held = !bilateral && g0.to_f64() >= -slop.to_f64() && finite;
+    if held && depth > 1.01 * slop.to_f64() + 1e-9 * (1.0 + from.q[0].to_f64().abs()) {
+        return Some(format!("ended {depth:e} below the ground, slop {:?}", slop));
+    }
+    None
 }
 
 /// What a caller can see of a contact stepper.
@@ -341,6 +511,7 @@ pub fn family() -> Family {
     entries!(v, 1.0, "FixedTimestep::new/advance/reset", fixed_timestep);
     entries!(v, 0.6, "Projected<Rk4>", projected);
     entries!(v, 0.8, "ContactStepper<Rk4>", contact_stepper);
+    entries!(v, 0.8, "ImpulseStepper<SemiImplicitEuler>", impulse_stepper);
     entries!(
         v,
         0.6,

@@ -15,8 +15,8 @@ use crate::{entries, say, tryv};
 use lagrange_core::constraints::contact::Contacts;
 use lagrange_core::{Constraints, Error, Lagrangian, Projection, Real, State};
 use lagrange_integrators::{
-    ActiveRows, ContactModel, ContactStepper, Integrator, Rk4, SemiImplicitEuler, StormerVerlet,
-    VelocityVerlet,
+    ActiveRows, ContactModel, ContactStepper, ImpulseSettings, ImpulseStepper, Integrator, Rk4,
+    SemiImplicitEuler, StormerVerlet, VelocityVerlet,
 };
 use lagrange_systems::{
     Ragdoll, RagdollBody, RagdollContacts, ADULT_JOINT_LIMITS, RAGDOLL_CONTACTS,
@@ -477,6 +477,96 @@ where
     Verdict::Ok
 }
 
+/// The time-stepping stepper's promises on the same drops as [`drop_promises`]: a ragdoll
+/// (joint damping drawn 0 or the adult's) thrown by semi-implicit Euler inside an
+/// `ImpulseStepper` (slop 2 mm, 1 to 8 rounds) at 60, 120 or 240 Hz for 120 steps. After every
+/// step: the energy at most the larger of the start's and the free step's plus the free
+/// step's own error (to 18 ulps of the terms), every friction impulse within the cone, no
+/// floor point deeper than the slop and no limit further past than the slop (to 1e-6: the
+/// drift correction is exact on linearised gaps) unless it started deeper, and the work
+/// within the cap (rows at most 31, rounds at most four times the cap).
+fn impulse_drop_promises<T: Real>(ctx: &mut Ctx) -> Verdict {
+    let damping = if ctx.pick(2) == 0 { 0.0 } else { 0.5 };
+    let body = RagdollBody {
+        joint_damping: T::from_f64(damping),
+        ..RagdollBody::adult()
+    };
+    let m = tryv!(setup(Ragdoll::new(body), &[]));
+    let c = tryv!(setup(RagdollContacts::adult(&m, T::zero()), &[]));
+    let (e, mu) = (ctx.uniform::<T>(0.0, 1.0), ctx.uniform::<T>(0.0, 1.0));
+    let model = tryv!(setup(
+        ContactModel::new(e, T::from_f64(0.3), T::one()).and_then(|m| m.with_friction(mu)),
+        &[]
+    ));
+    let rounds = 1 + u32::try_from(ctx.pick(8)).unwrap_or(0);
+    let slop = T::from_f64(2e-3);
+    let settings = tryv!(setup(ImpulseSettings::new(slop, rounds), &[]));
+    let mut q = [T::zero(); N];
+    let mut qd = [T::zero(); N];
+    q[1] = ctx.uniform(1.0, 2.0);
+    q[2] = ctx.uniform(-3.0, 3.0);
+    for (k, [lo, hi]) in ADULT_JOINT_LIMITS.into_iter().enumerate() {
+        q[k + 3] = ctx.uniform(lo, hi);
+    }
+    for v in &mut qd {
+        *v = ctx.uniform(-5.0, 5.0);
+    }
+    let dt = T::from_f64([1.0 / 60.0, 1.0 / 120.0, 1.0 / 240.0][ctx.pick(3)]);
+    say!(
+        ctx,
+        "let s0 = State::<{}, {N}>::new(0.0, {}, {});",
+        ty::<T>(),
+        lits(&q),
+        lits(&qd)
+    );
+    say!(ctx, "let mut st = ImpulseStepper::new(SemiImplicitEuler, c, ContactModel::new({}, 0.3, 1.0)?.with_friction({})?, ImpulseSettings::new(2e-3, {rounds})?); // damping {damping}, dt {}", lit(e), lit(mu), lit(dt));
+    let mut st = ImpulseStepper::new(SemiImplicitEuler, c, model, settings);
+    let mut s = State::new(T::zero(), q, qd);
+    for step in 0..120 {
+        let free = match SemiImplicitEuler.step(&m, &s, dt) {
+            Ok(f) => f,
+            Err(e) => return Verdict::Error(e),
+        };
+        let r = st.step(&m, &s, dt);
+        let Ok(next) = r else {
+            return verdict(&r, &[]);
+        };
+        let (e0, ef, e1) = (
+            m.energy(&s).to_f64(),
+            m.energy(&free).to_f64(),
+            m.energy(&next).to_f64(),
+        );
+        let sizes = e0.abs() + ef.abs() + e1.abs() + 2.0 * m.potential_energy(&next).to_f64().abs();
+        let allowed = e0.max(ef) + (ef - e0).abs() + 18.0 * T::EPSILON.to_f64() * sizes;
+        if e1 > allowed {
+            return Verdict::Broken(format!("step {step}: energy {e0} -> {e1}, free step {ef}"));
+        }
+        let (normal, tangent) = st.impulses();
+        if let Some(i) = (0..RAGDOLL_CONTACTS)
+            .find(|&i| tangent[i].abs() > mu * normal[i] * T::from_f64(1.0 + 1e-6))
+        {
+            return Verdict::Broken(format!(
+                "step {step}: row {i} friction {:?} outside the cone of {:?}",
+                tangent[i], normal[i]
+            ));
+        }
+        let (g0, g1) = (c.position_residual(&s.q), c.position_residual(&next.q));
+        let floor = slop.to_f64() + 1e-6;
+        if let Some(i) = (0..RAGDOLL_CONTACTS).find(|&i| -g1[i].to_f64() > floor && g1[i] < g0[i]) {
+            return Verdict::Broken(format!(
+                "step {step}: row {i} ended {:?} below zero (slop {slop:?}), from {:?}",
+                g1[i], g0[i]
+            ));
+        }
+        let peak = st.peak_report();
+        if peak.rows > 31 || peak.rounds > 4 * rounds {
+            return Verdict::Broken(format!("step {step}: work {peak:?} over the cap"));
+        }
+        s = next;
+    }
+    Verdict::Ok
+}
+
 /// A body refused by its field, as `refused` would say of a plain parameter list (kept for
 /// the constructor's own entry: every field drawn at once).
 fn constructor<T: Real>(ctx: &mut Ctx) -> Verdict {
@@ -520,6 +610,12 @@ pub fn family() -> Family {
             stepper_verlet
         );
         entries!(v, 0.1, "ContactStepper drops (promises)", drop_promises);
+        entries!(
+            v,
+            0.1,
+            "ImpulseStepper drops (promises)",
+            impulse_drop_promises
+        );
     }
     Family {
         name: "ragdoll",
