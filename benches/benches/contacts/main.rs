@@ -107,6 +107,10 @@ pub struct Row {
     pub scalar: &'static str,
     /// Median over rounds of a round's mean step, ns.
     pub mean_ns: Option<f64>,
+    /// The fastest round's mean step, ns.
+    pub min_mean_ns: Option<f64>,
+    /// The fastest round's mean over the free step's fastest round's.
+    pub min_ratio: Option<f64>,
     /// Median over rounds of a round's slowest step, ns.
     pub worst_ns: Option<f64>,
     /// The slowest of the steps' fastest times over the rounds, ns.
@@ -211,6 +215,13 @@ fn measure(
             stepper: c.stepper,
             scalar,
             mean_ns: timed.then(|| median(means[i].clone())),
+            min_mean_ns: timed.then(|| fastest_of(&means[i])),
+            min_ratio: match free {
+                Some(f) if timed && failures[f].is_none() && c.stepper != "rapier2d" => {
+                    Some(fastest_of(&means[i]) / fastest_of(&means[f]))
+                }
+                _ => None,
+            },
             worst_ns: timed.then(|| median(worsts[i].clone())),
             worst_min_ns: timed.then(|| fastest[i].iter().copied().fold(0.0, f64::max)),
             free_rk4_ns: if c.stepper == "rapier2d" {
@@ -225,6 +236,11 @@ fn measure(
         });
     }
     rows
+}
+
+/// The smallest of `xs`.
+fn fastest_of(xs: &[f64]) -> f64 {
+    xs.iter().copied().fold(f64::INFINITY, f64::min)
 }
 
 /// The rapier2d candidate: the thrown ragdoll, `steps` steps of 1/240 s.

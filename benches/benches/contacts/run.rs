@@ -73,7 +73,8 @@ pub struct Figures {
 
 /// The untimed run: `steps` steps of `stepper` from `start`, each beside the free step of
 /// `free` (the stepper's inner method, contacts ignored) from the same state; depth over the
-/// first `floor_rows` rows of `contacts` (the floor) and apart over the others (limits).
+/// first `floor_rows` rows of `contacts` (the floor) and apart over the others (limits);
+/// `observe` sees the stepper after each step (its report).
 ///
 /// # Errors
 /// As [`timed_run`].
@@ -87,6 +88,7 @@ pub fn figures<T, M, I, F, K, const N: usize, const C: usize>(
     steps: usize,
     mut stepper: I,
     mut free: F,
+    mut observe: impl FnMut(&I),
 ) -> Result<Figures, String>
 where
     T: Real,
@@ -126,6 +128,7 @@ where
                 .energy_gain
                 .max(mechanism.energy(&next).to_f64() - allowed);
         }
+        observe(&stepper);
         s = next;
         depth(&s, &mut f);
     }

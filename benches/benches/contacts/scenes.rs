@@ -240,7 +240,10 @@ where
                 timed_run(&mechanism, &start, dt, steps, time_stepping(), per_step)
             }),
             figures: Some(Box::new(move || {
-                figures(
+                // What the steps did, from the stepper's report: rows and rounds.
+                let (mut rows, mut most_rows, mut rounds, mut most_rounds) = (0u64, 0, 0u64, 0);
+                let (mut unsettled, mut guarded, mut touching) = (0u64, 0u64, 0u64);
+                let f = figures(
                     &mechanism,
                     &contacts,
                     floor_rows,
@@ -249,8 +252,30 @@ where
                     steps,
                     time_stepping(),
                     SemiImplicitEuler,
-                )
-                .map(as_figures)
+                    |st: &ImpulseStepper<T, N2, C, SemiImplicitEuler, K>| {
+                        let r = st.last_report();
+                        if r.rows > 0 {
+                            touching += 1;
+                            rows += u64::from(r.rows);
+                            rounds += u64::from(r.rounds);
+                        }
+                        most_rows = most_rows.max(r.rows);
+                        most_rounds = most_rounds.max(r.rounds);
+                        unsettled += u64::from(!r.settled);
+                        guarded += u64::from(r.energy_guard);
+                    },
+                )?;
+                let per = |x: u64| x as f64 / touching.max(1) as f64;
+                Ok(crate::Measured {
+                    note: format!(
+                        "steps with rows: {touching}, rows {:.1} on average (at most \
+                         {most_rows}), rounds {:.1} (at most {most_rounds}); friction \
+                         unsettled in {unsettled} steps, energy guard in {guarded}",
+                        per(rows),
+                        per(rounds)
+                    ),
+                    ..as_figures(f)
+                })
             })),
         },
         Candidate {
@@ -259,7 +284,8 @@ where
                 timed_run(&mechanism, &start, dt, steps, event(), per_step)
             }),
             figures: Some(Box::new(move || {
-                figures(
+                let (mut impacts, mut most) = (0u64, 0u64);
+                let f = figures(
                     &mechanism,
                     &contacts,
                     floor_rows,
@@ -268,8 +294,15 @@ where
                     steps,
                     event(),
                     Rk4,
-                )
-                .map(as_figures)
+                    |st: &ContactStepper<T, N2, C, Rk4, K>| {
+                        most = most.max(st.impacts() - impacts);
+                        impacts = st.impacts();
+                    },
+                )?;
+                Ok(crate::Measured {
+                    note: format!("impacts: {impacts}, at most {most} in a step"),
+                    ..as_figures(f)
+                })
             })),
         },
     ])
