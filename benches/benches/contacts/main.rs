@@ -16,7 +16,9 @@
 //! and at most 4 sweeps per solve ([`scenes::SLOP`], [`scenes::MAX_ITERATIONS`]: a game's
 //! budget; the slop is what a contact may rest below zero, so its depth is that by design);
 //! `event` is `ContactStepper` with `Rk4` inside; `rapier2d` is the peer ([`peer`]), in the
-//! `f32` ragdoll rows only (rapier2d computes in `f32`; its `f64` build is another crate).
+//! `f32` ragdoll rows only (rapier2d computes in `f32`; its `f64` build is another crate),
+//! with its bodies kept awake (lagrange's steppers do not sleep); the Markdown also times it
+//! with sleeping allowed, as rapier comes (`rapier2d_sleeping`, not a row of the CSV).
 //! `free_rk4_ns` is plain `Rk4` on the same mechanism from the same start, no contacts.
 //!
 //! **Timing.** Every candidate of a scene (free RK4, the steppers, rapier) is run in the same
@@ -24,12 +26,16 @@
 //! the machine's load falls on all of them. In each round each candidate makes two whole
 //! runs from the start: one timed as a whole (`mean_ns` is its time over its steps; no clock
 //! is read inside it, as a reading costs about 20 ns, a fifth of a double pendulum's free
-//! step) and one with every step timed (for the worst step). Reported: `mean_ns` the median
-//! over rounds of each round's mean; `worst_ns` the median over rounds of each round's
-//! slowest step. On a loaded machine a round's slowest step is often a preemption, not
-//! work; the runs are deterministic, so the Markdown also gives the slowest step of the
-//! per-step minima over rounds (each step at its fastest), which is the work of the worst
-//! step. Ratios to the free step are the medians of the per-round ratios.
+//! step) and one with every step timed (for the worst step). Reported (CSV, and the goals'
+//! verdicts): `mean_ns` the fastest round's mean; `worst_ns` the slowest step of the
+//! per-step minima over the rounds (each step at its fastest: the runs are deterministic,
+//! step `k` does the same work in every round, so this is the work of the worst step);
+//! `free_rk4_ns` the free step's fastest round's mean. Minima rather than medians because
+//! the machine this was written on is shared (load 6 to 8 on 2 cores): a whole run's median
+//! moved by 2x from one invocation to the next and a run's slowest step was a preemption
+//! (milliseconds) in most rounds, whereas the minima held within a few percent. The
+//! Markdown gives the medians beside them: the median over rounds of a round's mean, of a
+//! round's slowest step, and of the per-round ratio to the free step.
 //!
 //! **Depth.** `max_penetration`: the deepest negative gap of a floor row at the end of any
 //! step, m (zero when none); the joint limits' depth (rad) is in the Markdown. For rapier,
@@ -105,20 +111,22 @@ pub struct Row {
     pub stepper: &'static str,
     /// `"f32"` or `"f64"`.
     pub scalar: &'static str,
-    /// Median over rounds of a round's mean step, ns.
+    /// The fastest round's mean step, ns (the CSV's `mean_ns`).
     pub mean_ns: Option<f64>,
-    /// The fastest round's mean step, ns.
-    pub min_mean_ns: Option<f64>,
-    /// The fastest round's mean over the free step's fastest round's.
-    pub min_ratio: Option<f64>,
-    /// Median over rounds of a round's slowest step, ns.
+    /// The median over rounds of a round's mean step, ns.
+    pub median_mean_ns: Option<f64>,
+    /// The slowest of the steps' fastest times over the rounds, ns (the CSV's `worst_ns`).
     pub worst_ns: Option<f64>,
-    /// The slowest of the steps' fastest times over the rounds, ns.
-    pub worst_min_ns: Option<f64>,
-    /// The free RK4 step's mean, ns (none for rapier).
+    /// The median over rounds of a round's slowest step, ns.
+    pub median_worst_ns: Option<f64>,
+    /// The free RK4 step's fastest round's mean, ns (none for rapier).
     pub free_rk4_ns: Option<f64>,
-    /// Median over rounds of mean / the free step's mean in the same round.
+    /// The free RK4 step's median mean, ns.
+    pub free_median_ns: Option<f64>,
+    /// `mean_ns / free_rk4_ns`.
     pub mean_ratio: Option<f64>,
+    /// The median over rounds of a round's mean / the free step's mean in the same round.
+    pub median_ratio: Option<f64>,
     /// Rounds timed.
     pub rounds: usize,
     /// Depth and energy.
@@ -190,8 +198,12 @@ fn measure(
             }
         }
     }
-    let free = candidates.iter().position(|c| c.stepper == FREE);
-    let free_mean = free.and_then(|f| failures[f].is_none().then(|| median(means[f].clone())));
+    let free = candidates
+        .iter()
+        .position(|c| c.stepper == FREE)
+        .filter(|&f| failures[f].is_none());
+    let free_min = free.map(|f| fastest_of(&means[f]));
+    let free_median = free.map(|f| median(means[f].clone()));
     let mut rows = Vec::new();
     for (i, c) in candidates.iter_mut().enumerate() {
         if c.stepper == FREE {
@@ -204,32 +216,23 @@ fn measure(
             None => (None, None),
         };
         let timed = failures[i].is_none();
-        let mean_ratio = match free {
-            Some(f) if timed && failures[f].is_none() && c.stepper != "rapier2d" => Some(median(
-                means[i].iter().zip(&means[f]).map(|(a, b)| a / b).collect(),
-            )),
-            _ => None,
-        };
+        let peer = c.stepper.starts_with("rapier");
+        let mean = timed.then(|| fastest_of(&means[i]));
+        let against = |x: Option<f64>| x.filter(|_| timed && !peer);
         rows.push(Row {
             scene,
             stepper: c.stepper,
             scalar,
-            mean_ns: timed.then(|| median(means[i].clone())),
-            min_mean_ns: timed.then(|| fastest_of(&means[i])),
-            min_ratio: match free {
-                Some(f) if timed && failures[f].is_none() && c.stepper != "rapier2d" => {
-                    Some(fastest_of(&means[i]) / fastest_of(&means[f]))
-                }
-                _ => None,
-            },
-            worst_ns: timed.then(|| median(worsts[i].clone())),
-            worst_min_ns: timed.then(|| fastest[i].iter().copied().fold(0.0, f64::max)),
-            free_rk4_ns: if c.stepper == "rapier2d" {
-                None
-            } else {
-                free_mean
-            },
-            mean_ratio,
+            mean_ns: mean,
+            median_mean_ns: timed.then(|| median(means[i].clone())),
+            worst_ns: timed.then(|| fastest[i].iter().copied().fold(0.0, f64::max)),
+            median_worst_ns: timed.then(|| median(worsts[i].clone())),
+            free_rk4_ns: if peer { None } else { free_min },
+            free_median_ns: if peer { None } else { free_median },
+            mean_ratio: against(mean.zip(free_min).map(|(a, b)| a / b)),
+            median_ratio: against(
+                free.map(|f| median(means[i].iter().zip(&means[f]).map(|(a, b)| a / b).collect())),
+            ),
             rounds: plan.rounds,
             measured,
             failure: failures[i].clone().or(figure_failure),
@@ -241,6 +244,21 @@ fn measure(
 /// The smallest of `xs`.
 fn fastest_of(xs: &[f64]) -> f64 {
     xs.iter().copied().fold(f64::INFINITY, f64::min)
+}
+
+/// The peer with its bodies allowed to fall asleep (rapier's default), in the Markdown only:
+/// what a game using rapier as it comes would pay once the ragdoll rests.
+pub const RAPIER_SLEEPING: &str = "rapier2d_sleeping";
+
+/// rapier2d with sleeping allowed: timed only.
+fn rapier_sleeping(steps: usize) -> Candidate {
+    let start = scenes::thrown();
+    let dt = scenes::RAGDOLL_DT;
+    Candidate {
+        stepper: RAPIER_SLEEPING,
+        run: Box::new(move |per_step| peer::timed_run(&start, dt, steps, true, per_step)),
+        figures: None,
+    }
 }
 
 /// The rapier2d candidate: the thrown ragdoll, `steps` steps of 1/240 s.
@@ -277,6 +295,7 @@ fn scenes_in<T: lagrange_core::Real>(plan: Plan, rows: &mut Vec<Row>) -> Result<
     let mut c = scenes::candidates(scene).map_err(e)?;
     if scalar == "f32" {
         c.push(rapier(steps));
+        c.push(rapier_sleeping(steps));
     }
     println!("== ragdoll, {scalar}: {steps} steps");
     rows.extend(measure("ragdoll", scalar, steps, c, plan));
