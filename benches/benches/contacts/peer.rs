@@ -215,9 +215,12 @@ impl Peer {
             .get_multibody_mut(link.multibody)
             .ok_or("no multibody")?;
         mb.set_self_contacts_enabled(false);
-        // The root's pose is read from the torso's body (its angle too: rapier's free joint
-        // keeps its angle coordinate apart from its rotation, so the angle goes in as a
-        // displacement as well); the hinges move from zero by lagrange's joint angles.
+        // The root's pose is read from the torso's body, and its angle goes in as a
+        // displacement as well: in 2D rapier's free root joint keeps its angle coordinate
+        // apart from its rotation, takes only the rotation from the body, and rebuilds the
+        // rotation from the coordinate when it integrates, so that a root body created at
+        // 0.6 rad is back at 0 after the first step (rapier2d 0.36.1) unless its coordinate
+        // is set too. The hinges move from zero by lagrange's joint angles.
         mb.forward_kinematics(&world.bodies, true);
         let ndofs = mb.ndofs();
         let mut disp = vec![0.0f32; ndofs];
