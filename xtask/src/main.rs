@@ -10,6 +10,9 @@
 //!   cost of a scene's frame against the fraction awake and against plain loops, and the
 //!   constant-mass skip (`scene.csv`, `scene.md`). `--automatic`: ns per automatic
 //!   acceleration against the hand-derived and generated ones (`automatic.csv`, `automatic.md`).
+//!   `--contacts`: ns per step of the contact steppers (thrown ragdoll, double pendulum on
+//!   the floor, bouncing ball) against a free RK4 step and against rapier2d, with depth and
+//!   energy gain (`contacts.csv`, `contacts.md`).
 //! - `cross`: thumbv7em-none-eabihf builds of the library crates, with and without `defmt`,
 //!   and a linked no_std binary with no allocator, with its size.
 //! - `qemu`: the firmware on an emulated Cortex-M4F (QEMU `mps2-an386`), its defmt log compared
@@ -119,16 +122,31 @@ const AUTOMATIC_BENCH: [&str; 9] = [
     "--",
 ];
 
-/// `cargo xtask bench [--scene | --automatic] ...`: the work-precision bench, or with
-/// `--scene` the scene bench, with `--automatic` the automatic-path bench, with the other
-/// flags passed on.
+/// The contacts bench (`--contacts`): a `[[bench]]` target, so that its peer (rapier2d) is a
+/// dev-dependency of `lagrange-benches` only; `cargo bench` builds it in the bench profile
+/// (release).
+const CONTACTS_BENCH: [&str; 7] = [
+    "bench",
+    "--quiet",
+    "-p",
+    "lagrange-benches",
+    "--bench",
+    "contacts",
+    "--",
+];
+
+/// `cargo xtask bench [--scene | --automatic | --contacts] ...`: the work-precision bench,
+/// or with `--scene` the scene bench, with `--automatic` the automatic-path bench, with
+/// `--contacts` the contacts bench, with the other flags passed on.
 fn bench(args: &[String]) -> Result<(), String> {
-    let which = if args.iter().any(|a| a == "--scene") {
-        SCENE_BENCH
+    let which: &[&str] = if args.iter().any(|a| a == "--scene") {
+        &SCENE_BENCH
     } else if args.iter().any(|a| a == "--automatic") {
-        AUTOMATIC_BENCH
+        &AUTOMATIC_BENCH
+    } else if args.iter().any(|a| a == "--contacts") {
+        &CONTACTS_BENCH
     } else {
-        BENCH
+        &BENCH
     };
     cmd::run(cmd::cargo().args(which).args(args))
 }
