@@ -293,8 +293,8 @@ where
     fn velocity_jumps<const K: usize>(
         &self,
         state: &State<T, N>,
-        impulses: &SMatrix<T, N, K>,
-    ) -> Result<SMatrix<T, N, K>, Error> {
+        impulses: &mut SMatrix<T, N, K>,
+    ) -> Result<(), Error> {
         self.mechanism.velocity_jumps(state, impulses)
     }
 }

@@ -234,27 +234,27 @@ pub trait Mechanism<T: Real, const N: usize>: Lagrangian<T, N> {
         finite(self.solve_mass(state, impulse)?)
     }
 
-    /// The velocity changes of `K` generalized impulses at once, the columns of `impulses`:
-    /// [`Mechanism::velocity_jump`] of each column that is not zero (a zero column stays
-    /// zero) by default. A mechanism whose mass solve can share work between right-hand sides
-    /// (its configuration's trigonometry, a factorisation) overrides it with the same result,
-    /// faster: what a contact solver builds its rows' mobilities `M^-1 J^T` with.
+    /// The velocity changes of `K` generalized impulses at once, in place: each column of
+    /// `impulses` that is not zero replaced by its [`Mechanism::velocity_jump`] (a zero
+    /// column stays zero), by default one at a time. A mechanism whose mass solve can share
+    /// work between right-hand sides (its configuration's trigonometry, a factorisation)
+    /// overrides it with the same result, faster: what a contact solver builds its rows'
+    /// mobilities `M^-1 J^T` with, in storage it keeps from step to step.
     ///
     /// # Errors
-    /// As [`Mechanism::velocity_jump`].
+    /// As [`Mechanism::velocity_jump`]; after an error the columns are unspecified.
     fn velocity_jumps<const K: usize>(
         &self,
         state: &State<T, N>,
-        impulses: &SMatrix<T, N, K>,
-    ) -> Result<SMatrix<T, N, K>, Error> {
-        let mut out = SMatrix::<T, N, K>::zeros();
+        impulses: &mut SMatrix<T, N, K>,
+    ) -> Result<(), Error> {
         for k in 0..K {
-            if (0..N).any(|i| impulses[(i, k)] != T::zero()) {
-                let column = SVector::<T, N>::from_fn(|i, _| impulses[(i, k)]);
-                out.set_column(k, &self.velocity_jump(state, &column)?);
+            if impulses.column(k).iter().any(|x| *x != T::zero()) {
+                let jump = self.velocity_jump(state, &impulses.column(k).into_owned())?;
+                impulses.set_column(k, &jump);
             }
         }
-        Ok(out)
+        Ok(())
     }
 
     /// These instances of the type side by side, as one mechanism over [`Lanes`] (lane `i`

@@ -730,21 +730,20 @@ impl<T: Real> Mechanism<T, RAGDOLL_COORDINATES> for Ragdoll<T> {
     fn velocity_jumps<const K: usize>(
         &self,
         s: &State<T, RAGDOLL_COORDINATES>,
-        impulses: &SMatrix<T, RAGDOLL_COORDINATES, K>,
-    ) -> Result<SMatrix<T, RAGDOLL_COORDINATES, K>, Error> {
+        impulses: &mut SMatrix<T, RAGDOLL_COORDINATES, K>,
+    ) -> Result<(), Error> {
         let factor = Cholesky::factor(&self.mass_matrix(&State {
             qd: SVector::zeros(),
             ..*s
         }))?;
-        let mut out = SMatrix::<T, RAGDOLL_COORDINATES, K>::zeros();
         for k in 0..K {
-            if (0..RAGDOLL_COORDINATES).any(|i| impulses[(i, k)] != T::zero()) {
-                let column = SVector::<T, RAGDOLL_COORDINATES>::from_fn(|i, _| impulses[(i, k)]);
-                out.set_column(k, &factor.solve(&column));
+            if impulses.column(k).iter().any(|x| *x != T::zero()) {
+                let jump = factor.solve(&impulses.column(k).into_owned());
+                impulses.set_column(k, &jump);
             }
         }
-        if all_finite(out.as_slice()) {
-            Ok(out)
+        if all_finite(impulses.as_slice()) {
+            Ok(())
         } else {
             Err(Error::NonFiniteState)
         }

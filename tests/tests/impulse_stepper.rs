@@ -323,9 +323,9 @@ const SLOP: f64 = 2e-3;
 /// the free step's own error (see [`checked`]), the friction cone kept (to 1e-9 of the
 /// impulses in f64, 1e-5 in f32), the floor never deeper than the slop and the joint limits
 /// never further past than the slop: semi-implicit Euler ends every step within
-/// `slop + 1e-6` (measured 2.00 mm); velocity Verlet within `1.1 slop` (measured 2.09 mm:
-/// where no kinetic energy pays for the drift's last lift after a landing, the guard leaves
-/// the contact a little deeper).
+/// `slop + 1e-6` (measured 2.00 mm); velocity Verlet within `1.1 slop` (measured 2.02 mm:
+/// where no kinetic energy pays for the drift's last lift after a landing, the guard keeps
+/// only the part of the lift the allowance pays for, and the contact stays a little deeper).
 fn ragdoll_keeps_energy_cone_depth_and_limits<T: Real>(seconds: f64) -> Result<(), Error> {
     let body = RagdollBody {
         joint_damping: T::zero(),

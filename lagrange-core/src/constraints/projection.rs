@@ -183,11 +183,11 @@ impl<T: Real> Projection<T> {
                 return Err(Error::NoConvergence { iterations });
             }
             let mut rows = Delassus::new(
-                contacts.jacobian(&s.q),
+                &contacts.jacobian(&s.q),
                 |jt| each_column(jt, |b| mechanism.solve_mass(&s, b)),
                 &[true; C],
             )?;
-            let kinds: [Row; C] = core::array::from_fn(|i| match (bilateral[i], held[i]) {
+            let kinds: [Row<T>; C] = core::array::from_fn(|i| match (bilateral[i], held[i]) {
                 (true, _) => Row::Bilateral,
                 (false, true) if two_sided => Row::Held,
                 _ => Row::Unilateral,

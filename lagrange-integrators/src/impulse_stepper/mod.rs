@@ -1,23 +1,23 @@
 //! [`ImpulseStepper`]: contacts at a bounded cost per step, for games and firmware: any
 //! integrator's free step, then one capped impulse solve over the rows in contact.
 
+mod energy;
 mod report;
 mod rows;
 mod settings;
 mod solve;
+mod step;
 
 pub use report::ImpulseReport;
 pub use settings::ImpulseSettings;
 
-use crate::integrator::{check_run_step, check_step, continues, step_loop};
+use crate::integrator::{check_run_step, check_step, step_loop};
 use crate::{Cost, Failure, Integrator, Method, Work};
-use lagrange_core::constraints::contact::{
-    within_kinetic_energy, ContactModel, Contacts, Delassus, Row,
-};
-use lagrange_core::nalgebra::{SMatrix, SVector};
+use lagrange_core::constraints::contact::{ContactModel, Contacts};
+use lagrange_core::nalgebra::SVector;
 use lagrange_core::{Error, Mechanism, Real, State};
-use rows::{finite_gaps, finite_rows, Direction};
-use solve::{Impulses, Problem, Solved};
+use rows::Workspace;
+use step::{Memory, Setup};
 
 /// Any integrator, stepping a mechanism with contacts `g(q) >= 0` (and optional bilateral
 /// rows) at a fixed step whose cost has a bound: time stepping at the velocity level, in the
@@ -116,40 +116,9 @@ use solve::{Impulses, Problem, Solved};
 #[derive(Debug, Clone, Copy)]
 pub struct ImpulseStepper<T: Real, const N: usize, const C: usize, I, K> {
     integrator: I,
-    contacts: K,
-    model: ContactModel<T>,
-    settings: ImpulseSettings<T>,
-    bilateral: [bool; C],
+    setup: Setup<T, C, K>,
     memory: Memory<T, N, C>,
-}
-
-/// What an [`ImpulseStepper`] keeps between steps.
-#[derive(Debug, Clone, Copy)]
-struct Memory<T: Real, const N: usize, const C: usize> {
-    /// The last step's impulses, its end state and that state's energy `T + V`.
-    last: Option<(Impulses<T, C>, State<T, N>, T)>,
-    /// The rows that pushed in the last step (or were bilateral): the contacts resting at its
-    /// end, which a body the scheme brought to rest may touch from up to `dt^2 g` above.
-    pushed: [bool; C],
-    report: ImpulseReport,
-    /// The largest counts of any step since the stepper was made or
-    /// [`ImpulseStepper::clear_peak`].
-    peak: ImpulseReport,
-    /// The last step's size, for the sleep test's trial step.
-    dt: Option<T>,
-}
-
-impl<T: Real, const N: usize, const C: usize> Memory<T, N, C> {
-    /// Nothing yet.
-    fn fresh() -> Self {
-        Self {
-            last: None,
-            pushed: [false; C],
-            report: ImpulseReport::default(),
-            peak: ImpulseReport::default(),
-            dt: None,
-        }
-    }
+    work: Workspace<T, N, C>,
 }
 
 impl<T: Real, const N: usize, const C: usize, I, K> ImpulseStepper<T, N, C, I, K> {
@@ -163,11 +132,14 @@ impl<T: Real, const N: usize, const C: usize, I, K> ImpulseStepper<T, N, C, I, K
     ) -> Self {
         Self {
             integrator,
-            contacts,
-            model,
-            settings,
-            bilateral: [false; C],
+            setup: Setup {
+                contacts,
+                model,
+                settings,
+                bilateral: [false; C],
+            },
             memory: Memory::fresh(),
+            work: Workspace::empty(),
         }
     }
 
@@ -176,7 +148,10 @@ impl<T: Real, const N: usize, const C: usize, I, K> ImpulseStepper<T, N, C, I, K
     #[must_use]
     pub fn with_bilateral(self, rows: [bool; C]) -> Self {
         Self {
-            bilateral: rows,
+            setup: Setup {
+                bilateral: rows,
+                ..self.setup
+            },
             memory: Memory::fresh(),
             ..self
         }
@@ -216,19 +191,19 @@ impl<T: Real, const N: usize, const C: usize, I, K> ImpulseStepper<T, N, C, I, K
     /// The contact model.
     #[must_use]
     pub fn model(&self) -> &ContactModel<T> {
-        &self.model
+        &self.setup.model
     }
 
     /// The settings.
     #[must_use]
     pub fn settings(&self) -> &ImpulseSettings<T> {
-        &self.settings
+        &self.setup.settings
     }
 
     /// The contact set.
     #[must_use]
     pub fn contacts(&self) -> &K {
-        &self.contacts
+        &self.setup.contacts
     }
 
     /// `f`, and the stepper as it was (warm start, report) when `f` fails.
@@ -255,345 +230,17 @@ where
         I: Integrator<T, N, M>,
     {
         let free = self.integrator.run_step(mechanism, s, dt)?;
-        let (end, memory) = self.contacts_of(mechanism, s, free, dt, &self.memory)?;
-        self.memory = memory;
-        Ok(end)
-    }
-
-    /// The contacts' part of a step from `s` whose free step reached `free`, with `memory` of
-    /// the steps before: the end state, and the memory after.
-    fn contacts_of<M>(
-        &self,
-        mechanism: &M,
-        s: &State<T, N>,
-        free: State<T, N>,
-        dt: T,
-        memory: &Memory<T, N, C>,
-    ) -> Result<(State<T, N>, Memory<T, N, C>), Error>
-    where
-        M: Mechanism<T, N>,
-    {
-        let (warm, start_energy) = match memory.last {
-            Some((p, last, e)) if continues(&last, s) => (p.tangent, Some(e)),
-            _ => ([T::zero(); C], None),
-        };
-        let mut next = *memory;
-        next.dt = Some(dt);
-        let gaps = finite_gaps(self.contacts.position_residual(&free.q))?;
-        let touching: [bool; C] =
-            core::array::from_fn(|i| self.bilateral[i] || gaps[i] <= T::zero());
-        let in_contact = touching.iter().filter(|&&t| t).count();
-        if in_contact == 0 {
-            next.report = ImpulseReport::default();
-            // The energy of a state no row touches is not needed: marked unknown.
-            next.last = Some((Impulses::zero(), free, T::INFINITY));
-            next.pushed = [false; C];
-            next.peak = next.peak.worst(&next.report);
-            return Ok((free, next));
-        }
-        if self
-            .settings
-            .max_rows()
-            .is_some_and(|cap| in_contact > cap as usize)
-        {
-            return Err(Error::InvalidParameter {
-                name: "max_rows",
-                reason: "more rows are in contact than max_rows allows",
-            });
-        }
-        let (jacobian, tangent_rows) = self.contacts.jacobians(&free.q);
-        let jacobian = finite_rows(jacobian, &[true; C])?;
-        let (mut normal, tangent) =
-            self.mobilities(mechanism, &free, &jacobian, tangent_rows, &touching)?;
-        let kinds = Row::kinds(&self.bilateral);
-        // The rows that pushed in the last step: the first guess of each solve's active rows.
-        let guess = if start_energy.is_some() {
-            memory.pushed
-        } else {
-            touching
-        };
-        let settings = self.settings;
-        let (rounds, tolerance, slop) = (
-            settings.max_iterations(),
-            settings.tolerance(),
-            settings.slop(),
-        );
-        let friction = self.model.friction();
-        let w = jacobian * free.qd;
         let share = T::from_f64(I::POSITION_SHARE) * dt;
-        let jump = |b: &SVector<T, N>| mechanism.velocity_jump(&free, b);
-        let mut target = SVector::<T, C>::zeros();
-        let solve = |work: &mut Delassus<T, N, C>, target: &SVector<T, C>, warm: &[T; C]| {
-            Problem {
-                normal: work,
-                kinds: &kinds,
-                tangent: &tangent,
-                friction,
-                pushed: &guess,
-            }
-            .solve(&free.qd, target, warm, rounds, tolerance)
-        };
-        let mut plastic = solve(&mut normal, &target, &warm)?;
-        let (mut taken, mut speculative) = (plastic.rounds, 0u32);
-        for _ in 0..SPECULATIVE_ROUNDS {
-            let reach = jacobian * ((plastic.velocity - free.qd) * share) + gaps;
-            let joining: [bool; C] =
-                core::array::from_fn(|i| !normal.candidates()[i] && reach[i] < -slop);
-            if share <= T::zero() || !joining.iter().any(|&j| j) {
-                break;
-            }
-            normal.extend(&jacobian, jump, &joining)?;
-            for i in (0..C).filter(|&i| joining[i]) {
-                target[i] = w[i] - gaps[i] / share;
-                speculative += 1;
-            }
-            plastic = solve(&mut normal, &target, &plastic.impulses.tangent)?;
-            taken += plastic.rounds;
-        }
-        let rebound = self.rebounds(&gaps, &w);
-        let solved = if rebound.iter().any(|&r| r > T::zero()) {
-            let bounce = target.zip_map(&rebound, |t, r| t.max(r));
-            let bounced = solve(&mut normal, &bounce, &plastic.impulses.tangent)?;
-            taken += bounced.rounds;
-            Solved {
-                settled: plastic.settled && bounced.settled,
-                ..bounced
-            }
-        } else {
-            plastic
-        };
-        let shift = (plastic.velocity - free.qd) * share;
-        let (dq, corrected) = self.drift(
-            &mut normal,
-            &jacobian,
-            jacobian * shift + gaps,
-            &kinds,
-            jump,
-        )?;
-        let end = State {
-            t: free.t,
-            q: free.q + shift + dq,
-            qd: solved.velocity,
-        };
-        let (end, energy, guarded) = guard(mechanism, s, start_energy, &free, end)?;
-        let count = |rows: &[bool; C]| {
-            u32::try_from(rows.iter().filter(|&&r| r).count()).unwrap_or(u32::MAX)
-        };
-        next.report = ImpulseReport {
-            rows: count(normal.candidates()),
-            speculative,
-            frictional: count(&core::array::from_fn(|i| tangent[i].is_some())),
-            rounds: taken,
-            settled: solved.settled,
-            corrected,
-            energy_guard: guarded,
-        };
-        next.pushed =
-            core::array::from_fn(|i| self.bilateral[i] || solved.impulses.normal[i] > T::zero());
-        next.last = Some((solved.impulses, end, energy));
-        next.peak = next.peak.worst(&next.report);
-        Ok((end, next))
+        self.setup.contacts_of(
+            &mut self.work,
+            &mut self.memory,
+            mechanism,
+            s,
+            free,
+            dt,
+            share,
+        )
     }
-
-    /// The rows of a step at `state`: the normal rows in `touching` (their [`Delassus`]), and
-    /// the tangents of those contacts (where the model has friction and
-    /// the set gives them), their mobilities from one call of
-    /// [`Mechanism::velocity_jumps`] where the tangents fit in the columns the normal rows
-    /// leave free (two calls where they do not).
-    #[allow(clippy::type_complexity)]
-    fn mobilities<M: Mechanism<T, N>>(
-        &self,
-        mechanism: &M,
-        state: &State<T, N>,
-        jacobian: &SMatrix<T, C, N>,
-        tangent_rows: Option<SMatrix<T, C, N>>,
-        touching: &[bool; C],
-    ) -> Result<(Delassus<T, N, C>, [Option<Direction<T, N>>; C]), Error> {
-        let frictional: [bool; C] = core::array::from_fn(|i| touching[i] && !self.bilateral[i]);
-        let tangent_rows = match tangent_rows {
-            Some(t) if self.model.friction() > T::zero() => Some(finite_rows(t, &frictional)?),
-            _ => None,
-        };
-        // Normal rows in their own columns; each tangent in a column no normal row uses.
-        let mut columns = SMatrix::<T, N, C>::zeros();
-        let mut slot = [None::<usize>; C];
-        let mut free = (0..C).filter(|&k| !touching[k]);
-        let mut overflow = false;
-        for i in (0..C).filter(|&i| touching[i]) {
-            columns.set_column(i, &jacobian.row(i).transpose());
-        }
-        if let Some(t) = &tangent_rows {
-            for i in (0..C).filter(|&i| frictional[i]) {
-                match free.next() {
-                    Some(k) => {
-                        columns.set_column(k, &t.row(i).transpose());
-                        slot[i] = Some(k);
-                    }
-                    None => overflow = true,
-                }
-            }
-        }
-        let jumps = mechanism.velocity_jumps(state, &columns)?;
-        let mut normal = jumps;
-        for k in (0..C).filter(|&k| !touching[k]) {
-            normal.column_mut(k).fill(T::zero());
-        }
-        let rows = Delassus::new(*jacobian, |_| Ok(normal), touching)?;
-        let mut out = [None; C];
-        let Some(t) = tangent_rows else {
-            return Ok((rows, out));
-        };
-        let rest = if overflow {
-            let mut columns = SMatrix::<T, N, C>::zeros();
-            for i in (0..C).filter(|&i| frictional[i] && slot[i].is_none()) {
-                columns.set_column(i, &t.row(i).transpose());
-            }
-            Some(mechanism.velocity_jumps(state, &columns)?)
-        } else {
-            None
-        };
-        for i in (0..C).filter(|&i| frictional[i]) {
-            let b = match (slot[i], &rest) {
-                (Some(k), _) => jumps.column(k).into_owned(),
-                (None, Some(r)) => r.column(i).into_owned(),
-                (None, None) => continue,
-            };
-            out[i] = Direction::new(t.row(i).transpose(), b);
-        }
-        Ok((rows, out))
-    }
-
-    /// The drift correction of coordinates whose rows' gaps would be `reach`: split impulses
-    /// over the normal rows, solved exactly on the linearised gaps, contacts back to `-slop`
-    /// and bilateral rows to zero; a contact that the correction itself would take below the
-    /// slop joins and it is solved again (at most [`SPECULATIVE_ROUNDS`] times). The
-    /// displacement, and whether there was one.
-    fn drift<F>(
-        &self,
-        normal: &mut Delassus<T, N, C>,
-        jacobian: &SMatrix<T, C, N>,
-        reach: SVector<T, C>,
-        kinds: &[Row; C],
-        jump: F,
-    ) -> Result<(SVector<T, N>, bool), Error>
-    where
-        F: FnMut(&SVector<T, N>) -> Result<SVector<T, N>, Error>,
-    {
-        let slop = self.settings.slop();
-        let mut jump = jump;
-        let mut dq = SVector::<T, N>::zeros();
-        let mut corrected = false;
-        let off = SVector::<T, C>::from_fn(|i, _| {
-            if self.bilateral[i] {
-                reach[i]
-            } else {
-                reach[i] + slop
-            }
-        });
-        for _ in 0..=SPECULATIVE_ROUNDS {
-            let after = jacobian * dq + off;
-            let joining: [bool; C] = core::array::from_fn(|i| {
-                !normal.candidates()[i] && !self.bilateral[i] && after[i] < T::zero()
-            });
-            let deep = (0..C).any(|i| {
-                (normal.candidates()[i] || joining[i])
-                    && (after[i] < T::zero() || (self.bilateral[i] && after[i] != T::zero()))
-            });
-            if !deep {
-                break;
-            }
-            normal.extend(jacobian, &mut jump, &joining)?;
-            let push = normal.complementary(&off, kinds)?.lambda;
-            dq = normal.response(&push);
-            corrected = true;
-        }
-        Ok((dq, corrected))
-    }
-
-    /// Each row's rebound: `-e w` for a contact touching and approaching at `w` fast enough
-    /// that it would leave at the model's rest speed or more, else zero (it rests).
-    fn rebounds(&self, gaps: &SVector<T, C>, w: &SVector<T, C>) -> SVector<T, C> {
-        let e = self.model.restitution();
-        SVector::from_fn(|i, _| {
-            let rebound = -e * w[i];
-            if !self.bilateral[i] && gaps[i] <= T::zero() && rebound >= self.model.rest_speed() {
-                rebound
-            } else {
-                T::zero()
-            }
-        })
-    }
-}
-
-/// How many times a step's plastic solve (or its drift correction) may be done again with
-/// contacts joining that its coordinates' shift would close (speculative rows).
-const SPECULATIVE_ROUNDS: u32 = 2;
-
-/// The energy guard of a step from `start` (whose energy `T + V` is `known`, when the step
-/// continues the last one) whose free step reached `free` and whose impulses and drift
-/// correction reached `end`: the end state, its energy, and whether the guard acted.
-/// Allowed: the larger of the start's energy and the free step's, plus the free step's own
-/// energy error, to rounding. Above it, the velocities
-/// are scaled down to the kinetic energy the allowance leaves; where the contacts' move of
-/// the coordinates alone takes the potential energy above it (a body lifted out of the floor
-/// with no kinetic energy to pay for it), the velocities are zeroed and the move shortened
-/// to what the allowance pays (the free step's coordinates, at rest, are within it): a
-/// contact stays deeper for a step rather than gain energy.
-///
-/// # Errors
-/// As [`within_kinetic_energy`].
-fn guard<T: Real, M: Mechanism<T, N>, const N: usize>(
-    mechanism: &M,
-    start: &State<T, N>,
-    known: Option<T>,
-    free: &State<T, N>,
-    mut end: State<T, N>,
-) -> Result<(State<T, N>, T, bool), Error> {
-    let before = match known {
-        Some(e) if e.is_finite() => e,
-        _ => mechanism.energy(start),
-    };
-    let after_free = mechanism.energy(free);
-    // Allowed: the larger of the start's energy and the free step's, plus the free step's
-    // own energy error (the motion the contacts allow is integrated no better than the free
-    // motion: a sliding or rotating contact gains or loses as the free step does), plus the
-    // rounding of the energies compared (16 ulps of the sizes of their terms: T + V may be
-    // near zero while T and V are not).
-    let allowed = before.max(after_free) + (after_free - before).abs();
-    let energy = mechanism.energy(&end);
-    let potential = mechanism.potential_energy(&end);
-    let rounding =
-        T::from_f64(16.0) * T::EPSILON * (allowed.abs() + energy.abs() + T::TWO * potential.abs());
-    if energy <= allowed + rounding {
-        return Ok((end, energy, false));
-    }
-    let kinetic = allowed - potential;
-    if kinetic > T::zero() {
-        end.qd = within_kinetic_energy(mechanism, &end, kinetic)?;
-    } else {
-        let rest = State {
-            qd: SVector::zeros(),
-            ..end
-        };
-        let moved = end.q - free.q;
-        let at = |share: T| State {
-            q: free.q + moved * share,
-            ..rest
-        };
-        let low = mechanism.potential_energy(&at(T::zero()));
-        let high = mechanism.potential_energy(&rest);
-        let share = if low < allowed && high > low {
-            ((allowed - low) / (high - low)).min(T::one())
-                * (T::one() - T::from_f64(16.0) * T::EPSILON)
-        } else {
-            T::zero()
-        };
-        end = at(share);
-        if mechanism.potential_energy(&end) > allowed {
-            end = at(T::zero());
-        }
-    }
-    Ok((end, mechanism.energy(&end), true))
 }
 
 impl<T: Real, I: Method, K, const N: usize, const C: usize> Method
@@ -650,7 +297,11 @@ where
             .last
             .map(|(p, _, _)| (p, rest, mechanism.energy(&rest)));
         let free = self.integrator.clone().run_step(mechanism, &rest, dt)?;
-        let (next, _) = self.contacts_of(mechanism, &rest, free, dt, &memory)?;
+        let share = T::from_f64(I::POSITION_SHARE) * dt;
+        let mut work = Workspace::empty();
+        let next =
+            self.setup
+                .contacts_of(&mut work, &mut memory, mechanism, &rest, free, dt, share)?;
         Ok(next.qd / dt)
     }
 

@@ -1,8 +1,111 @@
-//! [`Tangents`]: the friction directions of one step's contacts, each with its mobility
-//! through the mechanism's own mass solve; and the rows' checks.
+//! [`Workspace`]: the rows of one step (the normal rows' [`Delassus`], the friction
+//! directions, each with its mobility through the mechanism's own mass solve), in storage
+//! kept from step to step; and the rows' checks.
 
+use lagrange_core::constraints::contact::Delassus;
 use lagrange_core::nalgebra::{SMatrix, SVector};
-use lagrange_core::{Error, Real};
+use lagrange_core::{Error, Mechanism, Real, State};
+
+/// What a step fills and solves with, kept by the stepper so that a step neither makes nor
+/// clears storage of `C^2` numbers (a ragdoll's is 19 kB in `f64`): nothing in it outlives
+/// the step that filled it.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Workspace<T: Real, const N: usize, const C: usize> {
+    /// The normal rows of the step (the candidates: in contact, or speculative).
+    pub(super) normal: Delassus<T, N, C>,
+    /// The tangents of the contacts with friction.
+    pub(super) tangent: [Option<Direction<T, N>>; C],
+    /// The columns handed to the mechanism's mass solve.
+    jumps: SMatrix<T, N, C>,
+}
+
+impl<T: Real, const N: usize, const C: usize> Workspace<T, N, C> {
+    /// Nothing filled.
+    pub(super) fn empty() -> Self {
+        Self {
+            normal: Delassus::empty(),
+            tangent: [None; C],
+            jumps: SMatrix::zeros(),
+        }
+    }
+
+    /// The rows of a step at `state`: the normal rows of `jacobian` in `touching`, and the
+    /// tangents (rows of `tangents`) of the contacts in `frictional`, their mobilities from
+    /// one call of [`Mechanism::velocity_jumps`] where the tangents fit in the columns the
+    /// normal rows leave free (two calls where they do not).
+    ///
+    /// # Errors
+    /// The mass solve's; [`Error::NonFiniteState`] when `W` is not finite.
+    pub(super) fn fill<M: Mechanism<T, N>>(
+        &mut self,
+        mechanism: &M,
+        state: &State<T, N>,
+        jacobian: &SMatrix<T, C, N>,
+        tangents: Option<&SMatrix<T, C, N>>,
+        touching: &[bool; C],
+        frictional: &[bool; C],
+    ) -> Result<(), Error> {
+        // Normal rows in their own columns; each tangent in a column no normal row uses.
+        let mut slot = [None::<usize>; C];
+        let mut spare = (0..C).filter(|&k| !touching[k]);
+        let mut overflow = false;
+        for (k, &on) in touching.iter().enumerate() {
+            if on {
+                self.jumps.set_column(k, &jacobian.row(k).transpose());
+            } else {
+                self.jumps.column_mut(k).fill(T::zero());
+            }
+        }
+        if let Some(t) = tangents {
+            for i in (0..C).filter(|&i| frictional[i]) {
+                match spare.next() {
+                    Some(k) => {
+                        self.jumps.set_column(k, &t.row(i).transpose());
+                        slot[i] = Some(k);
+                    }
+                    None => overflow = true,
+                }
+            }
+        }
+        mechanism.velocity_jumps(state, &mut self.jumps)?;
+        let jumps = &self.jumps;
+        self.normal.rebuild(
+            jacobian,
+            |m| {
+                for k in (0..C).filter(|&k| touching[k]) {
+                    m.set_column(k, &jumps.column(k));
+                }
+                Ok(())
+            },
+            touching,
+        )?;
+        self.tangent = [None; C];
+        let Some(t) = tangents else {
+            return Ok(());
+        };
+        for i in (0..C).filter(|&i| frictional[i]) {
+            if let Some(k) = slot[i] {
+                self.tangent[i] =
+                    Direction::new(t.row(i).transpose(), self.jumps.column(k).into_owned());
+            }
+        }
+        if overflow {
+            for i in 0..C {
+                if frictional[i] && slot[i].is_none() {
+                    self.jumps.set_column(i, &t.row(i).transpose());
+                } else {
+                    self.jumps.column_mut(i).fill(T::zero());
+                }
+            }
+            mechanism.velocity_jumps(state, &mut self.jumps)?;
+            for i in (0..C).filter(|&i| frictional[i] && slot[i].is_none()) {
+                self.tangent[i] =
+                    Direction::new(t.row(i).transpose(), self.jumps.column(i).into_owned());
+            }
+        }
+        Ok(())
+    }
+}
 
 /// One tangent direction: its Jacobian row `j`, its mobility `b = M^-1 j^T` (the velocity
 /// change of a unit impulse, from the mechanism's velocity jump, which keeps a constrained

@@ -43,7 +43,7 @@ pub(super) struct Problem<'a, T: Real, const N: usize, const C: usize> {
     /// The normal rows (the candidates: in contact, or speculative).
     pub(super) normal: &'a mut Delassus<T, N, C>,
     /// How each normal row holds.
-    pub(super) kinds: &'a [Row; C],
+    pub(super) kinds: &'a [Row<T>; C],
     /// The tangents of the contacts with friction.
     pub(super) tangent: &'a [Option<Direction<T, N>>; C],
     /// The Coulomb coefficient.
@@ -69,14 +69,14 @@ impl<T: Real, const N: usize, const C: usize> Problem<'_, T, N, C> {
         self,
         v0: &SVector<T, N>,
         target: &SVector<T, C>,
-        warm: &[T; C],
+        warm: &Impulses<T, C>,
         rounds: u32,
         tolerance: T,
     ) -> Result<Solved<T, N, C>, Error> {
         let mut p = Impulses::zero();
         for (i, t) in self.tangent.iter().enumerate() {
             if t.is_some() {
-                p.tangent[i] = warm[i];
+                p.tangent[i] = warm.tangent[i];
             }
         }
         let frictional = self.friction > T::zero() && self.tangent.iter().any(Option::is_some);

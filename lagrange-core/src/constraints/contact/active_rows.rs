@@ -79,11 +79,11 @@ impl<'a, T: Real, const C: usize, M, K> ActiveRows<'a, T, C, M, K> {
         K: Contacts<T, N, C>,
     {
         let mut rows = Delassus::new(
-            self.contacts.jacobian(&state.q),
+            &self.contacts.jacobian(&state.q),
             |jt| each_column(jt, |b| self.mechanism.solve_mass(state, b)),
             &self.active,
         )?;
-        let kinds: [Row; C] = core::array::from_fn(|i| {
+        let kinds: [Row<T>; C] = core::array::from_fn(|i| {
             if self.unilateral[i] {
                 Row::Unilateral
             } else {

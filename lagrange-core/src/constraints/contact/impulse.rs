@@ -135,7 +135,7 @@ impl<'a, T: Real, const C: usize, K> Impacts<'a, T, C, K> {
             core::array::from_fn(|i| self.bilateral[i] || resting[i] || approaching[i]);
         let (mut after, impulses, kept) = if approaching.iter().any(|&a| a) {
             let mut rows = Delassus::new(
-                jacobian,
+                &jacobian,
                 |jt| each_column(jt, |b| mechanism.solve_mass(state, b)),
                 &candidate,
             )?;

@@ -6,10 +6,12 @@
 use crate::nalgebra::{SMatrix, SVector};
 use crate::{Error, Real};
 
-/// How a row of [`Delassus::complementary`] is held.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+/// How a row of [`Delassus::complementary`] is held: the bounds of its multiplier
+/// `lambda`, and what its `a = W lambda + b` must be inside them (zero; at a bound, of the
+/// sign that would push the multiplier out).
+#[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub enum Row {
+pub enum Row<T> {
     /// `a >= 0`, `lambda >= 0`, `lambda a = 0`: a contact.
     Unilateral,
     /// `a = 0`, `lambda` of either sign; must not depend on the other such rows.
@@ -17,9 +19,14 @@ pub enum Row {
     /// `a = 0`, `lambda` of either sign, like a bilateral row, but left out where it depends
     /// on the rows held with it (a resting contact projected back onto zero).
     Held,
+    /// `|lambda| <= bound` (finite, `>= 0`): `a = 0` inside, `a <= 0` at `+bound`, `a >= 0`
+    /// at `-bound`. Coulomb friction of a contact whose normal impulse is known, its bound
+    /// `mu` times it: the tangent sticks (`a = 0`, no sliding) or slides against the bound.
+    /// Left out, at zero, where it depends on the rows held with it.
+    Bounded(T),
 }
 
-impl Row {
+impl<T: Real> Row<T> {
     /// `Bilateral` where `bilateral` is true, else `Unilateral`.
     #[must_use]
     pub fn kinds<const C: usize>(bilateral: &[bool; C]) -> [Self; C] {
@@ -31,15 +38,25 @@ impl Row {
             }
         })
     }
+
+    /// The multiplier's bounds, lower and upper.
+    fn bounds(&self) -> (T, T) {
+        match *self {
+            Self::Unilateral => (T::zero(), T::INFINITY),
+            Self::Bilateral | Self::Held => (-T::INFINITY, T::INFINITY),
+            Self::Bounded(b) => (-b, b),
+        }
+    }
 }
 
-/// A solution of [`Delassus::complementary`]: the multipliers (zero off the active rows) and
-/// the rows that carry them.
+/// A solution of [`Delassus::complementary`]: the multipliers and the rows solved for.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Complementary<T: Real, const C: usize> {
-    /// The multipliers (forces, impulses or displacements), zero on the rows not in `active`.
+    /// The multipliers (forces, impulses or displacements): zero on the rows neither in
+    /// `active` nor at a bound.
     pub lambda: SVector<T, C>,
-    /// The rows in force: bilateral rows, and unilateral rows that push.
+    /// The rows solved for, `a = 0`: bilateral rows, unilateral rows that push, bounded rows
+    /// inside their bounds.
     pub active: [bool; C],
 }
 
@@ -61,21 +78,21 @@ pub struct Delassus<T: Real, const N: usize, const C: usize> {
 
 impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
     /// The rows of `jacobian` marked `candidate` (the others are zeroed), with `mobility_of`
-    /// giving the velocity changes of the columns of `J^T` (the generalized impulses of unit
-    /// row impulses; zero columns for the other rows): [`Mechanism::velocity_jumps`], or
-    /// [`each_column`] of a mass solve.
+    /// turning the columns of `J^T` in place into their velocity changes (the generalized
+    /// impulses of unit row impulses; the other rows' columns are zero and stay zero):
+    /// [`Mechanism::velocity_jumps`], or [`each_column`] of a mass solve.
     ///
     /// [`Mechanism::velocity_jumps`]: crate::Mechanism::velocity_jumps
     ///
     /// # Errors
     /// `mobility_of`'s; [`Error::NonFiniteState`] when `W` is not finite.
     pub fn new<F>(
-        jacobian: SMatrix<T, C, N>,
+        jacobian: &SMatrix<T, C, N>,
         mobility_of: F,
         candidate: &[bool; C],
     ) -> Result<Self, Error>
     where
-        F: FnOnce(&SMatrix<T, N, C>) -> Result<SMatrix<T, N, C>, Error>,
+        F: FnOnce(&mut SMatrix<T, N, C>) -> Result<(), Error>,
     {
         let mut d = Self::empty();
         d.rebuild(jacobian, mobility_of, candidate)?;
@@ -94,27 +111,40 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
         }
     }
 
-    /// As [`Delassus::new`], in place.
+    /// As [`Delassus::new`], in place: what a stepper that keeps its rows from step to step
+    /// calls, with no storage of `C^2` numbers made and cleared again.
     ///
     /// # Errors
-    /// As [`Delassus::new`].
+    /// As [`Delassus::new`]; after an error the rows are none.
     pub fn rebuild<F>(
         &mut self,
-        jacobian: SMatrix<T, C, N>,
+        jacobian: &SMatrix<T, C, N>,
         mobility_of: F,
         candidate: &[bool; C],
     ) -> Result<(), Error>
     where
-        F: FnOnce(&SMatrix<T, N, C>) -> Result<SMatrix<T, N, C>, Error>,
+        F: FnOnce(&mut SMatrix<T, N, C>) -> Result<(), Error>,
     {
-        self.jacobian = jacobian;
+        // The entries of W of rows that stop being candidates are cleared (W is zero off
+        // the candidates); the candidates' are all written below.
+        for i in (0..C).filter(|&i| self.candidate[i] && !candidate[i]) {
+            self.w.row_mut(i).fill(T::zero());
+            self.w.column_mut(i).fill(T::zero());
+        }
+        self.candidate = [false; C];
         for (i, &on) in candidate.iter().enumerate() {
-            if !on {
+            if on {
+                self.jacobian.set_row(i, &jacobian.row(i));
+                self.mobility.set_column(i, &jacobian.row(i).transpose());
+            } else {
                 self.jacobian.row_mut(i).fill(T::zero());
+                self.mobility.column_mut(i).fill(T::zero());
             }
         }
-        self.mobility = mobility_of(&self.jacobian.transpose())?;
-        self.candidate = *candidate;
+        if let Err(e) = mobility_of(&mut self.mobility) {
+            self.w.fill(T::zero());
+            return Err(e);
+        }
         for i in (0..C).filter(|&i| candidate[i]) {
             for k in (i..C).filter(|&k| candidate[k]) {
                 let x = self
@@ -123,12 +153,14 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
                     .transpose()
                     .dot(&self.mobility.column(k));
                 if !x.is_finite() {
+                    self.w.fill(T::zero());
                     return Err(Error::NonFiniteState);
                 }
                 self.w[(i, k)] = x;
                 self.w[(k, i)] = x;
             }
         }
+        self.candidate = *candidate;
         Ok(())
     }
 
@@ -151,17 +183,36 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
         for i in (0..C).filter(|&i| joining[i]) {
             let j = jacobian.row(i).transpose();
             let b = solve_mass(&j)?;
-            self.jacobian.set_row(i, &j.transpose());
-            self.mobility.set_column(i, &b);
-            self.candidate[i] = true;
-            for k in (0..C).filter(|&k| self.candidate[k]) {
-                let x = self.jacobian.row(k).transpose().dot(&b);
-                if !x.is_finite() {
-                    return Err(Error::NonFiniteState);
-                }
-                self.w[(i, k)] = x;
-                self.w[(k, i)] = x;
+            self.insert(i, &j, &b)?;
+        }
+        Ok(())
+    }
+
+    /// Row `i` joins the candidates (or is replaced) with Jacobian row `j` and mobility `b`
+    /// (`M^-1 j^T`, from a velocity jump): its entries of `W`, `R N` products.
+    ///
+    /// # Errors
+    /// [`Error::NonFiniteState`] when an entry is not finite (the row is then no candidate).
+    pub fn insert(&mut self, i: usize, j: &SVector<T, N>, b: &SVector<T, N>) -> Result<(), Error> {
+        if i >= C {
+            return Err(Error::InvalidParameter {
+                name: "row",
+                reason: "must be below the set's size",
+            });
+        }
+        self.jacobian.set_row(i, &j.transpose());
+        self.mobility.set_column(i, b);
+        self.candidate[i] = true;
+        for k in (0..C).filter(|&k| self.candidate[k]) {
+            let x = self.jacobian.row(k).transpose().dot(b);
+            if !x.is_finite() {
+                self.candidate[i] = false;
+                self.w.row_mut(i).fill(T::zero());
+                self.w.column_mut(i).fill(T::zero());
+                return Err(Error::NonFiniteState);
             }
+            self.w[(i, k)] = x;
+            self.w[(k, i)] = x;
         }
         Ok(())
     }
@@ -193,36 +244,42 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
     /// The multipliers `lambda` of the candidate rows for which `a = W lambda + b` is zero on
     /// the bilateral and held rows (see [`Row`]) and, on the unilateral ones, `lambda >= 0`,
     /// `a >= 0` and `lambda a = 0`: each unilateral row either pushes and holds (`a = 0`) or
-    /// is free and opens (`a >= 0`), never pulls and never closes. With `b` the free
-    /// accelerations of the rows (`J a0 + J'q'`) these are the contact forces; with `b` the
-    /// velocities of the rows less their targets, the impulses that reach the targets.
+    /// is free and opens (`a >= 0`), never pulls and never closes; a bounded row sticks
+    /// (`a = 0`) inside its bounds or rests against one. With `b` the free accelerations of
+    /// the rows (`J a0 + J'q'`) these are the contact forces; with `b` the velocities of the
+    /// rows less their targets, the impulses that reach the targets.
     ///
     /// The primal active-set method of the convex program `min lambda^T W lambda / 2 +
-    /// b^T lambda` over `lambda_u >= 0`, from `lambda = 0` and every candidate active: the
-    /// solve on the active rows; where a unilateral multiplier comes out negative, a step
-    /// towards it as far as the multipliers stay non-negative, and the row that reached zero
-    /// leaves; where every multiplier pushes, the row that would close fastest (`a` most
-    /// negative) joins. Each step lowers the program's value, so the method ends, for a
-    /// positive definite `W` in at most a few passes per row. A row that depends on the
-    /// active ones (more contacts than the motion has freedoms: the others already hold it)
-    /// cannot join them until one leaves.
+    /// b^T lambda` over the rows' bounds, from `lambda = 0`, every unilateral candidate held
+    /// at zero and the others solved for: the solve on the rows solved for, the others at
+    /// their bounds; where a multiplier comes out beyond a bound, a step towards the
+    /// solution as far as every multiplier stays within its bounds, and the row that reached
+    /// a bound is held there; where every multiplier is within its bounds, the held row whose
+    /// `a` would lower the program most by moving off its bound (a unilateral row: the one
+    /// that would close fastest) is solved for again. Each step lowers the program's value,
+    /// so the method ends, in a few passes per row. A row that depends on the rows solved
+    /// for (more contacts than the motion has freedoms: `W` only semi-definite) joins along
+    /// the ray that leaves `W lambda` unchanged, as far as the first bound: the row that
+    /// reaches it is held there (the program falls along the ray at the rate of the row's
+    /// pull). Where no bound ends the ray (held rows, with no bounds, that disagree), the
+    /// row is left out.
     ///
     /// # Errors
-    /// [`Error::RedundantConstraints`] when bilateral rows depend on each other (a held or
-    /// unilateral row that depends on the others is left out instead);
+    /// [`Error::InvalidParameter`] `bound` for a bounded row's bound that is negative or not
+    /// finite; [`Error::RedundantConstraints`] when bilateral rows depend on each other;
     /// [`Error::NoConvergence`] after `4 C + 4` passes (a degenerate set that cycles);
     /// [`Error::NonFiniteState`] for non-finite multipliers.
     pub fn complementary(
         &mut self,
         b: &SVector<T, C>,
-        kinds: &[Row; C],
+        kinds: &[Row<T>; C],
     ) -> Result<Complementary<T, C>, Error> {
         let all = self.candidate;
         self.complementary_from(b, kinds, &all)
     }
 
     /// As [`Delassus::complementary`], with the unilateral rows of `guess` (among the
-    /// candidates; bilateral and held rows always) as the first active set: a good guess (the
+    /// candidates; the other kinds always) as the first rows solved for: a good guess (the
     /// rows that pushed a moment ago) ends the method in one pass.
     ///
     /// # Errors
@@ -230,72 +287,193 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
     pub fn complementary_from(
         &mut self,
         b: &SVector<T, C>,
-        kinds: &[Row; C],
+        kinds: &[Row<T>; C],
         guess: &[bool; C],
     ) -> Result<Complementary<T, C>, Error> {
-        let unilateral: [bool; C] =
-            core::array::from_fn(|i| self.candidate[i] && kinds[i] == Row::Unilateral);
-        let mut active: [bool; C] =
-            core::array::from_fn(|i| self.candidate[i] && (guess[i] || !unilateral[i]));
-        // Rows that could not join the active rows (dependent on them) until one leaves.
+        if (0..C).any(|i| {
+            self.candidate[i]
+                && matches!(kinds[i], Row::Bounded(x) if !(x >= T::zero() && x.is_finite()))
+        }) {
+            return Err(Error::InvalidParameter {
+                name: "bound",
+                reason: "a bounded row's bound must be finite and not negative",
+            });
+        }
+        let bounds: [(T, T); C] = core::array::from_fn(|i| kinds[i].bounds());
+        // The candidates, listed: every loop below runs over them alone.
+        let (mut cand, mut m) = ([0usize; C], 0usize);
+        for i in (0..C).filter(|&i| self.candidate[i]) {
+            cand[m] = i;
+            m += 1;
+        }
+        let cand = &cand[..m.min(C)];
+        // Solved for (a = 0 between its bounds), in the order they joined (so that a row
+        // that depends on the others is always the one joining, at its bound: leaving it out
+        // changes no multiplier); the other candidates are held at a bound, or left out at
+        // zero while they depend on the rows solved for (`blocked`).
+        let mut free = [false; C];
+        let (mut order, mut n) = ([0usize; C], 0usize);
+        for &i in cand {
+            let solved_for = match kinds[i] {
+                Row::Unilateral => guess[i],
+                Row::Bounded(x) => x > T::zero(),
+                Row::Bilateral | Row::Held => true,
+            };
+            if solved_for {
+                free[i] = true;
+                order[n] = i;
+                n += 1;
+            }
+        }
+        // The rows of the factor still valid: those before the first change of `order`.
+        let mut kept = 0;
         let mut blocked = [false; C];
         let mut lambda = SVector::<T, C>::zeros();
+        // The row that joined last, and the way it moves off its bound.
+        let mut joined: Option<(usize, T)> = None;
         let passes = 4 * C + 4;
         for _ in 0..passes {
-            let x = match self.solve(&active, &(-b)) {
+            // The rows held at a bound push on the rows solved for.
+            let mut rhs = SVector::<T, C>::zeros();
+            for &i in cand.iter().filter(|&&i| free[i]) {
+                rhs[i] = cand
+                    .iter()
+                    .filter(|&&k| !free[k] && lambda[k] != T::zero())
+                    .fold(-b[i], |r, &k| r - self.w[(i, k)] * lambda[k]);
+            }
+            let x = match self.solve(&order, n, kept, &rhs) {
                 Ok(x) => x,
+                // A joining row that depends on the rows solved for: along the ray that moves
+                // it off its bound and them so that W lambda is unchanged, the program falls
+                // at the rate of its pull; as far as the first bound, where that row is held.
+                Err(Error::RedundantConstraints { row })
+                    if joined.is_some_and(|(j, _)| j == row) =>
+                {
+                    let way = joined.map_or(T::zero(), |(_, w)| w);
+                    joined = None;
+                    match self.ray(
+                        &mut order,
+                        &mut n,
+                        &mut free,
+                        &mut lambda,
+                        &bounds,
+                        row,
+                        way,
+                    )? {
+                        Some(at) => {
+                            kept = at;
+                            blocked = [false; C];
+                        }
+                        // No bound ends the ray: the row is left out at its bound.
+                        None => {
+                            kept = remove(&mut order, &mut n, row);
+                            free[row] = false;
+                            blocked[row] = true;
+                        }
+                    }
+                    continue;
+                }
+                // A row of the first set that depends on the ones before it, at zero: left
+                // out, free to join later (along a ray).
                 Err(Error::RedundantConstraints { row })
                     if kinds.get(row).is_some_and(|&k| k != Row::Bilateral) =>
                 {
-                    active[row] = false;
-                    blocked[row] = true;
+                    kept = remove(&mut order, &mut n, row);
+                    free[row] = false;
                     lambda[row] = T::zero();
                     continue;
                 }
                 Err(e) => return Err(e),
             };
-            // The step from lambda towards x, as far as no unilateral multiplier goes
-            // negative; the row that stops it leaves.
-            let mut stop: Option<(usize, T)> = None;
-            for i in 0..C {
-                if active[i] && unilateral[i] && x[i] < T::zero() {
-                    let reach = lambda[i] / (lambda[i] - x[i]);
-                    if stop.is_none_or(|(_, r)| reach < r) {
-                        stop = Some((i, reach));
-                    }
+            kept = n;
+            joined = None;
+            // The step from lambda towards x, as far as every multiplier stays within its
+            // bounds; the row that stops it is held at the bound it reached.
+            let mut stop: Option<(usize, T, T)> = None;
+            for &i in cand.iter().filter(|&&i| free[i]) {
+                let (lo, hi) = bounds[i];
+                let (reach, at) = if x[i] < lo {
+                    ((lambda[i] - lo) / (lambda[i] - x[i]), lo)
+                } else if x[i] > hi {
+                    ((hi - lambda[i]) / (x[i] - lambda[i]), hi)
+                } else {
+                    continue;
+                };
+                if stop.is_none_or(|(_, r, _)| reach < r) {
+                    stop = Some((i, reach, at));
                 }
             }
-            if let Some((row, reach)) = stop {
-                lambda += (x - lambda) * reach;
-                lambda[row] = T::zero();
-                active[row] = false;
+            if let Some((row, reach, at)) = stop {
+                for &i in cand.iter().filter(|&&i| free[i]) {
+                    let l = lambda[i];
+                    lambda[i] = l + (x[i] - l) * reach;
+                }
+                lambda[row] = at;
+                free[row] = false;
+                kept = remove(&mut order, &mut n, row);
                 blocked = [false; C];
                 continue;
             }
-            lambda = x;
-            // Every active row pushes: the free row that would close fastest joins.
+            for &i in cand.iter().filter(|&&i| free[i]) {
+                lambda[i] = x[i];
+            }
+            // Every multiplier within its bounds: the held row whose a would lower the
+            // program most by moving off its bound is solved for.
             let mut join: Option<(usize, T)> = None;
-            for i in (0..C).filter(|&i| unilateral[i] && !active[i] && !blocked[i]) {
-                let (a, size) =
-                    (0..C)
-                        .filter(|&k| active[k])
-                        .fold((b[i], b[i].abs()), |(a, s), k| {
-                            let term = self.w[(i, k)] * lambda[k];
-                            (a + term, s + term.abs())
-                        });
-                // Rounding (64 ulps of the sum's terms) is no closing: a row held at zero
-                // does not rejoin on the sign of noise.
-                let closing = a < -(T::from_f64(64.0) * T::EPSILON * size);
-                if closing && join.is_none_or(|(_, worst)| a < worst) {
-                    join = Some((i, a));
+            for &i in cand.iter().filter(|&&i| !free[i] && !blocked[i]) {
+                let (lo, hi) = bounds[i];
+                if lo == hi {
+                    continue;
+                }
+                let (a, size) = cand.iter().filter(|&&k| lambda[k] != T::zero()).fold(
+                    (b[i], b[i].abs()),
+                    |(a, s), &k| {
+                        let term = self.w[(i, k)] * lambda[k];
+                        (a + term, s + term.abs())
+                    },
+                );
+                // Off the lower bound where a < 0, off the upper where a > 0 (a row left
+                // out at zero inside its bounds: either way). Rounding (64 ulps of the sum's
+                // terms) is no pull: a row held at a bound does not leave it on the sign of
+                // noise.
+                let pull = if lambda[i] <= lo {
+                    -a
+                } else if lambda[i] >= hi {
+                    a
+                } else {
+                    a.abs()
+                };
+                if pull > T::from_f64(64.0) * T::EPSILON * size
+                    && join.is_none_or(|(_, most)| pull > most)
+                {
+                    join = Some((i, pull));
                 }
             }
             match join {
-                Some((row, _)) => active[row] = true,
-                None if lambda.iter().all(|x| x.is_finite()) => {
-                    return Ok(Complementary { lambda, active });
+                Some((row, _)) if n < C => {
+                    free[row] = true;
+                    order[n] = row;
+                    n += 1;
+                    // The way it moves off its bound: up from the lower, down from the upper,
+                    // against a from inside.
+                    let (lo, hi) = bounds[row];
+                    let a = self.w.row(row).dot(&lambda.transpose()) + b[row];
+                    let way = if lambda[row] <= lo {
+                        T::one()
+                    } else if lambda[row] >= hi || a > T::zero() {
+                        -T::one()
+                    } else {
+                        T::one()
+                    };
+                    joined = Some((row, way));
                 }
-                None => return Err(Error::NonFiniteState),
+                None if lambda.iter().all(|x| x.is_finite()) => {
+                    return Ok(Complementary {
+                        lambda,
+                        active: free,
+                    });
+                }
+                _ => return Err(Error::NonFiniteState),
             }
         }
         Err(Error::NoConvergence {
@@ -303,67 +481,142 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
         })
     }
 
-    /// `x = W_AA^-1 r_A` on the `active` rows (zero elsewhere), by a Cholesky factorisation
-    /// of the active rows alone, refusing a pivot below `sqrt(EPSILON)` of its diagonal
-    /// entry (a row dependent on the ones before it).
-    fn solve(&mut self, active: &[bool; C], r: &SVector<T, C>) -> Result<SVector<T, C>, Error> {
-        let mut set = [0usize; C];
-        let mut n = 0;
-        for i in (0..C).filter(|&i| active[i]) {
-            set[n] = i;
-            n += 1;
+    /// The ray step of [`Delassus::complementary_from`] for `row`, last of `order[..n]` and
+    /// dependent on the rows before it, moving `way` (+1 up, -1 down) off its bound: `c =
+    /// W_FF^-1 W_F,row` on those rows, then `lambda_row += way t` and `lambda_F -= way c t`
+    /// (which leaves `W lambda` unchanged) as far as the first bound; the row that reaches
+    /// it is held there (`row` itself, or one of the others, which `row` then replaces).
+    /// The position from which the order changed; `None`, with nothing changed, where no
+    /// bound ends the ray (rows with no bounds that depend on each other and do not agree).
+    ///
+    /// # Errors
+    /// As the solve of the rows before `row`.
+    #[allow(clippy::too_many_arguments)]
+    fn ray(
+        &mut self,
+        order: &mut [usize; C],
+        n: &mut usize,
+        free: &mut [bool; C],
+        lambda: &mut SVector<T, C>,
+        bounds: &[(T, T); C],
+        row: usize,
+        way: T,
+    ) -> Result<Option<usize>, Error> {
+        let before = (*n).min(C).saturating_sub(1);
+        let mut column = SVector::<T, C>::zeros();
+        for &k in order.iter().take(before) {
+            column[k] = self.w[(k, row)];
         }
+        let c = self.solve(order, before, before, &column)?;
+        let (lo, hi) = bounds[row];
+        let own = if way > T::zero() {
+            hi - lambda[row]
+        } else {
+            lambda[row] - lo
+        };
+        let mut limit: (usize, T, T) = (row, own, if way > T::zero() { hi } else { lo });
+        for &k in order.iter().take(before) {
+            let rate = -way * c[k];
+            let (lo, hi) = bounds[k];
+            let (t, at) = if rate < T::zero() {
+                ((lambda[k] - lo) / -rate, lo)
+            } else if rate > T::zero() {
+                ((hi - lambda[k]) / rate, hi)
+            } else {
+                continue;
+            };
+            if t < limit.1 {
+                limit = (k, t, at);
+            }
+        }
+        let (held, t, at) = limit;
+        if !t.is_finite() {
+            return Ok(None);
+        }
+        for &k in order.iter().take(before) {
+            lambda[k] -= way * c[k] * t;
+        }
+        lambda[row] += way * t;
+        lambda[held] = at;
+        free[held] = false;
+        Ok(Some(remove(order, n, held)))
+    }
+
+    /// `x = W_AA^-1 r_A` on the rows `order[..n]` (zero elsewhere), by a Cholesky
+    /// factorisation of those rows alone in that order, refusing a pivot below
+    /// `sqrt(EPSILON)` of its diagonal entry (a row dependent on the ones before it). The
+    /// factor's first `kept` rows are those of the last call's (the same rows in the same
+    /// order): only the rows after them are factored.
+    fn solve(
+        &mut self,
+        order: &[usize; C],
+        n: usize,
+        kept: usize,
+        r: &SVector<T, C>,
+    ) -> Result<SVector<T, C>, Error> {
+        let n = n.min(C);
         let threshold = T::EPSILON.sqrt();
         let l = &mut self.factor;
-        for p in 0..n {
-            let wpp = self.w[(set[p], set[p])];
+        for p in kept.min(n)..n {
+            let row = order[p];
+            for q in 0..p {
+                let x = (0..q).fold(self.w[(row, order[q])], |x, k| x - l[(p, k)] * l[(q, k)]);
+                l[(p, q)] = x / l[(q, q)];
+            }
+            let wpp = self.w[(row, row)];
             let d = (0..p).fold(wpp, |d, k| d - l[(p, k)] * l[(p, k)]);
             if !d.is_finite() {
                 return Err(Error::NonFiniteState);
             }
             if d <= wpp.abs() * threshold {
-                return Err(Error::RedundantConstraints { row: set[p] });
+                return Err(Error::RedundantConstraints { row });
             }
-            let lpp = d.sqrt();
-            l[(p, p)] = lpp;
-            for q in p + 1..n {
-                let x = (0..p).fold(self.w[(set[q], set[p])], |x, k| x - l[(q, k)] * l[(p, k)]);
-                l[(q, p)] = x / lpp;
-            }
+            l[(p, p)] = d.sqrt();
         }
         let mut y = [T::zero(); C];
         for p in 0..n {
-            y[p] = (0..p).fold(r[set[p]], |s, k| s - l[(p, k)] * y[k]) / l[(p, p)];
+            y[p] = (0..p).fold(r[order[p]], |s, k| s - l[(p, k)] * y[k]) / l[(p, p)];
         }
         let mut x = SVector::<T, C>::zeros();
         for p in (0..n).rev() {
-            let s = (p + 1..n).fold(y[p], |s, k| s - l[(k, p)] * x[set[k]]);
-            x[set[p]] = s / l[(p, p)];
+            let s = (p + 1..n).fold(y[p], |s, k| s - l[(k, p)] * x[order[k]]);
+            x[order[p]] = s / l[(p, p)];
         }
         Ok(x)
     }
 }
 
-/// `solve` applied to each column of `columns` that is not zero (a zero column stays zero):
-/// the mobilities of rows from a mass solve of one right-hand side at a time.
+/// `row` taken out of `order[..n]` (the rows after it move up one): the position it had,
+/// before which the order is unchanged.
+fn remove<const C: usize>(order: &mut [usize; C], n: &mut usize, row: usize) -> usize {
+    let count = (*n).min(C);
+    let Some(at) = order.iter().take(count).position(|&r| r == row) else {
+        return count;
+    };
+    order.copy_within(at + 1..count, at);
+    *n = count - 1;
+    at
+}
+
+/// Each column of `columns` that is not zero replaced by `solve` of it (a zero column stays
+/// zero): the mobilities of rows from a mass solve of one right-hand side at a time, in place.
 ///
 /// # Errors
-/// The first error of `solve`.
+/// The first error of `solve` (the columns before it are solved, the rest as they were).
 pub fn each_column<T: Real, const N: usize, const C: usize, F>(
-    columns: &SMatrix<T, N, C>,
+    columns: &mut SMatrix<T, N, C>,
     mut solve: F,
-) -> Result<SMatrix<T, N, C>, Error>
+) -> Result<(), Error>
 where
     F: FnMut(&SVector<T, N>) -> Result<SVector<T, N>, Error>,
 {
-    let mut out = SMatrix::<T, N, C>::zeros();
     for k in 0..C {
-        if (0..N).any(|i| columns[(i, k)] != T::zero()) {
-            let column = SVector::<T, N>::from_fn(|i, _| columns[(i, k)]);
-            out.set_column(k, &solve(&column)?);
+        if columns.column(k).iter().any(|x| *x != T::zero()) {
+            let solved = solve(&columns.column(k).into_owned())?;
+            columns.set_column(k, &solved);
         }
     }
-    Ok(out)
+    Ok(())
 }
 
 #[cfg(test)]
@@ -376,7 +629,7 @@ mod tests {
     /// `x >= 0` that meet at a corner, and a third row `x + y >= 0` that depends on both.
     fn corner() -> Result<Delassus<f64, 2, 3>, Error> {
         let j = SMatrix::<f64, 3, 2>::new(0.0, 1.0, 1.0, 0.0, 1.0, 1.0);
-        Delassus::new(j, |jt| Ok(*jt), &[true; 3])
+        Delassus::new(&j, |_| Ok(()), &[true; 3])
     }
 
     /// Pushed into the corner, both walls push and the dependent row is not needed; pulled
@@ -439,18 +692,136 @@ mod tests {
     #[test]
     fn candidates_and_dependent_bilateral_rows() -> Result<(), Error> {
         let j = SMatrix::<f64, 3, 2>::new(0.0, 1.0, 1.0, 0.0, 1.0, 1.0);
-        let mut d = Delassus::new(j, |jt| Ok(*jt), &[true, true, false])?;
+        let mut d = Delassus::new(&j, |_| Ok(()), &[true, true, false])?;
         let s = d.complementary(
             &SVector::<f64, 3>::new(-1.0, -2.0, -100.0),
             &[Row::Unilateral; 3],
         )?;
         assert_eq!(s.lambda, SVector::<f64, 3>::new(1.0, 2.0, 0.0));
-        let mut all = Delassus::new(j, |jt| Ok(*jt), &[true; 3])?;
+        let mut all = Delassus::new(&j, |_| Ok(()), &[true; 3])?;
         let bilateral = Row::kinds(&[true; 3]);
         assert_eq!(
             all.complementary(&SVector::<f64, 3>::zeros(), &bilateral),
             Err(Error::RedundantConstraints { row: 2 })
         );
+        Ok(())
+    }
+
+    /// A bounded row (a tangent `x` beside a floor `y >= 0`, and the dependent third row)
+    /// sticks inside its bound or rests against the bound it is pushed towards: the
+    /// complementarity conditions of each kind hold to rounding, whatever `b`.
+    #[test]
+    fn bounded_rows_stick_or_rest_against_a_bound() -> Result<(), Error> {
+        let mut d = corner()?;
+        let kinds = [Row::Unilateral, Row::Bounded(0.5), Row::Unilateral];
+        for b in [
+            SVector::<f64, 3>::new(-1.0, 0.2, 1.0),
+            SVector::<f64, 3>::new(-1.0, 3.0, 1.0),
+            SVector::<f64, 3>::new(-1.0, -3.0, -5.0),
+            SVector::<f64, 3>::new(2.0, -0.1, -0.5),
+            SVector::<f64, 3>::new(-2.0, -0.3, -2.5),
+        ] {
+            let s = d.complementary(&b, &kinds)?;
+            let a = d.w * s.lambda + b;
+            let tol = 1e-12;
+            for i in [0, 2] {
+                assert!(s.lambda[i] >= 0.0 && a[i] >= -tol, "{b:?}: {s:?} {a:?}");
+                assert!((s.lambda[i] * a[i]).abs() < tol, "{b:?}: {s:?} {a:?}");
+            }
+            let t = s.lambda[1];
+            assert!(t.abs() <= 0.5, "{b:?}: {s:?}");
+            if t.abs() < 0.5 {
+                assert!(a[1].abs() < tol, "sticks: {b:?}: {s:?} {a:?}");
+            } else {
+                assert!(a[1] * t <= tol, "against its bound: {b:?}: {s:?} {a:?}");
+            }
+        }
+        // The floor pushes 1 and the tangent, asked to stop a speed of 3, rests at -0.5.
+        let s = d.complementary(&SVector::<f64, 3>::new(-1.0, 3.0, 10.0), &kinds)?;
+        assert!(
+            (s.lambda[0] - 1.0).abs() < 1e-15 && s.lambda[1] == -0.5,
+            "{s:?}"
+        );
+        // A bound that is negative or not finite is refused by name.
+        for bad in [-1.0, f64::NAN, f64::INFINITY] {
+            let kinds = [Row::Unilateral, Row::Bounded(bad), Row::Unilateral];
+            assert!(matches!(
+                d.complementary(&SVector::zeros(), &kinds),
+                Err(Error::InvalidParameter { name: "bound", .. })
+            ));
+        }
+        Ok(())
+    }
+
+    /// Rows that stop being candidates leave no entries of `W` behind, and a row inserted
+    /// with its mobility gives the entries a rebuild would.
+    #[test]
+    fn rebuilds_and_inserted_rows() -> Result<(), Error> {
+        let j = SMatrix::<f64, 3, 2>::new(0.0, 1.0, 1.0, 0.0, 1.0, 1.0);
+        let mut d = corner()?;
+        d.rebuild(&j, |_| Ok(()), &[true, false, false])?;
+        let mut only_floor = SMatrix::<f64, 3, 3>::zeros();
+        only_floor[(0, 0)] = 1.0;
+        assert_eq!(d.w(), &only_floor);
+        d.insert(
+            2,
+            &SVector::<f64, 2>::new(1.0, 1.0),
+            &SVector::<f64, 2>::new(1.0, 1.0),
+        )?;
+        let rebuilt = Delassus::new(&j, |_| Ok(()), &[true, false, true])?;
+        assert_eq!(d.w(), rebuilt.w());
+        assert_eq!(d.candidates(), &[true, false, true]);
+        assert!(d.insert(3, &SVector::zeros(), &SVector::zeros()).is_err());
+        Ok(())
+    }
+
+    /// Random sets of six rows on three freedoms (so that rows depend on each other):
+    /// unilateral and bounded rows, and at most one held row (two or more held rows that
+    /// span the freedoms leave a pushing row no minimum), right sides `b = J v` of a random
+    /// velocity `v` (rows whose targets disagree can squeeze each other for ever: no
+    /// minimum): the conditions of each kind hold to rounding (the ray steps make the rows
+    /// that depend on the others join).
+    #[test]
+    fn dependent_rows_of_every_kind_meet_their_conditions() -> Result<(), Error> {
+        let mut seed = 0x2545_f491_4f6c_dd1d_u64;
+        let mut next = || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+        };
+        for _ in 0..2000 {
+            let j = SMatrix::<f64, 6, 3>::from_fn(|_, _| next());
+            let b = j * SVector::<f64, 3>::from_fn(|_, _| next());
+            let kinds: [Row<f64>; 6] = core::array::from_fn(|i| {
+                let x = next();
+                if i == 0 && x > 0.5 {
+                    Row::Held
+                } else if x < 0.0 {
+                    Row::Unilateral
+                } else {
+                    Row::Bounded(next().abs())
+                }
+            });
+            let mut d = Delassus::new(&j, |_| Ok(()), &[true; 6])?;
+            let s = d.complementary(&b, &kinds)?;
+            let a = d.w * s.lambda + b;
+            let tol = 1e-9;
+            for i in 0..6 {
+                let (l, ai) = (s.lambda[i], a[i]);
+                let ok = match kinds[i] {
+                    Row::Unilateral => l >= 0.0 && ai >= -tol && (l * ai).abs() < tol,
+                    Row::Bounded(x) => {
+                        l.abs() <= x
+                            && (l.abs() < x - tol && ai.abs() < tol
+                                || l >= x - tol && ai <= tol
+                                || l <= -x + tol && ai >= -tol)
+                    }
+                    Row::Held | Row::Bilateral => ai.abs() < tol,
+                };
+                assert!(ok, "row {i} of {kinds:?}: lambda {l}, a {ai}\n{j}{b}");
+            }
+        }
         Ok(())
     }
 }

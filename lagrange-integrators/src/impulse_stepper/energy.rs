@@ -1,0 +1,93 @@
+//! The energy guard of an [`ImpulseStepper`](super::ImpulseStepper)'s step: never above
+//! what the start and the free step allow.
+
+use lagrange_core::constraints::contact::within_kinetic_energy;
+use lagrange_core::nalgebra::SVector;
+use lagrange_core::{Error, Mechanism, Real, State};
+
+/// Potential evaluations the guard may spend finding how much of a move it can pay for.
+const GUARD_REFINEMENTS: u32 = 4;
+
+/// The energy guard of a step from `start` (whose energy `T + V` is `known`, when the step
+/// continues the last one) whose free step reached `free` and whose impulses and drift
+/// correction reached `end`: the end state, its energy, and whether the guard acted.
+/// Allowed: the larger of the start's energy and the free step's, plus the free step's own
+/// energy error, to rounding. Above it, the velocities
+/// are scaled down to the kinetic energy the allowance leaves; where the contacts' move of
+/// the coordinates alone takes the potential energy above it (a body lifted out of the floor
+/// with no kinetic energy to pay for it), the velocities are zeroed and the move shortened
+/// to what the allowance pays (the free step's coordinates, at rest, are within it): a
+/// contact stays deeper for a step rather than gain energy.
+///
+/// # Errors
+/// As [`within_kinetic_energy`].
+pub(super) fn guard<T: Real, M: Mechanism<T, N>, const N: usize>(
+    mechanism: &M,
+    start: &State<T, N>,
+    known: Option<T>,
+    free: &State<T, N>,
+    mut end: State<T, N>,
+) -> Result<(State<T, N>, T, bool), Error> {
+    let before = match known {
+        Some(e) if e.is_finite() => e,
+        _ => mechanism.energy(start),
+    };
+    let energy = mechanism.energy(&end);
+    // No more than the start's energy, to the rounding of the two: within what is allowed
+    // whatever the free step did (most steps of a landing or a rest; two evaluations saved).
+    let rounding = T::from_f64(16.0) * T::EPSILON * (before.abs() + energy.abs());
+    if energy <= before + rounding {
+        return Ok((end, energy, false));
+    }
+    let after_free = mechanism.energy(free);
+    // Allowed: the larger of the start's energy and the free step's, plus the free step's
+    // own energy error (the motion the contacts allow is integrated no better than the free
+    // motion: a sliding or rotating contact gains or loses as the free step does), plus the
+    // rounding of the energies compared (16 ulps of the sizes of their terms: T + V may be
+    // near zero while T and V are not).
+    let allowed = before.max(after_free) + (after_free - before).abs();
+    let potential = mechanism.potential_energy(&end);
+    let rounding =
+        T::from_f64(16.0) * T::EPSILON * (allowed.abs() + energy.abs() + T::TWO * potential.abs());
+    if energy <= allowed + rounding {
+        return Ok((end, energy, false));
+    }
+    let kinetic = allowed - potential;
+    if kinetic > T::zero() {
+        end.qd = within_kinetic_energy(mechanism, &end, kinetic)?;
+    } else {
+        let rest = State {
+            qd: SVector::zeros(),
+            ..end
+        };
+        let moved = end.q - free.q;
+        let at = |share: T| State {
+            q: free.q + moved * share,
+            ..rest
+        };
+        // The largest share of the move whose potential is within the allowance: regula
+        // falsi between the free step's coordinates (within it) and the end's (above it),
+        // keeping the last share found within (the potential is not linear along the move
+        // where it turns a link).
+        let (mut lo, mut v_lo) = (T::zero(), mechanism.potential_energy(&at(T::zero())));
+        let (mut hi, mut v_hi) = (T::one(), mechanism.potential_energy(&rest));
+        end = at(T::zero());
+        if v_lo < allowed {
+            for _ in 0..GUARD_REFINEMENTS {
+                if v_hi <= v_lo {
+                    break;
+                }
+                let share = lo + (hi - lo) * (allowed - v_lo) / (v_hi - v_lo);
+                let share = share.max(lo).min(hi) * (T::one() - T::from_f64(16.0) * T::EPSILON);
+                let v = mechanism.potential_energy(&at(share));
+                if v <= allowed {
+                    (lo, v_lo) = (share, v);
+                    end = at(share);
+                } else {
+                    (hi, v_hi) = (share, v);
+                }
+            }
+        }
+    }
+    Ok((end, mechanism.energy(&end), true))
+}

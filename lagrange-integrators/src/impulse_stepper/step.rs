@@ -1,0 +1,282 @@
+//! The contacts' part of an [`ImpulseStepper`](super::ImpulseStepper)'s step, after the free
+//! step: rows, impulses, the coordinates' shift, rebounds, drift, energy (steps 2 to 7 of
+//! the type's docs).
+
+use super::energy::guard;
+use super::report::ImpulseReport;
+use super::rows::{finite_gaps, finite_rows, Workspace};
+use super::settings::ImpulseSettings;
+use super::solve::{Impulses, Problem, Solved};
+use crate::integrator::continues;
+use lagrange_core::constraints::contact::{ContactModel, Contacts, Delassus, Row};
+use lagrange_core::nalgebra::{SMatrix, SVector};
+use lagrange_core::{Error, Mechanism, Real, State};
+
+/// How many times a step's plastic solve (or its drift correction) may be done again with
+/// contacts joining that its coordinates' shift would close (speculative rows).
+const SPECULATIVE_ROUNDS: u32 = 2;
+
+/// What a stepper is given: its contacts, their model, the settings, the bilateral rows.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Setup<T: Real, const C: usize, K> {
+    pub(super) contacts: K,
+    pub(super) model: ContactModel<T>,
+    pub(super) settings: ImpulseSettings<T>,
+    pub(super) bilateral: [bool; C],
+}
+
+/// What an [`ImpulseStepper`](super::ImpulseStepper) keeps between steps.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Memory<T: Real, const N: usize, const C: usize> {
+    /// The last step's impulses, its end state and that state's energy `T + V` (infinite
+    /// where it was not needed: a step no row touched).
+    pub(super) last: Option<(Impulses<T, C>, State<T, N>, T)>,
+    /// The rows that pushed in the last step (or were bilateral): the contacts resting at its
+    /// end, the first guess of the next step's active rows.
+    pub(super) pushed: [bool; C],
+    pub(super) report: ImpulseReport,
+    /// The largest counts of any step since the stepper was made or the peak cleared.
+    pub(super) peak: ImpulseReport,
+    /// The last step's size, for the sleep test's trial step.
+    pub(super) dt: Option<T>,
+}
+
+impl<T: Real, const N: usize, const C: usize> Memory<T, N, C> {
+    /// Nothing yet.
+    pub(super) fn fresh() -> Self {
+        Self {
+            last: None,
+            pushed: [false; C],
+            report: ImpulseReport::default(),
+            peak: ImpulseReport::default(),
+            dt: None,
+        }
+    }
+
+    /// The step just taken ended at `end` (energy `energy`) with `impulses`, and did what
+    /// `report` says.
+    fn record(
+        &mut self,
+        impulses: Impulses<T, C>,
+        end: State<T, N>,
+        energy: T,
+        pushed: [bool; C],
+        report: ImpulseReport,
+    ) {
+        self.last = Some((impulses, end, energy));
+        self.pushed = pushed;
+        self.report = report;
+        self.peak = self.peak.worst(&report);
+    }
+}
+
+impl<T: Real, const C: usize, K> Setup<T, C, K> {
+    /// Each row's rebound: `-e w` for a contact touching and approaching at `w` fast enough
+    /// that it would leave at the model's rest speed or more, else zero (it rests).
+    fn rebounds(&self, gaps: &SVector<T, C>, w: &SVector<T, C>) -> SVector<T, C> {
+        let e = self.model.restitution();
+        SVector::from_fn(|i, _| {
+            let rebound = -e * w[i];
+            if !self.bilateral[i] && gaps[i] <= T::zero() && rebound >= self.model.rest_speed() {
+                rebound
+            } else {
+                T::zero()
+            }
+        })
+    }
+
+    /// The drift correction of coordinates whose rows' gaps would be `reach`: split impulses
+    /// over the normal rows, solved exactly on the linearised gaps, contacts back to `-slop`
+    /// and bilateral rows to zero; a contact that the correction itself would take below the
+    /// slop joins and it is solved again (at most [`SPECULATIVE_ROUNDS`] times). The
+    /// displacement, and whether there was one.
+    fn drift<const N: usize, F>(
+        &self,
+        normal: &mut Delassus<T, N, C>,
+        jacobian: &SMatrix<T, C, N>,
+        reach: SVector<T, C>,
+        kinds: &[Row<T>; C],
+        mut jump: F,
+    ) -> Result<(SVector<T, N>, bool), Error>
+    where
+        F: FnMut(&SVector<T, N>) -> Result<SVector<T, N>, Error>,
+    {
+        let slop = self.settings.slop();
+        let mut dq = SVector::<T, N>::zeros();
+        let mut corrected = false;
+        let off = SVector::<T, C>::from_fn(|i, _| {
+            if self.bilateral[i] {
+                reach[i]
+            } else {
+                reach[i] + slop
+            }
+        });
+        for _ in 0..=SPECULATIVE_ROUNDS {
+            let after = jacobian * dq + off;
+            let joining: [bool; C] = core::array::from_fn(|i| {
+                !normal.candidates()[i] && !self.bilateral[i] && after[i] < T::zero()
+            });
+            let deep = (0..C).any(|i| {
+                (normal.candidates()[i] || joining[i])
+                    && (after[i] < T::zero() || (self.bilateral[i] && after[i] != T::zero()))
+            });
+            if !deep {
+                break;
+            }
+            normal.extend(jacobian, &mut jump, &joining)?;
+            let push = normal.complementary(&off, kinds)?.lambda;
+            dq = normal.response(&push);
+            corrected = true;
+        }
+        Ok((dq, corrected))
+    }
+}
+
+impl<T: Real, const C: usize, K> Setup<T, C, K> {
+    /// The contacts' part of a step from `s` whose free step reached `free`, the coordinates
+    /// moved by `share` (the inner method's position share times the step) of the plastic
+    /// impulses' velocity change: the end state, `memory` updated (the caller restores it
+    /// when this fails), `work` filled and used.
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn contacts_of<M, const N: usize>(
+        &self,
+        work: &mut Workspace<T, N, C>,
+        memory: &mut Memory<T, N, C>,
+        mechanism: &M,
+        s: &State<T, N>,
+        free: State<T, N>,
+        dt: T,
+        share: T,
+    ) -> Result<State<T, N>, Error>
+    where
+        M: Mechanism<T, N>,
+        K: Contacts<T, N, C>,
+    {
+        let (warm, start_energy) = match memory.last {
+            Some((p, last, e)) if continues(&last, s) => (p, Some(e)),
+            _ => (Impulses::zero(), None),
+        };
+        memory.dt = Some(dt);
+        let gaps = finite_gaps(self.contacts.position_residual(&free.q))?;
+        let touching: [bool; C] =
+            core::array::from_fn(|i| self.bilateral[i] || gaps[i] <= T::zero());
+        let in_contact = touching.iter().filter(|&&t| t).count();
+        if in_contact == 0 {
+            // The energy of a state no row touches is not needed: marked unknown.
+            let none = ImpulseReport::default();
+            memory.record(Impulses::zero(), free, T::INFINITY, [false; C], none);
+            return Ok(free);
+        }
+        if self
+            .settings
+            .max_rows()
+            .is_some_and(|cap| in_contact > cap as usize)
+        {
+            return Err(Error::InvalidParameter {
+                name: "max_rows",
+                reason: "more rows are in contact than max_rows allows",
+            });
+        }
+        let (jacobian, tangents) = self.contacts.jacobians(&free.q);
+        let jacobian = finite_rows(jacobian, &[true; C])?;
+        let frictional: [bool; C] = core::array::from_fn(|i| touching[i] && !self.bilateral[i]);
+        let tangents = match tangents {
+            Some(t) if self.model.friction() > T::zero() => Some(finite_rows(t, &frictional)?),
+            _ => None,
+        };
+        work.fill(
+            mechanism,
+            &free,
+            &jacobian,
+            tangents.as_ref(),
+            &touching,
+            &frictional,
+        )?;
+        let Workspace {
+            normal, tangent, ..
+        } = work;
+        let tangent = &*tangent;
+        let kinds = Row::kinds(&self.bilateral);
+        // The rows that pushed in the last step: the first guess of each solve's active rows.
+        let guess = if start_energy.is_some() {
+            memory.pushed
+        } else {
+            touching
+        };
+        let settings = self.settings;
+        let (rounds, tolerance, slop) = (
+            settings.max_iterations(),
+            settings.tolerance(),
+            settings.slop(),
+        );
+        let friction = self.model.friction();
+        let w = jacobian * free.qd;
+        let jump = |b: &SVector<T, N>| mechanism.velocity_jump(&free, b);
+        let mut target = SVector::<T, C>::zeros();
+        let solve =
+            |normal: &mut Delassus<T, N, C>, target: &SVector<T, C>, warm: &Impulses<T, C>| {
+                Problem {
+                    normal,
+                    kinds: &kinds,
+                    tangent,
+                    friction,
+                    pushed: &guess,
+                }
+                .solve(&free.qd, target, warm, rounds, tolerance)
+            };
+        let mut plastic = solve(normal, &target, &warm)?;
+        let (mut taken, mut speculative) = (plastic.rounds, 0u32);
+        for _ in 0..SPECULATIVE_ROUNDS {
+            let reach = jacobian * ((plastic.velocity - free.qd) * share) + gaps;
+            let joining: [bool; C] =
+                core::array::from_fn(|i| !normal.candidates()[i] && reach[i] < -slop);
+            if share <= T::zero() || !joining.iter().any(|&j| j) {
+                break;
+            }
+            normal.extend(&jacobian, jump, &joining)?;
+            for i in (0..C).filter(|&i| joining[i]) {
+                target[i] = w[i] - gaps[i] / share;
+                speculative += 1;
+            }
+            plastic = solve(normal, &target, &plastic.impulses)?;
+            taken += plastic.rounds;
+        }
+        let rebound = self.rebounds(&gaps, &w);
+        let solved = if rebound.iter().any(|&r| r > T::zero()) {
+            let bounce = target.zip_map(&rebound, |t, r| t.max(r));
+            let bounced = solve(normal, &bounce, &plastic.impulses)?;
+            taken += bounced.rounds;
+            Solved {
+                settled: plastic.settled && bounced.settled,
+                ..bounced
+            }
+        } else {
+            plastic
+        };
+        let shift = (plastic.velocity - free.qd) * share;
+        let (dq, corrected) =
+            self.drift(normal, &jacobian, jacobian * shift + gaps, &kinds, jump)?;
+        let end = State {
+            t: free.t,
+            q: free.q + shift + dq,
+            qd: solved.velocity,
+        };
+        let (end, energy, guarded) = guard(mechanism, s, start_energy, &free, end)?;
+        let count = |rows: &[bool; C]| {
+            u32::try_from(rows.iter().filter(|&&r| r).count()).unwrap_or(u32::MAX)
+        };
+        let report = ImpulseReport {
+            rows: count(normal.candidates()),
+            speculative,
+            frictional: count(&core::array::from_fn(|i| tangent[i].is_some())),
+            rounds: taken,
+            settled: solved.settled,
+            corrected,
+            energy_guard: guarded,
+        };
+        let pushed =
+            core::array::from_fn(|i| self.bilateral[i] || solved.impulses.normal[i] > T::zero());
+        memory.record(solved.impulses, end, energy, pushed, report);
+        Ok(end)
+    }
+}
