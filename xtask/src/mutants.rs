@@ -627,6 +627,8 @@ const AREAS: [Area; 22] = [
         only: None,
         tests: &[
             "--test",
+            "exact_solutions",
+            "--test",
             "spring_mass_damper",
             "--test",
             "driven",
