@@ -71,7 +71,8 @@ fn a_step_that_rounds_away_is_refused() -> Result<(), Error> {
 
 /// Far out in `f32` (t = 1e30, an ulp of 7.6e22), steps of 1e10 s round away but are finite:
 /// the steps of a run, forwards and (a symmetric base's substep) backwards, are taken, with
-/// the time where it was; a substep of zero or NaN is refused by name.
+/// the time where it was; so are huge steps from near `-MAX` whose end is finite; a substep of
+/// zero or NaN is refused by name.
 #[test]
 fn steps_of_a_run_far_out_are_taken() -> Result<(), Error> {
     let m = SimplePendulum::new(1.0f32, 1.0, 9.81, 0.0)?;
@@ -87,6 +88,17 @@ fn steps_of_a_run_far_out_are_taken() -> Result<(), Error> {
     ] {
         assert_eq!(next.t, 1e30);
         assert!(next.is_finite() && next.qd != s.qd, "{next:?}");
+    }
+    // Near the bottom of the range, a pendulum at rest at its bottom (it stays there) takes
+    // steps of 0.2 MAX from -0.9 MAX: the end, -0.7 MAX, is finite.
+    let bottom = State::new(-0.9 * f32::MAX, [0.0], [0.0]);
+    let huge = 0.2 * f32::MAX;
+    for next in [
+        Rk4.run_step(&m, &bottom, huge)?,
+        StormerVerlet::default().signed_run_step(&m, &bottom, huge)?,
+    ] {
+        assert_eq!(next.t, bottom.t + huge);
+        assert_eq!((next.q, next.qd), (bottom.q, bottom.qd));
     }
     for bad in [0.0, f32::NAN] {
         assert!(matches!(
