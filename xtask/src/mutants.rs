@@ -492,6 +492,8 @@ const AREAS: [Area; 22] = [
             "issue15",
             "--test",
             "derivatives",
+            "--test",
+            "law_parts",
         ],
         unit_tests: true,
         optimised: false,
