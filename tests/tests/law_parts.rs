@@ -145,3 +145,21 @@ fn the_residual_is_the_largest_row() {
     let nan = State::new(0.0, [f64::NAN, 0.1], [0.2, 0.3]);
     assert!(rows.residual(&nan).position.is_nan());
 }
+
+/// A state is finite only when its time, every coordinate and every velocity are: any one of
+/// them not finite makes it not finite.
+#[test]
+fn a_state_is_finite_in_every_part() {
+    let s = state();
+    assert!(s.is_finite());
+    for bad in [f64::NAN, f64::INFINITY] {
+        let (mut t, mut q, mut qd) = (s, s, s);
+        t.t = bad;
+        q.q[1] = bad;
+        qd.qd[0] = bad;
+        for x in [t, q, qd] {
+            assert!(!x.is_finite(), "{x:?}");
+            assert_eq!(x.check_finite(), Err(Error::NonFiniteState));
+        }
+    }
+}
