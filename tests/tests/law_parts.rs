@@ -163,3 +163,38 @@ fn a_state_is_finite_in_every_part() {
         }
     }
 }
+
+/// A quantity that overflows or underflows blames the parameter with the largest share of
+/// its logarithm, `power ln |x|`, and says which way it went wrong: a large factor and a
+/// large power (1e80 squared beats 1e100), a small divisor (1e-100 squared, divided by,
+/// beats 1e150), and the underflow of a divisor.
+#[test]
+fn errors_blame_the_largest_share() {
+    use lagrange_core::validate::{derived, divisor};
+    let blamed = |e: Result<f64, Error>| match e {
+        Err(Error::InvalidParameter { name, reason }) => Some((name, reason)),
+        _ => None,
+    };
+    let inf = f64::INFINITY;
+    assert_eq!(
+        blamed(derived(inf, &[("a", 1e100, 1), ("b", 1e80, 2)])),
+        Some((
+            "b",
+            "too large: a quantity formed from the parameters overflows"
+        ))
+    );
+    assert_eq!(
+        blamed(derived(inf, &[("x", 1e150, 1), ("m", 1e-100, -2)])),
+        Some((
+            "m",
+            "too small: a quantity formed from the parameters (divided by it) overflows"
+        ))
+    );
+    assert_eq!(
+        blamed(divisor(0.0, &[("k", 1e-200, 1), ("m", 1e-150, 1)])),
+        Some((
+            "k",
+            "too small: a quantity formed from the parameters that the motion divides by underflows"
+        ))
+    );
+}
