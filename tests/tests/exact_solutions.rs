@@ -235,3 +235,32 @@ fn the_kepler_orbit() -> Result<(), Error> {
     assert!(kepler_orbit(-1.0, 1.0, 0.5, 0.0).is_err());
     Ok(())
 }
+
+/// A parameter so large or so small that a quantity formed from it overflows is named, with
+/// the way it went wrong: the pendulum's rate (its speed scale 2 w), its period (divided by a
+/// tiny w), and the oscillator's mass, divided by in k / m and in (c / 2m)^2.
+#[test]
+fn the_parameter_to_blame_is_named() {
+    let named = |e: Result<(f64, f64), Error>| match e {
+        Err(Error::InvalidParameter { name, reason }) => Some((name, reason)),
+        _ => None,
+    };
+    let large = "too large: a quantity formed from the parameters overflows";
+    let small = "too small: a quantity formed from the parameters (divided by it) overflows";
+    assert_eq!(
+        named(pendulum_from_rest(0.5, 0.6 * f64::MAX, 0.0)),
+        Some(("omega", large))
+    );
+    assert_eq!(
+        named(pendulum_period(0.5, 1e-320).map(|p| (p, p))),
+        Some(("omega", small))
+    );
+    assert_eq!(
+        named(damped_oscillator(1e-300, 1e10, 0.0, 1.0, 0.0, 1.0)),
+        Some(("mass", small))
+    );
+    assert_eq!(
+        named(damped_oscillator(1e-150, 0.0, 1e10, 1.0, 0.0, 1.0)),
+        Some(("mass", small))
+    );
+}
