@@ -28,7 +28,7 @@
 //! scenes            225     808 s   (scene, bank, banks, sleep)
 //! clocks            201     246 s   (clock, frame_clock, fixed_timestep)
 //! drivers           128     532 s   (integrator, projected, adaptive/settings)
-//! exact             473        -    (exact, exact/*)
+//! exact             473     852 s   (exact, exact/*)
 //! ```
 //!
 //! ```text
