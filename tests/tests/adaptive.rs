@@ -285,6 +285,15 @@ fn bad_settings_and_calls_are_refused<T: Real>() -> Result<(), Error> {
     refuses(ok.with_initial_step(inf), "h_initial");
     refuses(ok.with_max_steps(0), "max_steps");
     refuses(ok.with_event_tolerance(-one), "event_tolerance");
+    // What is given is kept: each setting reads back as set, the others as they were.
+    let two = T::TWO;
+    let set = ok.with_step_bounds(tiny, two)?;
+    assert_eq!((set.h_min(), set.h_max()), (tiny, two));
+    assert_eq!((set.rtol(), set.atol()), (ok.rtol(), ok.atol()));
+    assert!(!ok.energy_projection());
+    let projecting = set.with_energy_projection();
+    assert!(projecting.energy_projection());
+    assert_eq!(projecting.h_max(), two);
 
     let p = SimplePendulum::new(one, one, T::from_f64(G), T::zero())?;
     let mut i = DormandPrince54::new(ok);

@@ -5,7 +5,7 @@ use lagrange_core::{
     Error, EulerLagrange, Lagrangian, Mechanism, Real, Scalar, State, ViscousDamping,
 };
 use lagrange_integrators::{
-    AdaptiveSettings, BackwardEuler, DormandPrince54, ExplicitEuler, GaussLegendre2,
+    AdaptiveSettings, BackwardEuler, DormandPrince54, ExplicitEuler, Failure, GaussLegendre2,
     ImplicitMidpoint, Integrator, RadauIIA2, Rk4, SemiImplicitEuler, StormerVerlet,
     VariationalMidpoint, VelocityVerlet, Yoshida4,
 };
@@ -295,4 +295,34 @@ fn rk4_refuses_poison<const N: usize>() -> Result<(), Error> {
 fn rk4_refuses_a_stage_that_is_not_finite() -> Result<(), Error> {
     rk4_refuses_poison::<1>()?;
     rk4_refuses_poison::<6>()
+}
+
+/// An error reads as a sentence that names what went wrong, and a failed run as the step, the
+/// time it began at and its error; the failure converts back to its error for `?`.
+#[test]
+fn errors_read_as_sentences() {
+    let nan = Error::NonFiniteState;
+    assert_eq!(nan.to_string(), "state is not finite (NaN or infinity)");
+    let dt = Error::InvalidParameter {
+        name: "dt",
+        reason: "must be positive and finite",
+    };
+    assert_eq!(
+        dt.to_string(),
+        "invalid parameter `dt`: must be positive and finite"
+    );
+    assert_eq!(
+        Error::RedundantConstraints { row: 2 }.to_string(),
+        "constraint 2 is singular here or depends on the ones before it (redundant or singular constraints)"
+    );
+    let failure = Failure {
+        error: nan,
+        step: 3,
+        last: State::new(0.5, [1.0], [0.0]),
+    };
+    assert_eq!(
+        failure.to_string(),
+        "step 3 (from t = 0.5) failed: state is not finite (NaN or infinity)"
+    );
+    assert_eq!(Error::from(failure), nan);
 }

@@ -94,6 +94,19 @@ fn inconsistent_start_is_refused<T: Real>() -> Result<(), Error> {
     let good = p.parts().state_from_angle(T::zero(), T::HALF, T::one());
     let next = stepper.step(&p, &good, dt)?;
     stepper.step(&p, &next, dt)?;
+    // The stepper's own last output continues unchecked; that output with its coordinates
+    // or its velocities moved off the constraint is a new start, checked and refused.
+    let last = stepper.step(&p, &next, dt)?;
+    let mut moved = last;
+    moved.q[0] += T::from_f64(0.1);
+    let mut pushed = last;
+    pushed.qd[0] += T::from_f64(0.1);
+    for bad in [moved, pushed] {
+        assert_eq!(
+            stepper.step(&p, &bad, dt),
+            Err(Error::ConstraintViolated { row: 0 })
+        );
+    }
 
     let linkage = Constrained::new(FourBarLinkage::new(
         [T::one(), T::from_f64(0.3), T::one(), T::from_f64(0.8)],
