@@ -423,11 +423,15 @@ where
             columns.set_column(i, &jacobian.row(i).transpose());
         }
         if let Some(t) = &tangent_rows {
-            for i in (0..C).filter(|&i| frictional[i]) {
+            // Row by row through iterators, and `k < C` clamped (a no-op), here and where the
+            // slots are read: no bounds check (no panic path) is left to the optimiser.
+            let tangents = t.row_iter().zip(&frictional).zip(&mut slot);
+            for ((row, _), slot) in tangents.filter(|((_, &on), _)| on) {
                 match free.next() {
                     Some(k) => {
-                        columns.set_column(k, &t.row(i).transpose());
-                        slot[i] = Some(k);
+                        let k = k.min(C - 1);
+                        columns.set_column(k, &row.transpose());
+                        *slot = Some(k);
                     }
                     None => overflow = true,
                 }
@@ -445,19 +449,26 @@ where
         };
         let rest = if overflow {
             let mut columns = SMatrix::<T, N, C>::zeros();
-            for i in (0..C).filter(|&i| frictional[i] && slot[i].is_none()) {
-                columns.set_column(i, &t.row(i).transpose());
+            let tangents = columns.column_iter_mut().zip(t.row_iter());
+            for ((mut column, row), _) in tangents
+                .zip(frictional.iter().zip(&slot))
+                .filter(|(_, (&on, slot))| on && slot.is_none())
+            {
+                column.copy_from(&row.transpose());
             }
             Some(mechanism.velocity_jumps(state, &columns)?)
         } else {
             None
         };
         for i in (0..C).filter(|&i| frictional[i]) {
-            let b = match (slot[i], &rest) {
-                (Some(k), _) => jumps.column(k).into_owned(),
-                (None, Some(r)) => r.column(i).into_owned(),
+            // Copied rather than `into_owned` (whose length assertion stays in the optimised
+            // code, a panic path).
+            let mut b = SVector::<T, N>::zeros();
+            match (slot[i], &rest) {
+                (Some(k), _) => b.copy_from(&jumps.column(k.min(C - 1))),
+                (None, Some(r)) => b.copy_from(&r.column(i)),
                 (None, None) => continue,
-            };
+            }
             out[i] = Direction::new(t.row(i).transpose(), b);
         }
         Ok((rows, out))

@@ -116,12 +116,11 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
         self.mobility = mobility_of(&self.jacobian.transpose())?;
         self.candidate = *candidate;
         for i in (0..C).filter(|&i| candidate[i]) {
+            let row = self.jacobian.row(i).transpose();
             for k in (i..C).filter(|&k| candidate[k]) {
-                let x = self
-                    .jacobian
-                    .row(i)
-                    .transpose()
-                    .dot(&self.mobility.column(k));
+                // `k < C`, clamped (a no-op) so that the optimiser drops the bounds check it
+                // otherwise keeps (a panic path).
+                let x = row.dot(&self.mobility.column(k.min(C - 1)));
                 if !x.is_finite() {
                     return Err(Error::NonFiniteState);
                 }
@@ -267,8 +266,11 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
             }
             if let Some((row, reach)) = stop {
                 lambda += (x - lambda) * reach;
-                lambda[row] = T::zero();
-                active[row] = false;
+                // `row < C`: reached through `get_mut`, so that no bounds check (no panic
+                // path) is left where the optimiser cannot see it.
+                if let (Some(l), Some(a)) = (lambda.get_mut(row), active.get_mut(row)) {
+                    (*l, *a) = (T::zero(), false);
+                }
                 blocked = [false; C];
                 continue;
             }
@@ -291,7 +293,11 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
                 }
             }
             match join {
-                Some((row, _)) => active[row] = true,
+                Some((row, _)) => {
+                    if let Some(a) = active.get_mut(row) {
+                        *a = true;
+                    }
+                }
                 None if lambda.iter().all(|x| x.is_finite()) => {
                     return Ok(Complementary { lambda, active });
                 }
@@ -307,38 +313,48 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
     /// of the active rows alone, refusing a pivot below `sqrt(EPSILON)` of its diagonal
     /// entry (a row dependent on the ones before it).
     fn solve(&mut self, active: &[bool; C], r: &SVector<T, C>) -> Result<SVector<T, C>, Error> {
+        // The active rows in order, `n` of them. Every index below is in range by
+        // construction; where the optimiser cannot see it (a count, a row number read back
+        // from `set`) it is clamped, a no-op, so that no bounds check (no panic path) is left.
         let mut set = [0usize; C];
         let mut n = 0;
-        for i in (0..C).filter(|&i| active[i]) {
-            set[n] = i;
+        for (slot, i) in set.iter_mut().zip((0..C).filter(|&i| active[i])) {
+            *slot = i;
             n += 1;
         }
+        let n = n.min(C);
+        let row = |p: usize| set[p].min(C - 1);
         let threshold = T::EPSILON.sqrt();
         let l = &mut self.factor;
         for p in 0..n {
-            let wpp = self.w[(set[p], set[p])];
+            let wpp = self.w[(row(p), row(p))];
             let d = (0..p).fold(wpp, |d, k| d - l[(p, k)] * l[(p, k)]);
             if !d.is_finite() {
                 return Err(Error::NonFiniteState);
             }
             if d <= wpp.abs() * threshold {
-                return Err(Error::RedundantConstraints { row: set[p] });
+                return Err(Error::RedundantConstraints { row: row(p) });
             }
             let lpp = d.sqrt();
             l[(p, p)] = lpp;
             for q in p + 1..n {
-                let x = (0..p).fold(self.w[(set[q], set[p])], |x, k| x - l[(q, k)] * l[(p, k)]);
+                let x = (0..p).fold(self.w[(row(q), row(p))], |x, k| x - l[(q, k)] * l[(p, k)]);
                 l[(q, p)] = x / lpp;
             }
         }
         let mut y = [T::zero(); C];
         for p in 0..n {
-            y[p] = (0..p).fold(r[set[p]], |s, k| s - l[(p, k)] * y[k]) / l[(p, p)];
+            y[p] = (0..p).fold(r[row(p)], |s, k| s - l[(p, k)] * y[k]) / l[(p, p)];
+        }
+        // Solved in the active rows' order, then put in place.
+        let mut solved = [T::zero(); C];
+        for p in (0..n).rev() {
+            let s = (p + 1..n).fold(y[p], |s, k| s - l[(k, p)] * solved[k]);
+            solved[p] = s / l[(p, p)];
         }
         let mut x = SVector::<T, C>::zeros();
-        for p in (0..n).rev() {
-            let s = (p + 1..n).fold(y[p], |s, k| s - l[(k, p)] * x[set[k]]);
-            x[set[p]] = s / l[(p, p)];
+        for (p, value) in solved.iter().enumerate().take(n) {
+            x[row(p)] = *value;
         }
         Ok(x)
     }
