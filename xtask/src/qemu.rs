@@ -368,6 +368,9 @@ fn run_image(elf: &Path) -> Result<(), String> {
 struct Log {
     /// `(cases, steps)` from the header line.
     header: Option<(usize, u32)>,
+    /// Bytes the stack probe paints (from the header line): a mark of all of them means the
+    /// probe was too shallow.
+    paint: Option<u64>,
     /// Final-state words by case id (`None`: the case returned an error).
     states: BTreeMap<usize, Option<Vec<u64>>>,
     /// SysTick ticks of a run of no steps and of `STEPS` steps (`None`: it wrapped).
@@ -407,6 +410,7 @@ fn parse_log(text: &str) -> Result<Log, String> {
                 let cases = field(words.next(), "cases=").ok_or_else(bad)?;
                 let steps = field(words.next(), "steps=").ok_or_else(bad)?;
                 log.header = Some((cases, steps));
+                log.paint = Some(field(words.next(), "paint=").ok_or_else(bad)?);
             }
             "case" => {
                 let id = usize::try_from(number(words.next())?).map_err(|_| bad())?;
@@ -524,6 +528,14 @@ fn lockstep(elf: &Path, decoder: &Path) -> Result<Vec<String>, String> {
             .stacks
             .get(&id)
             .map_or_else(|| "-".into(), u64::to_string);
+        if let (Some(&bytes), Some(paint)) = (log.stacks.get(&id), log.paint) {
+            if bytes >= paint {
+                failures.push(format!(
+                    "case {id}: its stack reached the probe's whole depth ({paint} B): deeper \
+                     than measured"
+                ));
+            }
+        }
         println!(
             "{id:>3}  {:<28} {:<21} {:<5} {:<12} {cost:>12} {stack:>8}",
             case.system, case.method, case.precision, verdict

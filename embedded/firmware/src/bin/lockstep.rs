@@ -8,7 +8,7 @@
 //! Log lines (the host parses them):
 //!
 //! ```text
-//! lockstep cases=<n> steps=<STEPS>
+//! lockstep cases=<n> steps=<STEPS> paint=<bytes the stack probe paints>
 //! case <id> <words as [a, b, ...]>       or   case <id> error
 //! cost <id> <ticks for 0 steps> <ticks for STEPS steps>
 //! stack <id> <bytes>
@@ -25,7 +25,7 @@
 use cortex_m_rt::{entry, exception, ExceptionFrame};
 use defmt_semihosting as _;
 use lagrange_cases::{CASES, KERNELS, KERNEL_CALLS, STEPS};
-use lagrange_firmware::{exit, stack_high_water, Counter};
+use lagrange_firmware::{exit, stack_high_water, Counter, PAINT_DEPTH};
 
 /// The calibration loop's argument: `cortex_m::asm::delay(n)` (cortex-m 0.7.10) runs `n + 1`
 /// iterations of `subs; bne`, so `delay(n)` takes `2 n` instructions more than `delay(0)`.
@@ -38,7 +38,12 @@ fn main() -> ! {
         exit(false)
     };
     let mut counter = Counter::start(peripherals.SYST);
-    defmt::println!("lockstep cases={=usize} steps={=u32}", CASES.len(), STEPS);
+    defmt::println!(
+        "lockstep cases={=usize} steps={=u32} paint={=u32}",
+        CASES.len(),
+        STEPS,
+        PAINT_DEPTH
+    );
     let mut ok = true;
     for (id, case) in CASES.iter().enumerate() {
         let (_, setup_ticks) = counter.measure(|| case.run(0));
