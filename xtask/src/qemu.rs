@@ -16,7 +16,8 @@
 //!    those of a run of none, times instructions per tick as the firmware's calibration loop
 //!    measures it), the worst single step of the cases that time their steps (the ragdoll
 //!    landing under the impulse stepper, beside its free RK4 step), stack high-water marks and
-//!    `.text` sizes, and checks the budgets.
+//!    `.text` sizes (the ragdoll stepped with and without the impulse stepper among them), and
+//!    checks the budgets.
 
 use std::collections::BTreeMap;
 use std::io::{Read, Write};
@@ -103,6 +104,10 @@ pub fn run() -> Result<(), String> {
         "scene-text",
         "--bin",
         "loop-text",
+        "--bin",
+        "ragdoll-text",
+        "--bin",
+        "ragdoll-impulse-text",
     ]) {
         Ok(dir) => dir,
         Err(e) => return Err(format!("xtask qemu: {e}")),
@@ -803,6 +808,16 @@ fn sizes(
         "loop-text (16 pendulums, a FixedTimestep each)",
         i64::from(scene) - i64::from(plain),
         f64::from(scene) / f64::from(plain)
+    );
+    let free = text_size(&dir.join("ragdoll-text"))?;
+    let impulses = text_size(&dir.join("ragdoll-impulse-text"))?;
+    println!(
+        "  {:<40} {free:>8} B\n  {:<40} {impulses:>8} B\n  the impulse stepper with the \
+         ragdoll's {RAGDOLL_ROWS} rows adds {:+} B ({:.2}x)",
+        "ragdoll-text (f32, semi-implicit Euler)",
+        "ragdoll-impulse-text (the same, impulses)",
+        i64::from(impulses) - i64::from(free),
+        f64::from(impulses) / f64::from(free)
     );
     match libm_one_mechanism {
         Ok(text) => println!("  {:<40} {text:>8} B", "one-mechanism with libm-trig"),
