@@ -215,6 +215,7 @@ pub(crate) struct Pose<S> {
 impl<S: Scalar> Pose<S> {
     /// The point `along`, `across` of link `link`, relative to the torso's centre of mass.
     pub fn point(&self, link: usize, along: S, across: S) -> [S; 2] {
+        let link = link.min(RAGDOLL_LINKS - 1);
         let (s, c) = (self.sin[link], self.cos[link]);
         let [ox, oy] = self.origin[link];
         [ox + along * s + across * c, oy - along * c + across * s]
@@ -491,9 +492,9 @@ impl<T: Real> Ragdoll<T> {
         (pose.sin[TORSO], pose.cos[TORSO]) = q[2].sin_cos();
         for k in 1..RAGDOLL_LINKS {
             let j = self.joint[k];
-            angle[k] = angle[j.link] + q[k + 2] + self.rest[k];
+            angle[k] = angle[PARENT[k]] + q[k + 2] + self.rest[k];
             (pose.sin[k], pose.cos[k]) = angle[k].sin_cos();
-            pose.origin[k] = pose.point(j.link, S::from_real(j.along), S::from_real(j.across));
+            pose.origin[k] = pose.point(PARENT[k], S::from_real(j.along), S::from_real(j.across));
             let half = S::from_real(self.length[k] * T::HALF);
             pose.com[k] = pose.point(k, half, zero);
         }
@@ -508,7 +509,7 @@ impl<T: Real> Ragdoll<T> {
         let mut w = [S::zero(); RAGDOLL_LINKS];
         w[TORSO] = qd[2];
         for k in 1..RAGDOLL_LINKS {
-            w[k] = w[self.joint[k].link] + qd[k + 2];
+            w[k] = w[PARENT[k]] + qd[k + 2];
         }
         w
     }

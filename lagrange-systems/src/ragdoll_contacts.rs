@@ -178,10 +178,11 @@ impl<T: Real> RagdollContacts<T> {
             dx[2] = -p[1];
             let mut k = m.link;
             while k != 0 {
-                let o = pose.origin[k];
-                dy[k + 2] = p[0] - o[0];
-                dx[k + 2] = -(p[1] - o[1]);
-                k = PARENT[k];
+                let link = k.min(RAGDOLL_LINKS - 1);
+                let o = pose.origin[link];
+                dy[link + 2] = p[0] - o[0];
+                dx[link + 2] = -(p[1] - o[1]);
+                k = PARENT[link];
             }
             (dy, dx)
         })

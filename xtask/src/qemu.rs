@@ -14,7 +14,10 @@
 //!    `lagrange_cases::CASES` on the host, and compares every final state bit for bit.
 //! 5. Reports instructions per step of every case (SysTick ticks of a run of `STEPS` steps less
 //!    those of a run of none, times instructions per tick as the firmware's calibration loop
-//!    measures it), stack high-water marks and `.text` sizes, and checks the budgets.
+//!    measures it), the worst single step of the cases that time their steps (the ragdoll
+//!    landing under the impulse stepper, beside its free RK4 step), stack high-water marks and
+//!    `.text` sizes (the ragdoll stepped with and without the impulse stepper among them), and
+//!    checks the budgets.
 
 use std::collections::BTreeMap;
 use std::io::{Read, Write};
@@ -22,7 +25,10 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, ExitStatus, Stdio};
 use std::time::{Duration, Instant};
 
-use lagrange_cases::{CASES, KERNELS, KERNEL_CALLS, LANE_INSTANCES, SLEEPERS, STEPS};
+use lagrange_cases::{
+    CASES, KERNELS, KERNEL_CALLS, LANE_INSTANCES, RAGDOLL_FREE, RAGDOLL_ITERATIONS,
+    RAGDOLL_LANDING, RAGDOLL_ROWS, SLEEPERS, STEPS,
+};
 
 use crate::cmd;
 use crate::cross::{self, TARGET};
@@ -98,6 +104,10 @@ pub fn run() -> Result<(), String> {
         "scene-text",
         "--bin",
         "loop-text",
+        "--bin",
+        "ragdoll-text",
+        "--bin",
+        "ragdoll-impulse-text",
     ]) {
         Ok(dir) => dir,
         Err(e) => return Err(format!("xtask qemu: {e}")),
@@ -107,7 +117,10 @@ pub fn run() -> Result<(), String> {
         format!("panic-free image: a panic path is left in the stepping code, or ({e})")
     });
     match &panic_free {
-        Ok(_) => println!("panic-free image linked: no panic path in the stepping code"),
+        Ok(_) => println!(
+            "panic-free image linked: no panic path in the stepping code (the ragdoll's \
+             impulse stepper included)"
+        ),
         Err(e) => failures.push(e.clone()),
     }
 
@@ -368,12 +381,18 @@ fn run_image(elf: &Path) -> Result<(), String> {
 struct Log {
     /// `(cases, steps)` from the header line.
     header: Option<(usize, u32)>,
+    /// Bytes the stack probe paints (from the header line): a mark of all of them means the
+    /// probe was too shallow.
+    paint: Option<u64>,
     /// Final-state words by case id (`None`: the case returned an error).
     states: BTreeMap<usize, Option<Vec<u64>>>,
     /// SysTick ticks of a run of no steps and of `STEPS` steps (`None`: it wrapped).
     costs: BTreeMap<usize, Option<(u64, u64)>>,
     /// Stack high-water mark by case id, bytes.
     stacks: BTreeMap<usize, u64>,
+    /// SysTick ticks of the slowest step by case id, for the cases that time their steps
+    /// (`None`: a step wrapped the counter).
+    worst: BTreeMap<usize, Option<u64>>,
     /// `(digest, ticks)` by kernel id.
     kernels: BTreeMap<usize, (u64, u64)>,
     /// `(instructions, ticks)` of the calibration loop.
@@ -407,6 +426,7 @@ fn parse_log(text: &str) -> Result<Log, String> {
                 let cases = field(words.next(), "cases=").ok_or_else(bad)?;
                 let steps = field(words.next(), "steps=").ok_or_else(bad)?;
                 log.header = Some((cases, steps));
+                log.paint = Some(field(words.next(), "paint=").ok_or_else(bad)?);
             }
             "case" => {
                 let id = usize::try_from(number(words.next())?).map_err(|_| bad())?;
@@ -435,6 +455,16 @@ fn parse_log(text: &str) -> Result<Log, String> {
             "stack" => {
                 let id = usize::try_from(number(words.next())?).map_err(|_| bad())?;
                 log.stacks.insert(id, number(words.next())?);
+            }
+            "worst" => {
+                let id = usize::try_from(number(words.next())?).map_err(|_| bad())?;
+                let next = words.next();
+                let ticks = if next == Some("wrapped") {
+                    None
+                } else {
+                    Some(number(next)?)
+                };
+                log.worst.insert(id, ticks);
             }
             "kernel" => {
                 let id = usize::try_from(number(words.next())?).map_err(|_| bad())?;
@@ -486,15 +516,22 @@ fn lockstep(elf: &Path, decoder: &Path) -> Result<Vec<String>, String> {
     let per_tick = instructions_per_tick(log.calibration)?;
     println!(
         "\nlockstep on the M4F (QEMU mps2-an386, -icount shift=0: {per_tick} instructions per \
-         SysTick tick), {STEPS} steps of 1 ms:"
+         SysTick tick), {STEPS} steps (of 1 ms; the scenes' frames of 1/120 s, the ragdoll's \
+         steps of 1/240 s); instructions per step, the mean and, where a case times its steps, \
+         the worst:"
     );
     println!(
-        "{:>3}  {:<28} {:<21} {:<5} {:<12} {:>12} {:>8}",
-        "id", "system", "integrator", "type", "host = M4F", "instr/step", "stack B"
+        "{:>3}  {:<28} {:<29} {:<5} {:<12} {:>12} {:>12} {:>8}",
+        "id", "system", "integrator", "type", "host = M4F", "instr/step", "worst step", "stack B"
     );
     let mut per_step = BTreeMap::new();
+    let mut worst_step = BTreeMap::new();
+    let mut words = BTreeMap::new();
     for (id, case) in CASES.iter().enumerate() {
         let host = case.run(STEPS).ok().map(|o| o.words().to_vec());
+        if let Some(h) = &host {
+            words.insert(id, h.clone());
+        }
         let firmware = log.states.get(&id);
         let verdict = match (firmware, &host) {
             (Some(Some(f)), Some(h)) if f == h => "identical",
@@ -520,12 +557,36 @@ fn lockstep(elf: &Path, decoder: &Path) -> Result<Vec<String>, String> {
                 "-".into()
             }
         };
+        let worst = match log.worst.get(&id) {
+            Some(Some(ticks)) => {
+                let instructions = ticks * per_tick;
+                worst_step.insert(id, instructions);
+                instructions.to_string()
+            }
+            Some(None) => {
+                failures.push(format!("case {id}: a step wrapped the counter"));
+                "wrapped".into()
+            }
+            None if case.times_steps() => {
+                failures.push(format!("case {id}: no worst step measured"));
+                "missing".into()
+            }
+            None => "-".into(),
+        };
         let stack = log
             .stacks
             .get(&id)
             .map_or_else(|| "-".into(), u64::to_string);
+        if let (Some(&bytes), Some(paint)) = (log.stacks.get(&id), log.paint) {
+            if bytes >= paint {
+                failures.push(format!(
+                    "case {id}: its stack reached the probe's whole depth ({paint} B): deeper \
+                     than measured"
+                ));
+            }
+        }
         println!(
-            "{id:>3}  {:<28} {:<21} {:<5} {:<12} {cost:>12} {stack:>8}",
+            "{id:>3}  {:<28} {:<29} {:<5} {:<12} {cost:>12} {worst:>12} {stack:>8}",
             case.system, case.method, case.precision, verdict
         );
     }
@@ -553,6 +614,7 @@ fn lockstep(elf: &Path, decoder: &Path) -> Result<Vec<String>, String> {
     }
     failures.extend(asleep_cost(&per_step));
     lane_cost(&per_step);
+    failures.extend(ragdoll_cost(&per_step, &worst_step, &words, &log.stacks));
     failures.extend(kernels(&log, per_tick));
     Ok(failures)
 }
@@ -605,6 +667,68 @@ fn lane_cost(per_step: &BTreeMap<usize, f64>) {
             bank / alone
         );
     }
+}
+
+/// The ragdoll landing under the impulse stepper against its free step: mean and worst
+/// instructions per step of each, their ratios, the worst step's work (the landing's peak
+/// report, from its outcome words) beside the stepper's documented bound, and the stack; the
+/// failed checks (a figure missing, the work past its cap).
+fn ragdoll_cost(
+    per_step: &BTreeMap<usize, f64>,
+    worst_step: &BTreeMap<usize, u64>,
+    words: &BTreeMap<usize, Vec<u64>>,
+    stacks: &BTreeMap<usize, u64>,
+) -> Vec<String> {
+    let id = |system: &str| CASES.iter().position(|c| c.system == system);
+    let (Some(landing), Some(free)) = (id(RAGDOLL_LANDING), id(RAGDOLL_FREE)) else {
+        return vec!["no ragdoll cases in CASES".into()];
+    };
+    let figures = (
+        per_step.get(&landing),
+        worst_step.get(&landing),
+        per_step.get(&free),
+        worst_step.get(&free),
+    );
+    let (Some(&mean), Some(&worst), Some(&free_mean), Some(&free_worst)) = figures else {
+        return vec!["no cost measured for the ragdoll cases".into()];
+    };
+    let worst = worst as f64;
+    println!(
+        "ragdoll landing (f32, impulse stepper, semi-implicit Euler inside, {RAGDOLL_ROWS} rows, \
+         1/240 s): {mean:.0} instructions per step on average, {worst:.0} in the worst step; \
+         a free RK4 step of the ragdoll {free_mean:.0} (worst {free_worst}): the landing's worst \
+         step is {:.1} free steps, its mean {:.2}; stack {} B (free: {} B)",
+        worst / free_mean,
+        mean / free_mean,
+        stacks.get(&landing).copied().unwrap_or_default(),
+        stacks.get(&free).copied().unwrap_or_default(),
+    );
+    let Some(&[.., rows, speculative, frictional, rounds]) = words.get(&landing).map(Vec::as_slice)
+    else {
+        return vec!["no peak report in the ragdoll landing's outcome".into()];
+    };
+    let k = u64::from(RAGDOLL_ITERATIONS);
+    println!(
+        "  its worst work (peak report): R = {rows} rows ({speculative} speculative), F = \
+         {frictional} with friction, {rounds} rounds (cap 4 K = {}, C = {RAGDOLL_ROWS})",
+        4 * k
+    );
+    println!(
+        "  bound (ImpulseStepper's docs): the inner step + position_residual + jacobian + \
+         tangent_jacobian + 2 velocity_jumps (R and F columns) + a velocity_jump per \
+         speculative row + at most 4 solves x K rounds (an exact solve of the R rows: Cholesky \
+         of at most R rows a pass, at most 4 C + 4 passes; a sweep of the F tangents) + at \
+         most 3 exact solves for the drift + 2 to 4 evaluations of T and V"
+    );
+    let mut failures = Vec::new();
+    if rows > RAGDOLL_ROWS as u64 || rounds > 4 * k {
+        failures.push(format!(
+            "ragdoll landing: {rows} rows and {rounds} rounds in a step, past the caps of \
+             {RAGDOLL_ROWS} rows and {} rounds",
+            4 * k
+        ));
+    }
+    failures
 }
 
 /// Compares the kernels' digests with the host's and prints instructions per call (the
@@ -687,6 +811,16 @@ fn sizes(
         "loop-text (16 pendulums, a FixedTimestep each)",
         i64::from(scene) - i64::from(plain),
         f64::from(scene) / f64::from(plain)
+    );
+    let free = text_size(&dir.join("ragdoll-text"))?;
+    let impulses = text_size(&dir.join("ragdoll-impulse-text"))?;
+    println!(
+        "  {:<40} {free:>8} B\n  {:<40} {impulses:>8} B\n  the impulse stepper with the \
+         ragdoll's {RAGDOLL_ROWS} rows adds {:+} B ({:.2}x)",
+        "ragdoll-text (f32, semi-implicit Euler)",
+        "ragdoll-impulse-text (the same, impulses)",
+        i64::from(impulses) - i64::from(free),
+        f64::from(impulses) / f64::from(free)
     );
     match libm_one_mechanism {
         Ok(text) => println!("  {:<40} {text:>8} B", "one-mechanism with libm-trig"),

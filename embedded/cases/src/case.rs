@@ -1,4 +1,5 @@
-//! [`Case`]: one mechanism x integrator x scalar run, and its [`Outcome`] as bit patterns.
+//! [`Case`]: one mechanism x integrator x scalar run, its [`Outcome`] as bit patterns, and
+//! the [`Stopwatch`] that times each step of a case that lets it.
 
 use core::hint::black_box;
 
@@ -72,6 +73,35 @@ impl Outcome {
     }
 }
 
+/// What times each step of a run, one at a time: the firmware's SysTick, for the worst step
+/// of a case whose cost varies from step to step (contacts); [`Untimed`] elsewhere.
+pub trait Stopwatch {
+    /// Runs `step` once (timing it) and returns its result.
+    ///
+    /// # Errors
+    /// `step`'s.
+    fn time(&mut self, step: &mut dyn FnMut() -> Result<(), Error>) -> Result<(), Error>;
+}
+
+/// The [`Stopwatch`] that times nothing: it only runs the step.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Untimed;
+
+impl Stopwatch for Untimed {
+    fn time(&mut self, step: &mut dyn FnMut() -> Result<(), Error>) -> Result<(), Error> {
+        step()
+    }
+}
+
+/// How a [`Case`] runs.
+#[derive(Debug, Clone, Copy)]
+enum Runner {
+    /// A run of `steps` steps, as a whole.
+    Whole(fn(u32) -> Result<Outcome, Error>),
+    /// A run of `steps` steps, each through a [`Stopwatch`].
+    Stepwise(fn(u32, &mut dyn Stopwatch) -> Result<Outcome, Error>),
+}
+
 /// One lockstep case: a [`Setup`] stepped by an integrator in a scalar type.
 #[derive(Debug, Clone, Copy)]
 pub struct Case {
@@ -84,7 +114,7 @@ pub struct Case {
     /// Words in its outcome: `1 + 2 N` for a mechanism's final state (`t`, `q`, `q'`), its
     /// own count for a scripted case.
     pub words: usize,
-    runner: fn(u32) -> Result<Outcome, Error>,
+    runner: Runner,
 }
 
 impl Case {
@@ -101,7 +131,7 @@ impl Case {
             method: I::NAME,
             precision: T::NAME,
             words: 1 + 2 * N,
-            runner: run::<T, N, S, I>,
+            runner: Runner::Whole(run::<T, N, S, I>),
         }
     }
 
@@ -118,7 +148,7 @@ impl Case {
             method: "variational midpoint",
             precision: T::NAME,
             words: 1 + 2 * N,
-            runner: run_variational::<T, N, S>,
+            runner: Runner::Whole(run_variational::<T, N, S>),
         }
     }
 
@@ -137,7 +167,27 @@ impl Case {
             method,
             precision,
             words,
-            runner,
+            runner: Runner::Whole(runner),
+        }
+    }
+
+    /// A case run by `runner` of its own, which takes each of its `steps` steps through the
+    /// [`Stopwatch`] it is given (so that the firmware can time the worst), and whose outcome
+    /// holds `words` words.
+    #[must_use]
+    pub const fn stepwise(
+        system: &'static str,
+        method: &'static str,
+        precision: &'static str,
+        words: usize,
+        runner: fn(u32, &mut dyn Stopwatch) -> Result<Outcome, Error>,
+    ) -> Self {
+        Self {
+            system,
+            method,
+            precision,
+            words,
+            runner: Runner::Stepwise(runner),
         }
     }
 
@@ -146,7 +196,26 @@ impl Case {
     /// # Errors
     /// Whatever the setup's constructor or a step returns.
     pub fn run(&self, steps: u32) -> Result<Outcome, Error> {
-        (self.runner)(steps)
+        self.run_timed(steps, &mut Untimed)
+    }
+
+    /// Whether the case takes its steps one by one through a [`Stopwatch`]
+    /// ([`Case::run_timed`] times them).
+    #[must_use]
+    pub fn times_steps(&self) -> bool {
+        matches!(self.runner, Runner::Stepwise(_))
+    }
+
+    /// As [`Case::run`], each step through `watch` where the case [times its
+    /// steps](Case::times_steps) (elsewhere `watch` is not called).
+    ///
+    /// # Errors
+    /// As [`Case::run`].
+    pub fn run_timed(&self, steps: u32, watch: &mut dyn Stopwatch) -> Result<Outcome, Error> {
+        match self.runner {
+            Runner::Whole(run) => run(steps),
+            Runner::Stepwise(run) => run(steps, watch),
+        }
     }
 }
 

@@ -28,14 +28,19 @@ mod case;
 mod kernels;
 mod lanes;
 mod libm_trig_pendulum;
+mod ragdoll;
 mod scenes;
 mod setups;
 mod spring_chain;
 
-pub use case::{Case, Outcome, Precision, MAX_WORDS};
+pub use case::{Case, Outcome, Precision, Stopwatch, Untimed, MAX_WORDS};
 pub use kernels::{Kernel, KERNELS, KERNEL_CALLS};
 pub use lanes::{pendulums_alone, pendulums_in_a_bank, pendulums_in_lanes, LANE_INSTANCES};
 pub use libm_trig_pendulum::LibmTrigPendulum;
+pub use ragdoll::{
+    ragdoll_free, ragdoll_landing, ragdoll_thrown, RAGDOLL_DT, RAGDOLL_FREE, RAGDOLL_ITERATIONS,
+    RAGDOLL_LANDING, RAGDOLL_ROWS,
+};
 pub use scenes::{many_sleepers, no_sleepers, scripted, with_sleepers, SLEEPERS};
 pub use setups::{
     CartPoleLagrangianSetup, CartPoleSetup, DoublePendulumSetup, LibmTrigPendulumSetup,
@@ -59,8 +64,10 @@ pub const STEPS: u32 = 1000;
 /// compared against. The cart-pole (mass matrix depending on `q`) is stepped by RK4, by
 /// Stormer-Verlet (symmetric, with an implicit kick), and by the variational midpoint rule,
 /// symplectic for any Lagrangian (on the automatic Euler-Lagrange path, Newton iterations in
-/// dual numbers).
-pub const CASES: [Case; 25] = [
+/// dual numbers). The ragdoll is thrown onto the floor and lands and settles under the
+/// impulse stepper (steps of 1/240 s: 4.2 s), beside the same throw with no floor stepped by
+/// RK4; both take their steps one by one, so that the firmware times the worst step of each.
+pub const CASES: [Case; 27] = [
     Case::new::<f32, 1, PendulumSetup, Rk4>(),
     Case::new::<f64, 1, PendulumSetup, Rk4>(),
     Case::new::<f32, 1, PendulumSetup, VelocityVerlet>(),
@@ -110,6 +117,14 @@ pub const CASES: [Case; 25] = [
         1,
         pendulums_in_a_bank,
     ),
+    Case::stepwise(
+        RAGDOLL_LANDING,
+        "impulses, semi-implicit Euler",
+        "f32",
+        9,
+        ragdoll_landing,
+    ),
+    Case::stepwise(RAGDOLL_FREE, "RK4", "f32", 5, ragdoll_free),
 ];
 
 #[cfg(test)]
@@ -132,6 +147,63 @@ mod tests {
                 );
             }
         }
+        Ok(())
+    }
+
+    /// A case that times its steps calls the stopwatch once a step, and the run timed ends
+    /// with the bits of the run untimed; any other case never calls it.
+    #[test]
+    fn stepwise_cases_time_every_step() -> Result<(), lagrange_core::Error> {
+        /// Counts the steps it runs.
+        struct Count(u32);
+        impl Stopwatch for Count {
+            fn time(
+                &mut self,
+                step: &mut dyn FnMut() -> Result<(), lagrange_core::Error>,
+            ) -> Result<(), lagrange_core::Error> {
+                self.0 += 1;
+                step()
+            }
+        }
+        for case in &CASES {
+            let mut count = Count(0);
+            let timed = case.run_timed(20, &mut count)?;
+            assert_eq!(timed, case.run(20)?, "{}", case.system);
+            assert_eq!(count.0, if case.times_steps() { 20 } else { 0 });
+        }
+        assert_eq!(CASES.iter().filter(|c| c.times_steps()).count(), 2);
+        Ok(())
+    }
+
+    /// The thrown ragdoll has landed and rests within the run: its torso moves by less than
+    /// 1e-5 (m, rad) over 100 more steps, lies above the floor, and the stepper's peak work
+    /// is within its documented cap (at most the 31 rows of the set; at most four solves of
+    /// `RAGDOLL_ITERATIONS` rounds).
+    #[test]
+    fn the_ragdoll_lands_and_rests() -> Result<(), lagrange_core::Error> {
+        let at = |steps| -> Result<[f32; 3], lagrange_core::Error> {
+            let words = ragdoll_landing(steps, &mut Untimed)?;
+            Ok(core::array::from_fn(|k| {
+                f32::from_bits(u32::try_from(words.words()[2 + k]).unwrap_or(0))
+            }))
+        };
+        let (end, later) = (at(STEPS)?, at(STEPS + 100)?);
+        for (a, b) in end.iter().zip(&later) {
+            assert!((a - b).abs() < 1e-5, "{end:?} then {later:?}");
+        }
+        assert!(end[1] > 0.0 && end[1] < 1.0, "torso at {end:?}");
+        let words = ragdoll_landing(STEPS, &mut Untimed)?;
+        let [rows, _, frictional, rounds] = [5, 6, 7, 8].map(|k| words.words()[k]);
+        let cap = RAGDOLL_ROWS as u64;
+        assert!(rows > 0 && rows <= cap, "{rows} rows");
+        assert!(
+            frictional <= rows,
+            "{frictional} of {rows} rows with friction"
+        );
+        assert!(
+            rounds <= 4 * u64::from(RAGDOLL_ITERATIONS),
+            "{rounds} rounds"
+        );
         Ok(())
     }
 

@@ -34,9 +34,15 @@ impl Counter {
     }
 
     /// Runs `f` and returns its result with the ticks it took, or `None` for the ticks when
-    /// the counter wrapped (more than 2^24 ticks, which no measured run comes near).
+    /// the counter wrapped (2^24 ticks or more, which no measured run comes near).
+    ///
+    /// The counter restarts from the top first: COUNTFLAG is set whenever it passes zero, so
+    /// a free-running counter would flag a run of any length that happened to cross zero.
     pub fn measure<R>(&mut self, f: impl FnOnce() -> R) -> (R, Option<u32>) {
-        // Reading the control register clears COUNTFLAG.
+        // Writing the current value clears it and COUNTFLAG; it reloads at the next tick.
+        self.syst.clear_current();
+        while SYST::get_current() == 0 {}
+        // Reading the control register clears COUNTFLAG (in case the reload set it).
         let _ = self.syst.has_wrapped();
         let before = SYST::get_current();
         let result = f();
@@ -50,9 +56,10 @@ impl Counter {
 /// The word painted below the stack pointer before a run.
 const PAINT: u32 = 0xdead_beef;
 
-/// How far below the stack pointer the probe paints, bytes: far more than any case uses, far
-/// less than the 4 MiB of RAM.
-pub const PAINT_DEPTH: u32 = 32 * 1024;
+/// How far below the stack pointer the probe paints, bytes: far more than any case uses (the
+/// ragdoll landing, the deepest, uses over 32 KiB), far less than the 4 MiB of RAM. A mark of
+/// the whole depth means the probe was too shallow.
+pub const PAINT_DEPTH: u32 = 256 * 1024;
 
 /// Runs `f` and returns its result with its stack high-water mark: the bytes below this
 /// function's stack pointer that `f` (and all it calls) wrote.

@@ -50,6 +50,7 @@ impl<T: Real, const N: usize, const C: usize> Workspace<T, N, C> {
         let mut spare = (0..C).filter(|&k| !touching[k]);
         let mut overflow = false;
         for (k, &on) in touching.iter().enumerate() {
+            let k = within::<C>(k);
             if on {
                 self.jumps.set_column(k, &jacobian.row(k).transpose());
             } else {
@@ -57,8 +58,8 @@ impl<T: Real, const N: usize, const C: usize> Workspace<T, N, C> {
             }
         }
         if let Some(t) = tangents {
-            for i in (0..C).filter(|&i| frictional[i]) {
-                match spare.next() {
+            for i in (0..C).filter(|&i| frictional[i]).map(within::<C>) {
+                match spare.next().map(within::<C>) {
                     Some(k) => {
                         self.jumps.set_column(k, &t.row(i).transpose());
                         slot[i] = Some(k);
@@ -72,7 +73,7 @@ impl<T: Real, const N: usize, const C: usize> Workspace<T, N, C> {
         self.normal.rebuild(
             jacobian,
             |m| {
-                for k in (0..C).filter(|&k| touching[k]) {
+                for k in (0..C).filter(|&k| touching[k]).map(within::<C>) {
                     m.set_column(k, &jumps.column(k));
                 }
                 Ok(())
@@ -83,14 +84,13 @@ impl<T: Real, const N: usize, const C: usize> Workspace<T, N, C> {
         let Some(t) = tangents else {
             return Ok(());
         };
-        for i in (0..C).filter(|&i| frictional[i]) {
+        for i in (0..C).filter(|&i| frictional[i]).map(within::<C>) {
             if let Some(k) = slot[i] {
-                self.tangent[i] =
-                    Direction::new(t.row(i).transpose(), self.jumps.column(k).into_owned());
+                self.tangent[i] = Direction::new(t.row(i).transpose(), column(&self.jumps, k));
             }
         }
         if overflow {
-            for i in 0..C {
+            for i in (0..C).map(within::<C>) {
                 if frictional[i] && slot[i].is_none() {
                     self.jumps.set_column(i, &t.row(i).transpose());
                 } else {
@@ -98,13 +98,33 @@ impl<T: Real, const N: usize, const C: usize> Workspace<T, N, C> {
                 }
             }
             mechanism.velocity_jumps(state, &mut self.jumps)?;
-            for i in (0..C).filter(|&i| frictional[i] && slot[i].is_none()) {
-                self.tangent[i] =
-                    Direction::new(t.row(i).transpose(), self.jumps.column(i).into_owned());
+            for i in (0..C)
+                .filter(|&i| frictional[i] && slot[i].is_none())
+                .map(within::<C>)
+            {
+                self.tangent[i] = Direction::new(t.row(i).transpose(), column(&self.jumps, i));
             }
         }
         Ok(())
     }
+}
+
+/// `i`, a row of a set of `C` counted here (so below `C`), clamped below `C`: a no-op that
+/// tells the optimiser that no bounds check is needed (a bounds check is a panic path, which
+/// the firmware's panic-free image refuses).
+fn within<const C: usize>(i: usize) -> usize {
+    i.min(C.saturating_sub(1))
+}
+
+/// Column `k` of `m`, copied (nalgebra's `into_owned` keeps a length check, a panic path, in
+/// optimised code).
+fn column<T: Real, const N: usize, const C: usize>(
+    m: &SMatrix<T, N, C>,
+    k: usize,
+) -> SVector<T, N> {
+    let mut out = SVector::<T, N>::zeros();
+    out.copy_from(&m.column(within::<C>(k)));
+    out
 }
 
 /// One tangent direction: its Jacobian row `j`, its mobility `b = M^-1 j^T` (the velocity

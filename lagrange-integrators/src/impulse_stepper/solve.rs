@@ -99,14 +99,15 @@ impl<T: Real, const N: usize, const C: usize> Problem<'_, T, N, C> {
             let mut v = sliding + self.normal.response(&p.normal);
             for sweep in 0..rounds.max(1) {
                 let (mut change, mut allowed) = (T::zero(), tolerance);
-                for (i, t) in self.tangent.iter().enumerate() {
+                let rows = self.tangent.iter().zip(&p.normal).zip(&mut p.tangent);
+                for ((t, normal), tangent) in rows {
                     let Some(t) = t else { continue };
                     let u = t.j.dot(&v);
-                    let bound = self.friction * p.normal[i];
-                    let next = (p.tangent[i] - u * t.inverse).max(-bound).min(bound);
-                    let dp = next - p.tangent[i];
+                    let bound = self.friction * *normal;
+                    let next = (*tangent - u * t.inverse).max(-bound).min(bound);
+                    let dp = next - *tangent;
                     v += t.b * dp;
-                    p.tangent[i] = next;
+                    *tangent = next;
                     change = change.max((dp / t.inverse).abs());
                     allowed = allowed.max(tolerance + rounding * u.abs());
                 }

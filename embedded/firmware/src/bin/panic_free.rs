@@ -1,11 +1,12 @@
 //! The panic-free check: steps every shipped unconstrained mechanism with every shipped
 //! fixed-step integrator (explicit, symplectic, Yoshida, implicit Runge-Kutta with Newton), in
-//! `f32` and `f64`, plus the automatic Euler-Lagrange path with a damping force
-//! and the variational integrator, and a scene that sleeps and wakes, from inputs the optimiser cannot see (`black_box`), with
-//! `panic-never` as the panic handler. That handler references an undefined symbol, so the
-//! image links only if the optimised stepping code holds no panic path at all (no bounds
-//! check, unwrap or overflow check left). `cargo xtask qemu` builds it in release (opt-level 3)
-//! and runs it.
+//! `f32` and `f64`, plus the automatic Euler-Lagrange path with a damping force and the
+//! variational integrator, a scene that sleeps and wakes, and the impulse stepper with the
+//! ragdoll's 31 rows (every setting and inner method it is built with), from inputs the
+//! optimiser cannot see (`black_box`), with `panic-never` as the panic handler. That handler
+//! references an undefined symbol, so the image links only if the optimised stepping code
+//! holds no panic path at all (no bounds check, unwrap or overflow check left). `cargo xtask
+//! qemu` builds it in release (opt-level 3) and runs it.
 
 #![no_std]
 #![no_main]
@@ -102,6 +103,45 @@ fn scene<T: Real>() -> Result<bool, Error> {
     Ok(black_box(drawn.q[0] + energy).is_finite())
 }
 
+/// The impulse stepper with the ragdoll's rows.
+mod ragdoll {
+    use core::hint::black_box;
+
+    use lagrange_core::{Error, Real, State};
+    use lagrange_integrators::{
+        ContactModel, ImpulseSettings, ImpulseStepper, Integrator, SemiImplicitEuler,
+    };
+    use lagrange_systems::{Ragdoll, RagdollBody, RagdollContacts, RAGDOLL_COORDINATES};
+
+    use super::STEPS;
+
+    /// The ragdoll on the floor under the impulse stepper (semi-implicit Euler inside, the 31
+    /// rows of `RagdollContacts`, friction): `STEPS` steps of 1/240 s from the throw of the
+    /// lockstep case lowered into the floor (so that rows are solved and the drift corrected
+    /// from the first step), a run by `integrate`, and the sleep test's law; `true` when every
+    /// call succeeds and rows were solved.
+    pub fn run<T: Real>() -> Result<bool, Error> {
+        let v = |x: f64| black_box(T::from_f64(x));
+        let doll = Ragdoll::new(black_box(RagdollBody::adult()))?;
+        let contacts = RagdollContacts::adult(&doll, v(0.0))?;
+        let model = ContactModel::new(v(0.3), v(0.3), v(1.0))?.with_friction(v(0.8))?;
+        let settings = ImpulseSettings::new(v(2e-3), black_box(4))?;
+        let mut stepper = ImpulseStepper::new(SemiImplicitEuler, contacts, model, settings);
+        let dt = v(1.0 / 240.0);
+        let mut start: State<T, RAGDOLL_COORDINATES> = lagrange_cases::ragdoll_thrown();
+        start.q[1] = v(0.8);
+        let mut s = black_box(start);
+        for _ in 0..black_box(STEPS) {
+            s = stepper.step(black_box(&doll), &s, dt)?;
+        }
+        let rows = stepper.last_report().rows + stepper.peak_report().rows;
+        let (normal, tangent) = stepper.impulses();
+        let end = stepper.integrate(&doll, &s, dt, u64::from(black_box(STEPS)))?;
+        let law = stepper.law_acceleration(&doll, &end)?;
+        Ok(rows > 0 && black_box(end.q[0] + law[0] + normal[0] + tangent[0]).is_finite())
+    }
+}
+
 /// Every shipped mechanism, and the automatic path, in `T`; `true` when every run succeeds.
 fn every_mechanism<T: Real>() -> Result<bool, Error> {
     let v = |x: f64| black_box(T::from_f64(x));
@@ -171,7 +211,9 @@ fn main() -> ! {
     let f32_ok = matches!(every_mechanism::<f32>(), Ok(true));
     let f64_ok = matches!(every_mechanism::<f64>(), Ok(true));
     let scenes_ok = matches!(scene::<f32>(), Ok(true)) && matches!(scene::<f64>(), Ok(true));
-    exit(f32_ok && f64_ok && scenes_ok)
+    let contacts_ok =
+        matches!(ragdoll::run::<f32>(), Ok(true)) && matches!(ragdoll::run::<f64>(), Ok(true));
+    exit(f32_ok && f64_ok && scenes_ok && contacts_ok)
 }
 
 #[exception]

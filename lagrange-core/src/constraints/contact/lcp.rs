@@ -127,12 +127,16 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
     {
         // The entries of W of rows that stop being candidates are cleared (W is zero off
         // the candidates); the candidates' are all written below.
-        for i in (0..C).filter(|&i| self.candidate[i] && !candidate[i]) {
+        for i in (0..C)
+            .filter(|&i| self.candidate[i] && !candidate[i])
+            .map(within::<C>)
+        {
             self.w.row_mut(i).fill(T::zero());
             self.w.column_mut(i).fill(T::zero());
         }
         self.candidate = [false; C];
         for (i, &on) in candidate.iter().enumerate() {
+            let i = within::<C>(i);
             if on {
                 self.jacobian.set_row(i, &jacobian.row(i));
                 self.mobility.set_column(i, &jacobian.row(i).transpose());
@@ -145,13 +149,13 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
             self.w.fill(T::zero());
             return Err(e);
         }
-        for i in (0..C).filter(|&i| candidate[i]) {
+        for i in (0..C).filter(|&i| candidate[i]).map(within::<C>) {
             for k in (i..C).filter(|&k| candidate[k]) {
                 let x = self
                     .jacobian
                     .row(i)
                     .transpose()
-                    .dot(&self.mobility.column(k));
+                    .dot(&self.mobility.column(within::<C>(k)));
                 if !x.is_finite() {
                     self.w.fill(T::zero());
                     return Err(Error::NonFiniteState);
@@ -180,7 +184,7 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
         F: FnMut(&SVector<T, N>) -> Result<SVector<T, N>, Error>,
     {
         let joining: [bool; C] = core::array::from_fn(|i| rows[i] && !self.candidate[i]);
-        for i in (0..C).filter(|&i| joining[i]) {
+        for i in (0..C).filter(|&i| joining[i]).map(within::<C>) {
             let j = jacobian.row(i).transpose();
             let b = solve_mass(&j)?;
             self.insert(i, &j, &b)?;
@@ -203,7 +207,7 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
         self.jacobian.set_row(i, &j.transpose());
         self.mobility.set_column(i, b);
         self.candidate[i] = true;
-        for k in (0..C).filter(|&k| self.candidate[k]) {
+        for k in (0..C).filter(|&k| self.candidate[k]).map(within::<C>) {
             let x = self.jacobian.row(k).transpose().dot(b);
             if !x.is_finite() {
                 self.candidate[i] = false;
@@ -301,19 +305,20 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
         }
         let bounds: [(T, T); C] = core::array::from_fn(|i| kinds[i].bounds());
         // The candidates, listed: every loop below runs over them alone.
-        let (mut cand, mut m) = ([0usize; C], 0usize);
-        for i in (0..C).filter(|&i| self.candidate[i]) {
-            cand[m] = i;
+        let mut cand = [0usize; C];
+        let mut m = 0;
+        for (slot, i) in cand.iter_mut().zip((0..C).filter(|&i| self.candidate[i])) {
+            *slot = i;
             m += 1;
         }
-        let cand = &cand[..m.min(C)];
+        let listed = cand.iter().take(m).map(|&i| within::<C>(i));
         // Solved for (a = 0 between its bounds), in the order they joined (so that a row
         // that depends on the others is always the one joining, at its bound: leaving it out
         // changes no multiplier); the other candidates are held at a bound, or left out at
         // zero while they depend on the rows solved for (`blocked`).
         let mut free = [false; C];
         let (mut order, mut n) = ([0usize; C], 0usize);
-        for &i in cand {
+        for i in listed.clone() {
             let solved_for = match kinds[i] {
                 Row::Unilateral => guess[i],
                 Row::Bounded(x) => x > T::zero(),
@@ -321,7 +326,7 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
             };
             if solved_for {
                 free[i] = true;
-                order[n] = i;
+                order[within::<C>(n)] = i;
                 n += 1;
             }
         }
@@ -335,11 +340,11 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
         for _ in 0..passes {
             // The rows held at a bound push on the rows solved for.
             let mut rhs = SVector::<T, C>::zeros();
-            for &i in cand.iter().filter(|&&i| free[i]) {
-                rhs[i] = cand
-                    .iter()
-                    .filter(|&&k| !free[k] && lambda[k] != T::zero())
-                    .fold(-b[i], |r, &k| r - self.w[(i, k)] * lambda[k]);
+            for i in listed.clone().filter(|&i| free[i]) {
+                rhs[i] = listed
+                    .clone()
+                    .filter(|&k| !free[k] && lambda[k] != T::zero())
+                    .fold(-b[i], |r, k| r - self.w[(i, k)] * lambda[k]);
             }
             let x = match self.solve(&order, n, kept, &rhs) {
                 Ok(x) => x,
@@ -349,6 +354,7 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
                 Err(Error::RedundantConstraints { row })
                     if joined.is_some_and(|(j, _)| j == row) =>
                 {
+                    let row = within::<C>(row);
                     let way = joined.map_or(T::zero(), |(_, w)| w);
                     joined = None;
                     match self.ray(
@@ -378,6 +384,7 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
                 Err(Error::RedundantConstraints { row })
                     if kinds.get(row).is_some_and(|&k| k != Row::Bilateral) =>
                 {
+                    let row = within::<C>(row);
                     kept = remove(&mut order, &mut n, row);
                     free[row] = false;
                     lambda[row] = T::zero();
@@ -390,7 +397,7 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
             // The step from lambda towards x, as far as every multiplier stays within its
             // bounds; the row that stops it is held at the bound it reached.
             let mut stop: Option<(usize, T, T)> = None;
-            for &i in cand.iter().filter(|&&i| free[i]) {
+            for i in listed.clone().filter(|&i| free[i]) {
                 let (lo, hi) = bounds[i];
                 let (reach, at) = if x[i] < lo {
                     ((lambda[i] - lo) / (lambda[i] - x[i]), lo)
@@ -404,7 +411,8 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
                 }
             }
             if let Some((row, reach, at)) = stop {
-                for &i in cand.iter().filter(|&&i| free[i]) {
+                let row = within::<C>(row);
+                for i in listed.clone().filter(|&i| free[i]) {
                     let l = lambda[i];
                     lambda[i] = l + (x[i] - l) * reach;
                 }
@@ -414,20 +422,20 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
                 blocked = [false; C];
                 continue;
             }
-            for &i in cand.iter().filter(|&&i| free[i]) {
+            for i in listed.clone().filter(|&i| free[i]) {
                 lambda[i] = x[i];
             }
             // Every multiplier within its bounds: the held row whose a would lower the
             // program most by moving off its bound is solved for.
             let mut join: Option<(usize, T)> = None;
-            for &i in cand.iter().filter(|&&i| !free[i] && !blocked[i]) {
+            for i in listed.clone().filter(|&i| !free[i] && !blocked[i]) {
                 let (lo, hi) = bounds[i];
                 if lo == hi {
                     continue;
                 }
-                let (a, size) = cand.iter().filter(|&&k| lambda[k] != T::zero()).fold(
+                let (a, size) = listed.clone().filter(|&k| lambda[k] != T::zero()).fold(
                     (b[i], b[i].abs()),
-                    |(a, s), &k| {
+                    |(a, s), k| {
                         let term = self.w[(i, k)] * lambda[k];
                         (a + term, s + term.abs())
                     },
@@ -451,8 +459,9 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
             }
             match join {
                 Some((row, _)) if n < C => {
+                    let row = within::<C>(row);
                     free[row] = true;
-                    order[n] = row;
+                    order[within::<C>(n)] = row;
                     n += 1;
                     // The way it moves off its bound: up from the lower, down from the upper,
                     // against a from inside.
@@ -502,9 +511,11 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
         row: usize,
         way: T,
     ) -> Result<Option<usize>, Error> {
+        let row = within::<C>(row);
         let before = (*n).min(C).saturating_sub(1);
+        let partners = order.iter().take(before).map(|&k| within::<C>(k));
         let mut column = SVector::<T, C>::zeros();
-        for &k in order.iter().take(before) {
+        for k in partners.clone() {
             column[k] = self.w[(k, row)];
         }
         let c = self.solve(order, before, before, &column)?;
@@ -515,7 +526,7 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
             lambda[row] - lo
         };
         let mut limit: (usize, T, T) = (row, own, if way > T::zero() { hi } else { lo });
-        for &k in order.iter().take(before) {
+        for k in partners.clone() {
             let rate = -way * c[k];
             let (lo, hi) = bounds[k];
             let (t, at) = if rate < T::zero() {
@@ -530,10 +541,11 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
             }
         }
         let (held, t, at) = limit;
+        let held = within::<C>(held);
         if !t.is_finite() {
             return Ok(None);
         }
-        for &k in order.iter().take(before) {
+        for k in partners {
             lambda[k] -= way * c[k] * t;
         }
         lambda[row] += way * t;
@@ -557,30 +569,31 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
         let n = n.min(C);
         let threshold = T::EPSILON.sqrt();
         let l = &mut self.factor;
+        let row = |p: usize| within::<C>(order[p]);
         for p in kept.min(n)..n {
-            let row = order[p];
+            let row_p = row(p);
             for q in 0..p {
-                let x = (0..q).fold(self.w[(row, order[q])], |x, k| x - l[(p, k)] * l[(q, k)]);
+                let x = (0..q).fold(self.w[(row_p, row(q))], |x, k| x - l[(p, k)] * l[(q, k)]);
                 l[(p, q)] = x / l[(q, q)];
             }
-            let wpp = self.w[(row, row)];
+            let wpp = self.w[(row_p, row_p)];
             let d = (0..p).fold(wpp, |d, k| d - l[(p, k)] * l[(p, k)]);
             if !d.is_finite() {
                 return Err(Error::NonFiniteState);
             }
             if d <= wpp.abs() * threshold {
-                return Err(Error::RedundantConstraints { row });
+                return Err(Error::RedundantConstraints { row: row_p });
             }
             l[(p, p)] = d.sqrt();
         }
         let mut y = [T::zero(); C];
         for p in 0..n {
-            y[p] = (0..p).fold(r[order[p]], |s, k| s - l[(p, k)] * y[k]) / l[(p, p)];
+            y[p] = (0..p).fold(r[row(p)], |s, k| s - l[(p, k)] * y[k]) / l[(p, p)];
         }
         let mut x = SVector::<T, C>::zeros();
         for p in (0..n).rev() {
-            let s = (p + 1..n).fold(y[p], |s, k| s - l[(k, p)] * x[order[k]]);
-            x[order[p]] = s / l[(p, p)];
+            let s = (p + 1..n).fold(y[p], |s, k| s - l[(k, p)] * x[row(k)]);
+            x[row(p)] = s / l[(p, p)];
         }
         Ok(x)
     }
@@ -593,9 +606,19 @@ fn remove<const C: usize>(order: &mut [usize; C], n: &mut usize, row: usize) -> 
     let Some(at) = order.iter().take(count).position(|&r| r == row) else {
         return count;
     };
-    order.copy_within(at + 1..count, at);
-    *n = count - 1;
+    for p in at..count.saturating_sub(1) {
+        order[p] = order[p + 1];
+    }
+    *n = count.saturating_sub(1);
     at
+}
+
+/// `i`, a row of a set of `C` that this module counted or listed (so below `C`), clamped
+/// below `C`: a no-op that tells the optimiser, which cannot follow a row number through an
+/// array, that no bounds check is needed (a bounds check is a panic path, which the
+/// firmware's panic-free image refuses).
+fn within<const C: usize>(i: usize) -> usize {
+    i.min(C.saturating_sub(1))
 }
 
 /// Each column of `columns` that is not zero replaced by `solve` of it (a zero column stays
