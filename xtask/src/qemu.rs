@@ -69,8 +69,8 @@ const M4F: Core = Core {
 /// The M0 stands for the M0+ (both ARMv6-M: the same instructions, so the same counts; the
 /// M0+ takes fewer cycles for some). QEMU's micro:bit is an nRF51 with 256 KiB of flash and
 /// 16 KiB of SRAM: both are enlarged (`memory/microbit.x` says to what), so that it runs the
-/// lockstep image whole. Every case but the ragdoll's fits the nRF51's own 16 KiB (stack
-/// under 3.2 KiB); the ragdoll landing's 47.9 kB of stack needs an RP2040's or an STM32G0B's
+/// lockstep image whole. Every case but the ragdoll landing fits the nRF51's own 16 KiB (7.1 kB
+/// of stack at most); the landing's 47.9 kB of stack needs an RP2040's or a larger STM32G0's
 /// RAM.
 /// The RISC-V cores run on QEMU's `virt` board with no firmware (`-bios none`), counting
 /// instructions with `minstret`.
