@@ -45,9 +45,9 @@ pub fn calibrate(counter: &mut Counter) -> (u64, u64) {
 const PAINT: u32 = 0xdead_beef;
 
 /// How far below the stack pointer the probe paints, bytes: far more than any case uses (the
-/// ragdoll landing, the deepest, uses over 32 KiB), and at most half the RAM of every board in
-/// `memory/` (the smallest has 256 KiB). A mark of the whole depth means the probe was too
-/// shallow.
+/// ragdoll landing, the deepest, uses 47 to 48 kB on every core), and at most half the RAM of
+/// every board in `memory/` (the smallest has 256 KiB). A mark of the whole depth means the
+/// probe was too shallow.
 pub const PAINT_DEPTH: u32 = 128 * 1024;
 
 /// Runs `f` and returns its result with its stack high-water mark: the bytes below this
