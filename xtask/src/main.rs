@@ -13,11 +13,13 @@
 //!   `--contacts`: ns per step of the contact steppers (thrown ragdoll, double pendulum on
 //!   the floor, bouncing ball) against a free RK4 step and against rapier2d, with depth and
 //!   energy gain (`contacts.csv`, `contacts.md`).
-//! - `cross`: thumbv7em-none-eabihf builds of the library crates, with and without `defmt`,
-//!   and a linked no_std binary with no allocator, with its size.
-//! - `qemu`: the firmware on an emulated Cortex-M4F (QEMU `mps2-an386`), its defmt log compared
-//!   bit for bit with the host, instructions per step, stack and `.text` sizes, the panic-free
-//!   image; installs QEMU and `defmt-print` when missing.
+//! - `cross`: builds of the library crates for the Cortex-M4F, M0+, M33 and RV32IMAC, with and
+//!   without `defmt`, a linked no_std binary with no allocator, with its size, and the embassy
+//!   example (`embedded/embassy-cartpole`, an nRF52840 application) linted and built.
+//! - `qemu`: the firmware on emulated cores (Cortex-M4F, M33, M0, RV32IMAC, RV32IMAFC), its
+//!   defmt log compared bit for bit with the host, instructions per step, stack and `.text`
+//!   sizes per core and side by side, the panic-free image on each; installs QEMU and
+//!   `defmt-print` when missing.
 //! - `trig-fit`: derives the polynomials and constants of `lagrange_core::fast_trig` and
 //!   checks the library's against them.
 //! - `derive SPEC.py [--out FILE.rs] [--name TypeName] [--tests]`: the origin's workflow,
