@@ -40,8 +40,9 @@ and Q explicitly (a driven mechanism).
 Names are the paper's: any SymPy name for a parameter or a coordinate (`M`, `m`, `s`, `I`,
 `theta_1`, `θ₂`, `lambda`). Each becomes a Rust identifier by the rule of `rust_name`; two
 names that become one are refused, naming both. The generated code's own names (the state
-`s`, the vectors `q` and `qd`, temporaries, constants, methods) give way to the spec's: nothing
-is reserved.
+`s`, the vectors `q` and `qd`, temporaries, constants, methods) give way to the spec's. The
+only reserved names are the spec's keys above, as Python variables, and the time's name (a
+symbol of that name is the time, not a parameter).
 
 Supported in the expressions: `+ - * /`, integer and half-integer powers, `sqrt`, `sin`,
 `cos`, `tan`, `exp`, `log`, `atan2`, `pi`. Everything else is refused with a message.
