@@ -63,6 +63,7 @@ fn a_file_it_did_not_make_is_left_alone() {
     assert!(stderr.contains("--force"), "{stderr}");
     let after = std::fs::read_to_string(dir.join("lib.rs")).ok();
     assert_eq!(after.as_deref(), Some("fn main() {}\n"));
+    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]
@@ -73,6 +74,7 @@ fn without_python_it_says_so() {
     assert!(!ok);
     assert!(stderr.contains("needs Python 3.9 or newer"), "{stderr}");
     assert!(!dir.join("m.rs").exists());
+    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]
@@ -90,4 +92,5 @@ fn bad_command_lines_and_missing_files() {
     }
     let (ok, _) = run(&dir, &["--help"]);
     assert!(ok);
+    let _ = std::fs::remove_dir_all(&dir);
 }
