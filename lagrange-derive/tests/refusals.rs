@@ -47,6 +47,7 @@ fn the_spec_is_never_the_output() {
         std::fs::read_to_string(dir.join("s.py")).ok().as_deref(),
         Some(SPEC)
     );
+    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]
