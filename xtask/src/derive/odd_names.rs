@@ -8,7 +8,6 @@
 //! from another folder than the one the files were made from.
 
 use crate::cmd;
-use lagrange_derive::Mode;
 use std::path::Path;
 
 /// The specs (relative to the workspace root), their type names and dimensions.
@@ -51,19 +50,15 @@ fn build(root: &Path) -> Result<(), String> {
             started.elapsed().as_secs_f64()
         );
     }
-    // The header's spec path is relative to the file: check and update from elsewhere.
-    let elsewhere = std::env::temp_dir();
-    let files: Vec<String> = SPECS
-        .iter()
-        .map(|(spec, _, _)| src.join(module(spec)).display().to_string())
-        .collect();
-    let previous = std::env::current_dir().map_err(|e| e.to_string())?;
-    std::env::set_current_dir(&elsewhere).map_err(|e| e.to_string())?;
-    let checked = files
-        .iter()
-        .try_for_each(|f| lagrange_derive::check_file(Path::new(f), Mode::Check));
-    std::env::set_current_dir(previous).map_err(|e| e.to_string())?;
-    checked?;
+    // The header's spec path is relative to the file: the command, run from another folder
+    // with the files' paths alone, finds every spec and finds every file up to date.
+    let exe = std::env::current_exe().map_err(|e| format!("cannot find xtask: {e}"))?;
+    let mut from_elsewhere = std::process::Command::new(exe);
+    from_elsewhere
+        .args(["derive", "--check"])
+        .args(SPECS.iter().map(|(spec, _, _)| src.join(module(spec))))
+        .current_dir(std::env::temp_dir());
+    cmd::run(&mut from_elsewhere)?;
     let target = root.join("target");
     let cargo = |args: &[&str]| {
         let mut c = cmd::cargo();
