@@ -210,7 +210,10 @@ def rust_name(name, method=False):
 
 
 def is_snake(name):
-    return not re.search(r"[A-Z]", name)
+    """Whether rustc's `non_snake_case` accepts `name`: no capital, and no run of `_` inside
+    (at either end they are allowed)."""
+    core = name.strip("_")
+    return not re.search(r"[A-Z]", core) and "__" not in core
 
 
 class Names:
@@ -221,7 +224,8 @@ class Names:
         self.taken = set(taken) | RUST_KEYWORDS
 
     def fresh(self, base):
-        name = base
+        # A run of `_` inside a name (`self_` + `_d`) is one: rustc's non_snake_case refuses it.
+        name = re.sub(r"(?<=[^_])_{2,}(?=[^_])", "_", base)
         while name in self.taken:
             name += "_"
         self.taken.add(name)

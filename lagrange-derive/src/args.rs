@@ -11,8 +11,9 @@ USAGE:
     lagrange-derive --check FILE.rs...
 
     SPEC.py          the spec: a Python file that defines q, params, T, V (and Q, phi, ...)
-    --out FILE.rs    where the Rust file goes (else stdout); never the spec, and never a file
-                     that lagrange-derive did not generate unless --force
+    --out FILE.rs    where the Rust file goes; never the spec, and never a file that
+                     lagrange-derive did not generate unless --force (without --out: stdout,
+                     and the header takes the file to be in the current folder)
     --name TypeName  the Rust type's name (else the spec's `name`, else its file name)
     --tests          add a test module: the closed form against the automatic path of its own
                      T and V, in f64 and f32 (needs only lagrange-core)

@@ -1,6 +1,6 @@
 //! The odd-name specs of `derive/odd/` (the paper's names `M`, `s`, Greek letters, a time
-//! `t` with assumptions, keywords, the generated code's own names, long and short names, many
-//! parameters, docs that Markdown could misread) derived as a user derives them: into a
+//! `t` with assumptions, Rust and Python keywords, the generated code's own names, runs of
+//! underscores, long and short names, many parameters, docs that Markdown could misread) derived as a user derives them: into a
 //! scratch crate outside the workspace that depends on `lagrange-core` alone (and on
 //! `lagrange-integrators` for its own test, which steps each with RK4 in `f32` and `f64`).
 //! It must pass `cargo clippy --all-targets -- -D warnings`, `cargo fmt --check` and its
@@ -11,10 +11,11 @@ use crate::cmd;
 use std::path::Path;
 
 /// The specs (relative to the workspace root), their type names and dimensions.
-const SPECS: [(&str, &str, usize); 3] = [
+const SPECS: [(&str, &str, usize); 4] = [
     ("derive/odd/wedge.py", "Wedge", 2),
     ("derive/odd/odd_names.py", "OddNames", 2),
     ("derive/odd/driven.py", "Driven", 1),
+    ("derive/odd/keywords.py", "Keywords", 2),
 ];
 
 /// Derives the specs into the scratch crate and checks it; returns what went wrong.
