@@ -67,6 +67,7 @@ stderr and exits with 1.
 
 import argparse
 import itertools
+import os
 import random
 import re
 import sys
@@ -258,6 +259,8 @@ def load_spec(path):
             f"{path}:{e.lineno}:{e.offset}: syntax error: {e.msg}\n    {text}\n    {caret}"
         ) from None
     namespace = {"__name__": "__spec__", "__file__": path}
+    # A spec may import a module beside it, from whatever folder the command runs.
+    sys.path.insert(0, os.path.dirname(os.path.abspath(path)))
     try:
         exec(code, namespace)  # noqa: S102 - running the user's spec is the point
     except Exception as e:  # noqa: BLE001 - any failure of the spec is reported, not raised
