@@ -1,11 +1,12 @@
 //! The odd-name specs of `derive/odd/` (the paper's names `M`, `s`, Greek letters, a time
 //! `t` with assumptions, Rust and Python keywords, the generated code's own names, runs of
-//! underscores, long and short names, many parameters, docs that Markdown could misread) derived as a user derives them: into a
-//! scratch crate outside the workspace that depends on `lagrange-core` alone (and on
-//! `lagrange-integrators` for its own test, which steps each with RK4 in `f32` and `f64`).
-//! It must pass `cargo clippy --all-targets -- -D warnings`, `cargo fmt --check` and its
-//! tests (the generated ones against the automatic path); `--check` and `--update` must work
-//! from another folder than the one the files were made from.
+//! underscores, long and short names, many parameters, docs that Markdown could misread)
+//! derived as a user derives them: by the command installed with `cargo install --path
+//! lagrange-derive`, run in a scratch crate outside the workspace that depends on
+//! `lagrange-core` alone (and on `lagrange-integrators` for its own test, which steps each
+//! with RK4 in `f32` and `f64`). It must pass `cargo clippy --all-targets -- -D warnings`,
+//! `cargo fmt --check` and its tests (the generated ones against the automatic path); the
+//! files must check as up to date from another folder, named by their paths alone.
 
 use crate::cmd;
 use std::path::Path;
@@ -36,16 +37,34 @@ fn build(root: &Path) -> Result<(), String> {
     write(&krate.join("Cargo.toml"), &manifest(root))?;
     write(&src.join("lib.rs"), &lib())?;
     write(&krate.join("tests/step.rs"), &step_test())?;
+    // The command as a user gets it: installed by `cargo install --path`, run in their crate.
+    let install = root.join("target/lagrange-derive/install");
+    cmd::run(
+        cmd::cargo()
+            .args([
+                "install",
+                "--quiet",
+                "--force",
+                "--path",
+                "lagrange-derive",
+                "--root",
+            ])
+            .arg(&install)
+            .arg("--target-dir")
+            .arg(root.join("target")),
+    )?;
+    let installed = install
+        .join("bin")
+        .join(format!("lagrange-derive{}", std::env::consts::EXE_SUFFIX));
     for (spec, _, _) in SPECS {
-        let out = src.join(module(spec));
+        let out = format!("src/{}", module(spec));
         let started = std::time::Instant::now();
-        let args = [
-            root.join(spec).display().to_string(),
-            "--tests".into(),
-            "--out".into(),
-            out.display().to_string(),
-        ];
-        lagrange_derive::run(&args)?;
+        let mut derive = std::process::Command::new(&installed);
+        derive
+            .arg(root.join(spec))
+            .args(["--tests", "--out", &out])
+            .current_dir(&krate);
+        cmd::run(&mut derive)?;
         println!(
             "   {spec}: derived in {:.1} s",
             started.elapsed().as_secs_f64()
