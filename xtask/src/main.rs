@@ -22,10 +22,12 @@
 //!   `defmt-print` when missing.
 //! - `trig-fit`: derives the polynomials and constants of `lagrange_core::fast_trig` and
 //!   checks the library's against them.
-//! - `derive SPEC.py [--out FILE.rs] [--name TypeName] [--tests]`: the origin's workflow,
-//!   SymPy derives the Euler-Lagrange equations of a spec's `T` and `V` and this writes a
-//!   `no_std` Rust mechanism (see `derive.rs`); `derive --check` regenerates the committed
-//!   ones under `derive/generated/` and checks that bad specs are refused.
+//! - `derive SPEC.py [--out FILE.rs] [--name TypeName] [--tests]`: the installable
+//!   `lagrange-derive` command (the same code, as a library): SymPy derives the
+//!   Euler-Lagrange equations of a spec's `T` and `V` and this writes a `no_std` Rust
+//!   mechanism; `derive --check` regenerates the committed ones under `derive/generated/`,
+//!   checks that bad specs and bad uses are refused, and builds the odd-name specs of
+//!   `derive/odd/` in a scratch crate with clippy, rustfmt and their tests.
 //! - `mutants`: mutation testing of the numerical core with `cargo-mutants`, a report per file
 //!   under `target/mutants/` (hours; not part of `ci`).
 //! - `fuzz [CALLS] [--seed S]`: the hostile-input campaign (`tests/tests/hostile`) in release,
@@ -52,7 +54,6 @@ mod publish;
 mod qemu;
 mod tools;
 mod trig_fit;
-mod venv;
 mod web;
 
 use std::process::ExitCode;
