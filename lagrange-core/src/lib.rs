@@ -2,6 +2,10 @@
 //!
 //! The core of lagrange: `no_std`, allocation-free Lagrangian mechanics.
 //!
+//! The guide to the three crates, by task (your own mechanism, choosing an integrator,
+//! contacts, scenes, firmware), is the book in the repository's `guide/` folder
+//! (`cargo xtask guide` builds it).
+//!
 //! - [`Real`] (`f32`, `f64`) and [`Scalar`] (those and [`Dual`] numbers): every computation is
 //!   generic over the scalar, and all math goes through `libm`.
 //! - [`State`]: time, coordinates and velocities, `N` a const generic.
@@ -16,6 +20,10 @@
 //! - [`Jacobian`]: `d/dq` and `d/dq'` of the equations of motion, exact from dual numbers for
 //!   [`EulerLagrange`], by [`central_difference_jacobian`] otherwise (for implicit integrators).
 //! - [`Error`]: one small `Copy` error type for every crate.
+//! - [`closed_form`]: a mechanism given by its equations in closed form ([`ClosedForm`]: what
+//!   `lagrange-derive` generates from a SymPy spec) is a [`Mechanism`] by one generic impl;
+//!   [`parameters!`] writes a mechanism's parameter struct, validated constructor and defaults;
+//!   [`agreement`] checks any mechanism against the automatic path of its own Lagrangian.
 //!
 //! ```
 //! use lagrange_core::{EulerLagrange, Lagrangian, Mechanism, Scalar, State, ViscousDamping};
@@ -44,7 +52,9 @@
 #![no_std]
 #![forbid(unsafe_code)]
 
+pub mod agreement;
 mod cholesky;
+pub mod closed_form;
 pub mod constraints;
 mod controlled;
 mod dual;
@@ -57,6 +67,7 @@ mod jet;
 mod lagrangian;
 mod lanes;
 mod mechanism;
+mod parameters;
 pub mod prelude;
 mod scalar;
 mod scalar_trig;
@@ -66,6 +77,7 @@ mod trig_memo;
 pub mod validate;
 
 pub use cholesky::{solve_spd, Cholesky};
+pub use closed_form::ClosedForm;
 pub use constraints::{
     Constrained, Constraints, Held, Holonomic, HolonomicConstraints, Pfaffian, PfaffianConstraints,
     Projection, Stabilization,
