@@ -756,7 +756,8 @@ const AREAS: [Area; 25] = [
             "lagrange-core/src/agreement.rs",
         ],
         only: None,
-        tests: &["--lib", "--test", "hand_derived"],
+        // `--lib` (from `unit_tests`) runs the unit tests of both packages.
+        tests: &["--test", "hand_derived"],
         unit_tests: true,
         optimised: false,
     },
@@ -1376,6 +1377,19 @@ mod tests {
         files.retain(|f| f != "lagrange-core/src/jet.rs");
         assert_eq!(unaccounted(&files).len(), 2, "{:?}", unaccounted(&files));
         Ok(())
+    }
+
+    /// An area that runs its package's unit tests does not name `--lib` itself: cargo refuses
+    /// the argument twice, and the area's baseline failed before a mutant ran.
+    #[test]
+    fn no_area_names_lib_twice() {
+        for area in super::AREAS {
+            assert!(
+                !(area.unit_tests && area.tests.contains(&"--lib")),
+                "area {}",
+                area.name
+            );
+        }
     }
 
     /// Timestamps as cargo-mutants writes them: the epoch, a leap day, and a run over midnight

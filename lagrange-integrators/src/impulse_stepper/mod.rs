@@ -11,7 +11,7 @@ mod step;
 pub use report::ImpulseReport;
 pub use settings::ImpulseSettings;
 
-use crate::integrator::{check_run_step, check_step, step_loop};
+use crate::integrator::{check_run_step, check_step, finish, step_loop};
 use crate::{Cost, Failure, Integrator, Method, Work};
 use lagrange_core::constraints::contact::{ContactModel, Contacts};
 use lagrange_core::nalgebra::SVector;
@@ -45,7 +45,13 @@ use step::{Memory, Setup};
 /// 6. drift          split impulses, exactly, on the rows' linearised gaps: contacts below
 ///                   -slop moved back to it, bilateral rows to zero (the velocities are left
 ///                   alone, so no body leaves the floor faster than it hit it); a contact the
-///                   correction would push below the slop joins, and it is solved again
+///                   correction would push below the slop joins, and it is solved again.
+///                   The gaps are not linear (a link turns in the step): the correction is
+///                   done again on the gaps it left, with the same rows, until no contact is
+///                   deeper than the slop (to 2^-10 of it and the rounding of the
+///                   coordinates), at most 3 times; where one still is and is deeper than
+///                   at the step's start (a link turned by most of a radian in one step),
+///                   the coordinates stay the start's (the report's held_back)
 /// 7. energy         T + V after at most max(T + V before, T + V after the free step): where
 ///                   the drift's potential or rebounds of rows coupled in the mass metric
 ///                   would add energy, the velocities are scaled down to it
@@ -65,7 +71,9 @@ use step::{Memory, Setup};
 ///   of Delassus::complementary: per pass, the Cholesky rows of the rows that joined, at most
 ///   4 C + 4 passes, one or two from the last step's rows), then sweeps of the F tangents
 ///   until one changes nothing, at most K
-/// at most 3 exact solves of the R rows for the drift
+/// at most 3 exact solves of the R rows for the drift; 1 position_residual after it, and at
+///   most 3 more exact solves and position_residuals on the gaps it left (1 more
+///   position_residual where the coordinates stay the start's)
 /// 1 evaluation of T + V (2 after a flight); where the end would pass the allowance, 2 to 3
 ///   more and at most 4 of V
 /// ```
@@ -240,7 +248,9 @@ where
     {
         let free = self.integrator.run_step(mechanism, s, dt)?;
         let share = T::from_f64(I::POSITION_SHARE) * dt;
-        self.setup.contacts_of(
+        // The contacts' move can overflow where the free step did not (a row's gap of -1e308
+        // corrected): an error, never a state that is not finite.
+        finish(self.setup.contacts_of(
             &mut self.work,
             &mut self.memory,
             mechanism,
@@ -248,7 +258,7 @@ where
             free,
             dt,
             share,
-        )
+        )?)
     }
 }
 
