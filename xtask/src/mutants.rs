@@ -237,6 +237,7 @@ const AREAS: [Area; 25] = [
         test_package: "lagrange-tests",
         files: &[
             "lagrange-core/src/constraints/contact/lcp.rs",
+            "lagrange-core/src/constraints/contact/lcp/relaxed.rs",
             "lagrange-core/src/constraints/contact/contacts.rs",
             "lagrange-core/src/constraints/contact/model.rs",
         ],

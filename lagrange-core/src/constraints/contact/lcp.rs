@@ -6,6 +6,8 @@
 use crate::nalgebra::{SMatrix, SVector};
 use crate::{Error, Real};
 
+mod relaxed;
+
 /// How a row of [`Delassus::complementary`] is held: the bounds of its multiplier
 /// `lambda`, and what its `a = W lambda + b` must be inside them (zero; at a bound, of the
 /// sign that would push the multiplier out).
