@@ -480,8 +480,11 @@ where
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::{Lagrangian, Scalar};
+    use crate::{GeneralizedForce, Lagrangian, Scalar};
     use nalgebra::SMatrix;
+
+    extern crate std;
+    use std::string::ToString;
 
     /// A pendulum whose closed form is right, or off by `error` in its gravity term.
     #[derive(Clone, Copy)]
@@ -540,5 +543,412 @@ mod tests {
             assert!((1.0..2.0).contains(&s.q[0]) && (-5.0..-4.0).contains(&s.q[1]));
             assert!((-3.0..3.0).contains(&s.qd[0]) && (0.0..10.0).contains(&s.t));
         }
+    }
+
+    /// `tolerance` is the single-precision one for `f32` and the double-precision one for
+    /// `f64`, and the two are what their documentation says.
+    #[test]
+    fn tolerance_follows_the_scalar() {
+        assert_eq!(tolerance::<f32>(), F32_TOLERANCE);
+        assert_eq!(tolerance::<f64>(), F64_TOLERANCE);
+        assert_eq!((F32_TOLERANCE, F64_TOLERANCE), (1e-4, 1e-12));
+    }
+
+    /// `Agreement::max` takes the worse entry from either side, entry by entry, whichever
+    /// side it is called on.
+    #[test]
+    fn agreement_max_is_entry_by_entry() {
+        let a = Agreement {
+            acceleration: 1.0,
+            mass_matrix: 0.5,
+            energy: 3.0,
+        };
+        let b = Agreement {
+            acceleration: 2.0,
+            mass_matrix: 0.25,
+            energy: 4.0,
+        };
+        let worst = Agreement {
+            acceleration: 2.0,
+            mass_matrix: 0.5,
+            energy: 4.0,
+        };
+        assert_eq!(a.max(b), worst);
+        assert_eq!(b.max(a), worst);
+        assert_eq!(a.max(a), a);
+    }
+
+    /// An `Agreement` prints each of its three figures, named, to two significant digits.
+    #[test]
+    fn agreement_prints_its_figures() {
+        let a = Agreement {
+            acceleration: 1.5e-13,
+            mass_matrix: 0.0,
+            energy: 2.5e-5,
+        };
+        assert_eq!(
+            a.to_string(),
+            "acceleration 1.5e-13, mass matrix 0.0e0, energy 2.5e-5"
+        );
+    }
+
+    /// A `Disagreement` says what differed, by how much against what limit, and where; or
+    /// what failed, where, and the error itself.
+    fn disagreement_prints_what_and_where<T: Real>() {
+        let state = State::<T, 1>::new(T::from_f64(0.5), [T::from_f64(1.25)], [T::TWO]);
+        let differs = Disagreement::Differs {
+            what: "M",
+            state,
+            relative: 2.5e-3,
+            tolerance: 1e-12,
+        };
+        let text = differs.to_string();
+        let head = "M differs from the automatic path by 2.5e-3 (relative; at most 1e-12) at ";
+        assert!(text.starts_with(head), "{text}");
+        // Where: the whole state (its time 0.5, coordinate 1.25 and velocity 2 among it).
+        let place = std::format!("{state:?}");
+        assert!(place.contains("0.5") && place.contains("1.25"), "{place}");
+        assert_eq!(&text[head.len()..], place);
+        let error = Error::SingularMassMatrix { pivot: 1 };
+        let failed: Disagreement<T, 1> = Disagreement::Failed {
+            what: "the mechanism's solve_mass",
+            state,
+            error,
+        };
+        assert!(!error.to_string().is_empty());
+        assert_eq!(
+            failed.to_string(),
+            std::format!("the mechanism's solve_mass failed at {place}: {error}")
+        );
+    }
+
+    #[test]
+    fn disagreement_prints_what_and_where_f32() {
+        disagreement_prints_what_and_where::<f32>();
+    }
+
+    #[test]
+    fn disagreement_prints_what_and_where_f64() {
+        disagreement_prints_what_and_where::<f64>();
+    }
+
+    /// Gravity of [`Bob`], m/s^2.
+    const G: f64 = 9.81;
+
+    /// A unit point mass in the plane, in gravity `G` along -y, with the row
+    /// `phi = (x^2 + y^2 - 1) / 2` (a rod of length 1 from the origin): every form written in
+    /// closed form, each multiplied by `1 + error` with the error its field (all zero: every
+    /// form right). Its law is its own closed form `q'' = f + extra` (`M` is the identity), which
+    /// reads neither `mass_matrix` nor `solve_mass`, so that each wrong form shows alone.
+    #[derive(Clone, Copy, Default)]
+    struct Bob<T> {
+        rhs: T,
+        mass: T,
+        solve: T,
+        energy: T,
+        phi: T,
+        jacobian: T,
+        product: T,
+        /// The law drops the extra force.
+        drops_force: bool,
+    }
+
+    impl<T: Real> Lagrangian<T, 2> for Bob<T> {
+        fn kinetic<S: Scalar<Real = T>>(&self, _: S, _: &SVector<S, 2>, qd: &SVector<S, 2>) -> S {
+            (qd[0] * qd[0] + qd[1] * qd[1]) * T::HALF
+        }
+        fn potential<S: Scalar<Real = T>>(&self, _: S, q: &SVector<S, 2>) -> S {
+            q[1] * T::from_f64(G)
+        }
+        fn energy(&self, s: &State<T, 2>) -> T {
+            (self.kinetic_energy(s) + self.potential_energy(s)) * (T::one() + self.energy)
+        }
+    }
+
+    impl<T: Real> Mechanism<T, 2> for Bob<T> {
+        fn mass_matrix(&self, _: &State<T, 2>) -> SMatrix<T, 2, 2> {
+            SMatrix::identity() * (T::one() + self.mass)
+        }
+        fn rhs(&self, _: &State<T, 2>) -> SVector<T, 2> {
+            SVector::from([T::zero(), -T::from_f64(G) * (T::one() + self.rhs)])
+        }
+        fn solve_mass(&self, _: &State<T, 2>, b: &SVector<T, 2>) -> Result<SVector<T, 2>, Error> {
+            Ok(b * (T::one() + self.solve))
+        }
+        fn law<F: GeneralizedForce<T, 2>>(
+            &self,
+            s: &State<T, 2>,
+            extra: &F,
+        ) -> Result<SVector<T, 2>, Error> {
+            let f = self.rhs(s);
+            Ok(if self.drops_force {
+                f
+            } else {
+                extra.added_to(s, f)
+            })
+        }
+    }
+
+    impl<T: Real> Constraints<T, 2, 1> for Bob<T> {
+        fn position_residual(&self, q: &SVector<T, 2>) -> SVector<T, 1> {
+            let phi = (q[0] * q[0] + q[1] * q[1] - T::one()) * T::HALF;
+            SVector::from([phi * (T::one() + self.phi)])
+        }
+        fn jacobian(&self, q: &SVector<T, 2>) -> SMatrix<T, 1, 2> {
+            SMatrix::from([[q[0]], [q[1]]]) * (T::one() + self.jacobian)
+        }
+        fn velocity_product(&self, _: &SVector<T, 2>, qd: &SVector<T, 2>) -> SVector<T, 1> {
+            SVector::from([(qd[0] * qd[0] + qd[1] * qd[1]) * (T::one() + self.product)])
+        }
+    }
+
+    impl<T: Real> HolonomicConstraints<T, 2, 1> for Bob<T> {
+        fn phi<S: Scalar<Real = T> + 'static>(&self, q: &SVector<S, 2>) -> SVector<S, 1> {
+            SVector::from([(q[0] * q[0] + q[1] * q[1] - T::one()) * T::HALF])
+        }
+    }
+
+    /// Where [`Bob`] is sampled: away from the origin, where its row's gradient vanishes.
+    const BOB_RANGES: [(f64, f64); 2] = [(0.5, 1.5), (-1.5, -0.5)];
+
+    /// The relative error put into a wrong form: a hundred times what [`check`] accepts in
+    /// `T` (1e-10 in f64, 1e-2 in f32), small against the form, far outside the tolerance.
+    fn small_error<T: Real>() -> T {
+        T::from_f64(100.0 * tolerance::<T>())
+    }
+
+    /// `found` is a [`Disagreement::Differs`] naming `named`, at the tolerance of `T`, with a
+    /// relative difference above it and at most `most`.
+    fn assert_names<T: Real, const N: usize>(
+        found: Result<(), Disagreement<T, N>>,
+        named: &str,
+        most: f64,
+    ) {
+        assert!(
+            matches!(
+                found,
+                Err(Disagreement::Differs { what, relative, tolerance: accepted, .. })
+                    if what == named
+                        && accepted == tolerance::<T>()
+                        && relative > accepted
+                        && relative <= most
+            ),
+            "{named}: {found:?}"
+        );
+    }
+
+    /// The check detects a mechanism whose rhs, mass matrix, `M^-1`, energy or constraint
+    /// rows are wrong by a small relative amount, and names which; the right one passes.
+    fn wrong_forms_are_named<T: Real>() {
+        let bob = Bob::<T>::default();
+        assert_eq!(check(&bob, &BOB_RANGES), Ok(()));
+        assert_eq!(check_held(&bob, &BOB_RANGES), Ok(()));
+        let e = small_error::<T>();
+        // A form `a (1 + e)` against `a` differs by `e |a| / (|a| (1 + e) + scale)`, at most
+        // `e`, give or take the rounding of forms of order one (4 EPSILON: each side rounded
+        // once or twice).
+        let most = e.to_f64() + 4.0 * T::EPSILON.to_f64();
+        for (wrong, named) in [
+            (Bob { rhs: e, ..bob }, "q''"),
+            (Bob { solve: e, ..bob }, "M^-1 f"),
+            (Bob { mass: e, ..bob }, "M"),
+            (Bob { energy: e, ..bob }, "energy"),
+            (Bob { phi: e, ..bob }, "phi"),
+            (Bob { jacobian: e, ..bob }, "J"),
+            (Bob { product: e, ..bob }, "J'q'"),
+        ] {
+            assert_names(check_held(&wrong, &BOB_RANGES), named, most);
+        }
+        // The rows alone, with the free law wrong: the constrained motion differs, by at most
+        // the error in `f`, `G e`, over the constrained `|q''| + 1`, at least 1.
+        let mut random = RandomStates::new(BOB_RANGES, SEED);
+        let states = (0..RANDOM_STATES).map(|_| random.state::<T>());
+        let found = compare_rows(&Bob { rhs: e, ..bob }, states, tolerance::<T>());
+        assert_names(found.map(|_| ()), "constrained q''", G * most);
+    }
+
+    #[test]
+    fn wrong_forms_are_named_f32() {
+        wrong_forms_are_named::<f32>();
+    }
+
+    #[test]
+    fn wrong_forms_are_named_f64() {
+        wrong_forms_are_named::<f64>();
+    }
+
+    /// The extra force of the comparison is `0.7 q' + 1/2`, and a law that drops it is caught:
+    /// at `q' = (1, -2)` the force is `(1.2, -0.9)`, the automatic path's `q''` is
+    /// `(0, -G) + (1.2, -0.9)` and the law's `(0, -G)`, so the relative difference is
+    /// `1.2 / (G + 1)` (the largest difference over the law's largest entry plus 1).
+    fn a_dropped_force_is_measured<T: Real>() {
+        let state = State::new(
+            T::one(),
+            [T::from_f64(0.75), T::from_f64(-0.5)],
+            [T::one(), -T::TWO],
+        );
+        let bob = Bob::<T> {
+            drops_force: true,
+            ..Bob::default()
+        };
+        let expected = 1.2 / (G + 1.0);
+        let found = compare(&bob, [state], Scales::UNIT, tolerance::<T>());
+        // 1.2 and G rounded to T, and one division: a few EPSILON.
+        let close = 4.0 * T::EPSILON.to_f64() * expected;
+        assert!(
+            matches!(
+                found,
+                Err(Disagreement::Differs { what: "q'' with an extra force", relative, .. })
+                    if (relative - expected).abs() <= close
+            ),
+            "{found:?} against {expected:e}"
+        );
+    }
+
+    #[test]
+    fn a_dropped_force_is_measured_f32() {
+        a_dropped_force_is_measured::<f32>();
+    }
+
+    #[test]
+    fn a_dropped_force_is_measured_f64() {
+        a_dropped_force_is_measured::<f64>();
+    }
+
+    /// `compare_rows` returns the largest relative difference it saw: rows right to rounding
+    /// give a figure within the tolerance, and a `phi` 10% too large at `q = (0, -2)` (where
+    /// `phi = 3/2` exactly) gives `(0.15) / (1.65 + 1)`, the difference over the closed
+    /// form's size plus 1, when the tolerance lets it through.
+    fn compare_rows_reports_the_worst<T: Real>() {
+        let mut random = RandomStates::new(BOB_RANGES, SEED);
+        let states = (0..RANDOM_STATES).map(|_| random.state::<T>());
+        let right = compare_rows(&Bob::<T>::default(), states, tolerance::<T>());
+        assert!(
+            right.is_ok_and(|e| (0.0..=tolerance::<T>()).contains(&e)),
+            "{right:?}"
+        );
+        let state = State::new(T::zero(), [T::zero(), -T::TWO], [T::one(), T::HALF]);
+        let wrong = Bob::<T> {
+            phi: T::from_f64(0.1),
+            ..Bob::default()
+        };
+        let expected = (1.5 * 0.1) / (1.5 * 1.1 + 1.0);
+        let found = compare_rows(&wrong, [state], 1.0);
+        // The difference 1.65 - 1.5 in T magnifies the rounding of 1.65 (at most 1.3 EPSILON,
+        // from 1.1 and the product) by 1.65 / 0.15 = 11: 16 EPSILON covers it.
+        let close = 16.0 * T::EPSILON.to_f64() * expected;
+        assert!(
+            found.is_ok_and(|e| (e - expected).abs() <= close),
+            "{found:?} against {expected:e}"
+        );
+    }
+
+    #[test]
+    fn compare_rows_reports_the_worst_f32() {
+        compare_rows_reports_the_worst::<f32>();
+    }
+
+    #[test]
+    fn compare_rows_reports_the_worst_f64() {
+        compare_rows_reports_the_worst::<f64>();
+    }
+
+    /// SplitMix64 (Steele, Lea and Flood, 2014) written from its definition, as in Vigna's
+    /// reference `splitmix64.c`: the state advances by the golden-ratio increment
+    /// `0x9E3779B97F4A7C15`, and the output is the new state through Stafford's "Mix13"
+    /// finaliser (xor with itself shifted right 30, times `0xBF58476D1CE4E5B9`, xor-shift
+    /// 27, times `0x94D049BB133111EB`, xor-shift 31).
+    fn splitmix64(state: &mut u64) -> u64 {
+        *state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = *state;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+
+    /// A 64-bit output as a float in `[0, 1)`: its top 53 bits over 2^53.
+    fn top_53(x: u64) -> f64 {
+        (x >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    /// The generator is SplitMix64: the reimplementation above reproduces the published first
+    /// outputs from seed 0 (those of `splitmix64.c`, also the seeds of xoshiro's examples), and
+    /// `unit` gives their top 53 bits, for those and for 1,000 more draws from three seeds.
+    #[test]
+    fn random_states_are_splitmix64() {
+        let published: [u64; 4] = [
+            0xE220_A839_7B1D_CDAF,
+            0x6E78_9E6A_A1B9_65F4,
+            0x06C4_5D18_8009_454F,
+            0xF88B_B8A8_724C_81EC,
+        ];
+        let mut reference = 0;
+        for x in published {
+            assert_eq!(splitmix64(&mut reference), x);
+        }
+        let mut random = RandomStates::new([(0.0, 1.0)], 0);
+        for x in published {
+            assert_eq!(random.unit(), top_53(x));
+        }
+        for seed in [0, SEED, u64::MAX] {
+            let (mut random, mut reference) = (RandomStates::new([], seed), seed);
+            for _ in 0..1000 {
+                assert_eq!(random.unit(), top_53(splitmix64(&mut reference)));
+            }
+        }
+    }
+
+    /// A state is drawn coordinates first, then velocities in `[-3, 3)`, then the time in
+    /// `[0, 10)`, each from the next output, the same in `f32` (rounded) as in `f64`.
+    fn a_state_takes_outputs_in_order<T: Real>() {
+        let mut reference = 0;
+        let u: [f64; 5] = core::array::from_fn(|_| top_53(splitmix64(&mut reference)));
+        let s = RandomStates::new([(1.0, 2.0), (-4.0, 0.0)], 0).state::<T>();
+        let expected = State::<T, 2>::new(
+            T::from_f64(10.0 * u[4]),
+            [T::from_f64(1.0 + u[0]), T::from_f64(-4.0 + 4.0 * u[1])],
+            [
+                T::from_f64(-3.0 + 6.0 * u[2]),
+                T::from_f64(-3.0 + 6.0 * u[3]),
+            ],
+        );
+        assert_eq!(s, expected);
+    }
+
+    #[test]
+    fn a_state_takes_outputs_in_order_f32() {
+        a_state_takes_outputs_in_order::<f32>();
+    }
+
+    #[test]
+    fn a_state_takes_outputs_in_order_f64() {
+        a_state_takes_outputs_in_order::<f64>();
+    }
+
+    /// 10,000 draws from the check's seed are in `[0, 1)`, all different, with a mean and a
+    /// variance near those of the uniform distribution (1/2 and 1/12).
+    #[test]
+    fn random_units_look_uniform() {
+        const DRAWS: usize = 10_000;
+        let mut random = RandomStates::new([], SEED);
+        let mut u = [0.0f64; DRAWS];
+        for x in &mut u {
+            *x = random.unit();
+        }
+        assert!(u.iter().all(|x| (0.0..1.0).contains(x)));
+        let mean = u.iter().sum::<f64>() / DRAWS as f64;
+        let variance = u.iter().map(|x| (x - mean) * (x - mean)).sum::<f64>() / DRAWS as f64;
+        // The mean of n uniform draws has standard deviation sqrt(1/12 / n) = 0.0029 at
+        // n = 10^4, the sample variance about sqrt(1/180 / n) = 0.00075: five of each, which
+        // a uniform generator misses with probability below 1e-6.
+        let sd_mean = Scalar::sqrt(1.0 / 12.0 / DRAWS as f64);
+        let sd_variance = Scalar::sqrt(1.0 / 180.0 / DRAWS as f64);
+        assert!((mean - 0.5).abs() < 5.0 * sd_mean, "{mean}");
+        assert!(
+            (variance - 1.0 / 12.0).abs() < 5.0 * sd_variance,
+            "{variance}"
+        );
+        u.sort_unstable_by(f64::total_cmp);
+        assert!(u.windows(2).all(|w| w[0] < w[1]));
     }
 }

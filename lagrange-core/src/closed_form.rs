@@ -303,6 +303,7 @@ fn solve_symmetric<T: Real, const N: usize>(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::{Mechanism, Scalar};
 
     /// The closed forms refuse what the Cholesky solve refuses, and agree with it elsewhere.
     #[test]
@@ -354,5 +355,104 @@ mod tests {
             bad.solve(&SVector::from([1.0])),
             Err(Error::SingularMassMatrix { pivot: 0 })
         );
+    }
+
+    /// On the edge of the rounding test, the closed form for two coordinates refuses and
+    /// accepts what the Cholesky solve does: the second pivot `det / a` must be above
+    /// `EPSILON` times its diagonal entry `d`, that is `det > a |d| EPSILON`.
+    fn two_by_two_pivot_is_judged_against_its_diagonal<T: Real>() {
+        let (one, two, eps) = (T::one(), T::TWO, T::EPSILON);
+        // M = [1, 2; 2, 4 + 4 eps]: 4 + 4 eps is the float after 4, det = 4 eps exactly, not
+        // above (4 + 4 eps) eps: refused at pivot 1 (a test against a / |d| EPSILON = eps / 4
+        // would accept it).
+        let four = two * two;
+        let m = SMatrix::<T, 2, 2>::new(one, two, two, four + four * eps);
+        let b = SVector::from([one, two]);
+        let refused = Err(Error::SingularMassMatrix { pivot: 1 });
+        assert_eq!(solve_symmetric(&m, &b), refused);
+        assert_eq!(solve_spd(&m, &b), refused);
+        // M = [1, 1/2; 1/2, 1/4 + eps/2]: 1/4 + eps/2 is two floats after 1/4, det = eps/2
+        // exactly, above (1/4 + eps/2) eps: accepted (a test against a / |d| EPSILON = 4 eps
+        // would refuse it). By Cramer's rule, with b = (1, 2),
+        // x0 = (d - 1) / det = 1 - 3 / (2 eps) and x1 = (2 - 1/2) / det = 3 / eps, both
+        // floats (integers below 2^(digits)), and every step of either solve exact.
+        let quarter = T::HALF * T::HALF;
+        let m = SMatrix::<T, 2, 2>::new(one, T::HALF, T::HALF, quarter + eps * T::HALF);
+        let three = two + one;
+        let x = SVector::from([one - three / (two * eps), three / eps]);
+        assert_eq!(solve_symmetric(&m, &b), Ok(x));
+        assert_eq!(solve_spd(&m, &b), Ok(x));
+    }
+
+    #[test]
+    fn two_by_two_pivot_is_judged_against_its_diagonal_f32() {
+        two_by_two_pivot_is_judged_against_its_diagonal::<f32>();
+    }
+
+    #[test]
+    fn two_by_two_pivot_is_judged_against_its_diagonal_f64() {
+        two_by_two_pivot_is_judged_against_its_diagonal::<f64>();
+    }
+
+    /// A damped spring, `m q'' = -k q - c q'`, written as a [`ClosedForm`] with its damping as
+    /// the non-conservative force `Q = -c q'` and the default [`ClosedForm::equations`].
+    #[derive(Clone, Copy)]
+    struct DampedSpring<T: Real> {
+        m: T,
+        k: T,
+        c: T,
+    }
+
+    impl<T: Real> Lagrangian<T, 1> for DampedSpring<T> {
+        fn kinetic<S: Scalar<Real = T>>(&self, _: S, _: &SVector<S, 1>, qd: &SVector<S, 1>) -> S {
+            qd[0] * qd[0] * (self.m * T::HALF)
+        }
+        fn potential<S: Scalar<Real = T>>(&self, _: S, q: &SVector<S, 1>) -> S {
+            q[0] * q[0] * (self.k * T::HALF)
+        }
+        fn non_conservative_force(&self, s: &State<T, 1>) -> SVector<T, 1> {
+            SVector::from([-self.c * s.qd[0]])
+        }
+    }
+
+    impl<T: Real> ClosedForm<T, 1> for DampedSpring<T> {
+        fn mass_formula(&self, _: &State<T, 1>) -> SMatrix<T, 1, 1> {
+            SMatrix::from([[self.m]])
+        }
+        fn rhs_formula(&self, s: &State<T, 1>) -> SVector<T, 1> {
+            SVector::from([-self.k * s.q[0]])
+        }
+    }
+
+    crate::closed_form_mechanism!(DampedSpring, 1);
+
+    /// The default `equations` is `M` and `f + Q`, and the law solves with it: for the damped
+    /// spring (m, k, c) = (2, 4, 3/4) at q = 1/2, q' = -2, `f + Q = -k q - c q' = -2 + 3/2`
+    /// and `q'' = (f + Q) / m = -1/4`, every figure exact in binary.
+    fn equations_add_the_non_conservative_force<T: Real>() {
+        let f = |x: f64| T::from_f64(x);
+        let spring = DampedSpring {
+            m: f(2.0),
+            k: f(4.0),
+            c: f(0.75),
+        };
+        let s = State::new(T::zero(), [f(0.5)], [f(-2.0)]);
+        let force = -(4.0 * 0.5) - 0.75 * -2.0;
+        let (m, b) = spring.equations(&s);
+        assert_eq!(
+            (m, b),
+            (SMatrix::from([[f(2.0)]]), SVector::from([f(force)]))
+        );
+        assert_eq!(spring.acceleration(&s), Ok(SVector::from([f(force / 2.0)])));
+    }
+
+    #[test]
+    fn equations_add_the_non_conservative_force_f32() {
+        equations_add_the_non_conservative_force::<f32>();
+    }
+
+    #[test]
+    fn equations_add_the_non_conservative_force_f64() {
+        equations_add_the_non_conservative_force::<f64>();
     }
 }

@@ -15,9 +15,10 @@ const GUARD_REFINEMENTS: u32 = 4;
 /// energy error, to rounding. Above it, the velocities
 /// are scaled down to the kinetic energy the allowance leaves; where the contacts' move of
 /// the coordinates alone takes the potential energy above it (a body lifted out of the floor
-/// with no kinetic energy to pay for it), the velocities are zeroed and the move shortened
-/// to what the allowance pays (the free step's coordinates, at rest, are within it): a
-/// contact stays deeper for a step rather than gain energy.
+/// with no kinetic energy to pay for it), the velocities are zeroed and the coordinates are
+/// taken from the start's towards the end's only as far as the allowance pays (the start's,
+/// at rest, are within it): a contact stays as deep as it began for a step rather than gain
+/// energy, and never deeper.
 ///
 /// # Errors
 /// As [`within_kinetic_energy`].
@@ -60,13 +61,16 @@ pub(super) fn guard<T: Real, M: Mechanism<T, N>, const N: usize>(
             qd: SVector::zeros(),
             ..end
         };
-        let moved = end.q - free.q;
+        // From the start's coordinates, not the free step's: a contact the free step took
+        // deeper than it began is not left there (the start's potential is within the
+        // allowance too: V(start) <= T + V of the start).
+        let moved = end.q - start.q;
         let at = |share: T| State {
-            q: free.q + moved * share,
+            q: start.q + moved * share,
             ..rest
         };
         // The largest share of the move whose potential is within the allowance: regula
-        // falsi between the free step's coordinates (within it) and the end's (above it),
+        // falsi between the start's coordinates (within it) and the end's (above it),
         // keeping the last share found within (the potential is not linear along the move
         // where it turns a link).
         let (mut lo, mut v_lo) = (T::zero(), mechanism.potential_energy(&at(T::zero())));
