@@ -19,6 +19,9 @@
 //!   ([`Constrained`]), Baumgarte [`Stabilization`] and [`Projection`] against drift.
 //! - [`Jacobian`]: `d/dq` and `d/dq'` of the equations of motion, exact from dual numbers for
 //!   [`EulerLagrange`], by [`central_difference_jacobian`] otherwise (for implicit integrators).
+//! - [`links`]: where a mechanism's links are in the plane ([`links::Links`]), and the
+//!   Jacobian of a point fixed on one (by dual numbers, or by hand): what collision
+//!   detection needs of a mechanism.
 //! - [`Error`]: one small `Copy` error type for every crate.
 //! - [`closed_form`]: a mechanism given by its equations in closed form ([`ClosedForm`]: what
 //!   `lagrange-derive` generates from a SymPy spec) is a [`Mechanism`] by one generic impl;
@@ -66,6 +69,7 @@ mod jacobian;
 mod jet;
 mod lagrangian;
 mod lanes;
+pub mod links;
 mod mechanism;
 mod parameters;
 pub mod prelude;

@@ -124,7 +124,7 @@ impl Area {
 }
 
 /// The areas, in the order they run.
-const AREAS: [Area; 25] = [
+const AREAS: [Area; 27] = [
     Area {
         name: "explicit",
         package: "lagrange-integrators",
@@ -740,6 +740,30 @@ const AREAS: [Area; 25] = [
             "mechanisms_bad_input",
         ],
         unit_tests: true,
+        optimised: false,
+    },
+    Area {
+        // Where a mechanism's links are (issue 34's bodies): the pose and the point Jacobian
+        // by dual numbers. Not yet run.
+        name: "bodies",
+        package: "lagrange-core",
+        test_package: "lagrange-tests",
+        files: &["lagrange-core/src/links.rs"],
+        only: None,
+        tests: &["--test", "rigid_body"],
+        unit_tests: false,
+        optimised: false,
+    },
+    Area {
+        // The free rigid body (issue 34): its law, its constructors, its hand-derived link
+        // point. Not yet run.
+        name: "rigid-body",
+        package: "lagrange-systems",
+        test_package: "lagrange-tests",
+        files: &["lagrange-systems/src/rigid_body.rs"],
+        only: None,
+        tests: &["--test", "rigid_body"],
+        unit_tests: false,
         optimised: false,
     },
     Area {
