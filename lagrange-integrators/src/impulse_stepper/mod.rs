@@ -52,9 +52,13 @@ use step::{Memory, Setup};
 ///                   coordinates), at most 3 times; where one still is and is deeper than
 ///                   at the step's start (a link turned by most of a radian in one step),
 ///                   the coordinates stay the start's (the report's held_back)
-/// 7. energy         T + V after at most max(T + V before, T + V after the free step): where
-///                   the drift's potential or rebounds of rows coupled in the mass metric
-///                   would add energy, the velocities are scaled down to it
+/// 7. energy         T + V after at most T + V before plus the work the mechanism's forces
+///                   and time dependence can have done (dt times the larger of their rates,
+///                   Q . q' - dL/dt, at the start and the free step's end; none for a
+///                   conservative or damped mechanism), never the free step's own error:
+///                   where the drift's potential, rebounds of rows coupled in the mass
+///                   metric or the inner method's error would add energy, the velocities are
+///                   scaled down to it (a conservative ragdoll at 60 Hz is never pumped)
 /// ```
 ///
 /// **Work of a step** (a firmware budget; `R` normal rows, at most the contact set's `C`
@@ -76,8 +80,9 @@ use step::{Memory, Setup};
 /// at most 3 exact solves of the R rows for the drift; 1 position_residual after it, and at
 ///   most 3 more exact solves and position_residuals on the gaps it left (1 more
 ///   position_residual where the coordinates stay the start's)
-/// 1 evaluation of T + V (2 after a flight); where the end would pass the allowance, 2 to 3
-///   more and at most 4 of V
+/// 1 evaluation of T + V (2 after a flight); where the end would pass the start's, the
+///   forces' power and dL/dt (one dual evaluation of L) at two states, 1 to 2 more of T + V
+///   and at most 4 of V
 /// ```
 ///
 /// The stepper keeps the storage of its rows from step to step (about `2 C^2 + 5 C N`

@@ -323,7 +323,7 @@ impl<T: Real, const C: usize, K> Setup<T, C, K> {
             q,
             qd: solved.velocity,
         };
-        let (end, energy, guarded) = guard(mechanism, s, start_energy, &free, end)?;
+        let (end, energy, guarded) = guard(mechanism, s, start_energy, &free, end, dt)?;
         let count = |rows: &[bool; C]| {
             u32::try_from(rows.iter().filter(|&&r| r).count()).unwrap_or(u32::MAX)
         };
