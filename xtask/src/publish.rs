@@ -6,15 +6,17 @@ use std::path::{Path, PathBuf};
 
 use crate::cmd;
 
-/// The publishable crates, as `cargo -p` arguments: the three libraries and the
+/// The publishable crates, as `cargo -p` arguments: the four libraries and the
 /// `lagrange-derive` command (its package must carry `derive.py`, which it includes).
-const LIBRARIES: [&str; 8] = [
+const LIBRARIES: [&str; 10] = [
     "-p",
     "lagrange-core",
     "-p",
     "lagrange-integrators",
     "-p",
     "lagrange-systems",
+    "-p",
+    "lagrange-world",
     "-p",
     "lagrange-derive",
 ];
