@@ -86,6 +86,7 @@ pub fn collide<T: Real>(a: &Shape<T>, b: &Shape<T>, margin: T) -> Manifold<T> {
 /// A static half-plane: the points `x` with `normal . x >= offset` are free; the others are
 /// inside it (the floor: normal `(0, 1)`, offset 0).
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct HalfPlane<T> {
     normal: Vec2<T>,
     offset: T,

@@ -6,6 +6,7 @@ use lagrange_core::Real;
 
 /// One point of a [`Manifold`].
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct ContactPoint<T> {
     /// Midway between the two surfaces, world coordinates.
     pub point: Vec2<T>,
@@ -21,6 +22,7 @@ pub struct ContactPoint<T> {
 /// to the second, and up to two points (two where a face lies on a face: a box resting on the
 /// floor).
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Manifold<T> {
     /// Unit normal, from the first shape towards the second.
     pub normal: Vec2<T>,

@@ -27,6 +27,7 @@ pub const MAX_VERTICES: usize = 8;
 /// # Ok::<(), lagrange_core::Error>(())
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Shape<T> {
     vertices: [Vec2<T>; MAX_VERTICES],
     /// The outward unit normal of edge `i`, from vertex `i` to vertex `i + 1` (for a capsule,

@@ -35,7 +35,12 @@ pub(crate) const TARGETS: [&str; 4] = [
 /// the other [`TARGETS`] with the last (`defmt` on top of the defaults: the same code and the
 /// derives, so that a build more per target and crate would check nothing new there; the
 /// default set alone is built for them by `cargo xtask qemu`'s firmware).
-const CRATES: [&str; 3] = ["lagrange-core", "lagrange-integrators", "lagrange-systems"];
+const CRATES: [&str; 4] = [
+    "lagrange-core",
+    "lagrange-integrators",
+    "lagrange-systems",
+    "lagrange-world",
+];
 
 /// The extra cargo arguments of each feature set: default features, then `defmt` on top.
 const FEATURE_SETS: [&[&str]; 2] = [&[], &["--features", "defmt"]];
