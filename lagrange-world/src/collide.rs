@@ -118,6 +118,15 @@ impl<T: Real> HalfPlane<T> {
         })
     }
 
+    /// The floor `y >= 0`.
+    #[must_use]
+    pub fn floor() -> Self {
+        Self {
+            normal: [T::zero(), T::one()],
+            offset: T::zero(),
+        }
+    }
+
     /// The unit normal, out of the half-plane.
     #[must_use]
     pub fn normal(&self) -> Vec2<T> {

@@ -10,6 +10,9 @@
 //! - [`collide`]: the narrow phase of two shapes, a [`Manifold`] of up to two
 //!   [`ContactPoint`]s with their gaps and feature ids, within a speculative margin;
 //!   [`collide_half_plane`] against a static [`HalfPlane`] (a floor, a wall).
+//! - [`PlaneContacts`]: the contact rows of a mechanism's shapes against static half-planes,
+//!   for `ImpulseStepper` and `ContactStepper` (a crate on the floor, a wheel rolling down a
+//!   slope), from its [`Links`](lagrange_core::links::Links) alone.
 //!
 //! ```
 //! use lagrange_core::links::Pose;
@@ -30,10 +33,12 @@
 
 mod collide;
 mod manifold;
+mod plane_contacts;
 mod shape;
 mod vec2;
 
 pub use collide::{collide, collide_half_plane, HalfPlane};
 pub use manifold::{ContactPoint, Manifold};
+pub use plane_contacts::PlaneContacts;
 pub use shape::{Shape, MAX_VERTICES};
 pub use vec2::Vec2;

@@ -776,11 +776,12 @@ const AREAS: [Area; 28] = [
         files: &[
             "lagrange-world/src/collide.rs",
             "lagrange-world/src/manifold.rs",
+            "lagrange-world/src/plane_contacts.rs",
             "lagrange-world/src/shape.rs",
             "lagrange-world/src/vec2.rs",
         ],
         only: None,
-        tests: &["--test", "collide"],
+        tests: &["--test", "collide", "--test", "plane_contacts"],
         unit_tests: false,
         optimised: false,
     },
