@@ -63,6 +63,7 @@ pub mod exact;
 mod falling_particle;
 mod four_bar_linkage;
 mod kepler;
+mod links;
 mod n_link_pendulum;
 mod ragdoll;
 mod ragdoll_contacts;

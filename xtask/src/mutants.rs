@@ -756,14 +756,17 @@ const AREAS: [Area; 28] = [
         optimised: false,
     },
     Area {
-        // The free rigid body (issue 34): its law, its constructors, its hand-derived link
-        // point. Not yet run.
+        // The free rigid body and the standard chains' links (issue 34): its law, its
+        // constructors, its hand-derived link point; the chains' link poses. Not yet run.
         name: "rigid-body",
         package: "lagrange-systems",
         test_package: "lagrange-tests",
-        files: &["lagrange-systems/src/rigid_body.rs"],
+        files: &[
+            "lagrange-systems/src/rigid_body.rs",
+            "lagrange-systems/src/links.rs",
+        ],
         only: None,
-        tests: &["--test", "rigid_body"],
+        tests: &["--test", "rigid_body", "--test", "links"],
         unit_tests: false,
         optimised: false,
     },
