@@ -10,6 +10,9 @@
 //! - [`collide`]: the narrow phase of two shapes, a [`Manifold`] of up to two
 //!   [`ContactPoint`]s with their gaps and feature ids, within a speculative margin;
 //!   [`collide_half_plane`] against a static [`HalfPlane`] (a floor, a wall).
+//! - [`BroadPhase`]: the pairs of [`Proxy`] boxes that overlap and may touch (not both
+//!   static or asleep, not of one body, collision groups and masks), by sweep and prune, in
+//!   an order that does not depend on the order they were added.
 //! - [`PlaneContacts`]: the contact rows of a mechanism's shapes against static half-planes,
 //!   for `ImpulseStepper` and `ContactStepper` (a crate on the floor, a wheel rolling down a
 //!   slope), from its [`Links`](lagrange_core::links::Links) alone.
@@ -31,12 +34,14 @@
 #![no_std]
 #![forbid(unsafe_code)]
 
+mod broad;
 mod collide;
 mod manifold;
 mod plane_contacts;
 mod shape;
 mod vec2;
 
+pub use broad::{BroadPhase, Proxy};
 pub use collide::{collide, collide_half_plane, HalfPlane};
 pub use manifold::{ContactPoint, Manifold};
 pub use plane_contacts::PlaneContacts;

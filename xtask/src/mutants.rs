@@ -771,12 +771,13 @@ const AREAS: [Area; 28] = [
         optimised: false,
     },
     Area {
-        // The narrow phase (issue 34): shapes, manifolds, the collision of two shapes and of
-        // a shape with a half-plane. Not yet run.
+        // Collision geometry (issue 34): shapes, manifolds, the collision of two shapes and of
+        // a shape with a half-plane, rows against planes, the broad phase. Not yet run.
         name: "world",
         package: "lagrange-world",
         test_package: "lagrange-tests",
         files: &[
+            "lagrange-world/src/broad.rs",
             "lagrange-world/src/collide.rs",
             "lagrange-world/src/manifold.rs",
             "lagrange-world/src/plane_contacts.rs",
@@ -784,7 +785,14 @@ const AREAS: [Area; 28] = [
             "lagrange-world/src/vec2.rs",
         ],
         only: None,
-        tests: &["--test", "collide", "--test", "plane_contacts"],
+        tests: &[
+            "--test",
+            "collide",
+            "--test",
+            "plane_contacts",
+            "--test",
+            "broad_phase",
+        ],
         unit_tests: false,
         optimised: false,
     },
