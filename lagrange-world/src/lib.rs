@@ -10,6 +10,8 @@
 //! - [`collide`]: the narrow phase of two shapes, a [`Manifold`] of up to two
 //!   [`ContactPoint`]s with their gaps and feature ids, within a speculative margin;
 //!   [`collide_half_plane`] against a static [`HalfPlane`] (a floor, a wall).
+//! - Queries: [`Shape::distance`] of a point (signed), [`Shape::ray`] (where a ray first
+//!   meets a shape, a [`RayHit`]).
 //! - [`BroadPhase`]: the pairs of [`Proxy`] boxes that overlap and may touch (not both
 //!   static or asleep, not of one body, collision groups and masks), by sweep and prune, in
 //!   an order that does not depend on the order they were added.
@@ -38,6 +40,7 @@ mod broad;
 mod collide;
 mod manifold;
 mod plane_contacts;
+mod query;
 mod shape;
 mod vec2;
 
@@ -45,5 +48,6 @@ pub use broad::{BroadPhase, Proxy};
 pub use collide::{collide, collide_half_plane, HalfPlane};
 pub use manifold::{ContactPoint, Manifold};
 pub use plane_contacts::PlaneContacts;
+pub use query::RayHit;
 pub use shape::{Shape, MAX_VERTICES};
 pub use vec2::Vec2;
