@@ -4,7 +4,10 @@
 //! point at `(0, -l)` of a pendulum's link is its bob. The point Jacobians come from the
 //! poses in dual numbers ([`Links::point`]'s default).
 
-use crate::{Acrobot, CartPole, DoublePendulum, NLinkPendulum, SimplePendulum};
+use crate::{
+    Acrobot, CartPole, DoublePendulum, NLinkPendulum, Ragdoll, SimplePendulum, RAGDOLL_COORDINATES,
+    RAGDOLL_LINKS,
+};
 use lagrange_core::links::{Links, Pose};
 use lagrange_core::nalgebra::SVector;
 use lagrange_core::{Real, Scalar};
@@ -79,5 +82,22 @@ impl<T: Real> Links<T, 2> for CartPole<T> {
         } else {
             at(origin, -q[1])
         }
+    }
+}
+
+impl<T: Real> Links<T, RAGDOLL_COORDINATES> for Ragdoll<T> {
+    /// In the order of `q` and [`Ragdoll::segments`]: the torso (its frame at its centre of
+    /// mass, the neck at `(0, L/2)`, the pelvis at `(0, -L/2)`), the head and the limbs (each
+    /// from its joint, along `-y`).
+    const LINKS: usize = RAGDOLL_LINKS;
+    fn pose<S: Scalar<Real = T> + 'static>(
+        &self,
+        q: &SVector<S, RAGDOLL_COORDINATES>,
+        link: usize,
+    ) -> Pose<S> {
+        let link = link.min(RAGDOLL_LINKS - 1);
+        // The ragdoll's own pose of every link (its inherent method, not this one).
+        let origin = self.pose(q).origin[link];
+        at([q[0] + origin[0], q[1] + origin[1]], self.angles(q)[link])
     }
 }
