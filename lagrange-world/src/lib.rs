@@ -10,6 +10,9 @@
 //! - [`collide`]: the narrow phase of two shapes, a [`Manifold`] of up to two
 //!   [`ContactPoint`]s with their gaps and feature ids, within a speculative margin;
 //!   [`collide_half_plane`] against a static [`HalfPlane`] (a floor, a wall).
+//! - [`Pair`] (two mechanisms as one, their coordinates side by side) and [`ShapePairs`]
+//!   (contact rows between shapes on two links, from the narrow phase): two bodies that
+//!   touch, solved by the contact steppers with momentum kept.
 //! - Queries: [`Shape::distance`] of a point (signed), [`Shape::ray`] (where a ray first
 //!   meets a shape, a [`RayHit`]).
 //! - [`BroadPhase`]: the pairs of [`Proxy`] boxes that overlap and may touch (not both
@@ -39,15 +42,19 @@
 mod broad;
 mod collide;
 mod manifold;
+mod pair;
 mod plane_contacts;
 mod query;
 mod shape;
+mod shape_pairs;
 mod vec2;
 
 pub use broad::{BroadPhase, Proxy};
 pub use collide::{collide, collide_half_plane, HalfPlane};
 pub use manifold::{ContactPoint, Manifold};
+pub use pair::Pair;
 pub use plane_contacts::PlaneContacts;
 pub use query::RayHit;
 pub use shape::{Shape, MAX_VERTICES};
+pub use shape_pairs::{OnLink, ShapePairs};
 pub use vec2::Vec2;
