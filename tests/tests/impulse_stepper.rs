@@ -951,7 +951,343 @@ fn a_cycling_landing_still_steps<T: Real>() -> Result<(), Error> {
     Ok(())
 }
 
+/// Rows of a contact step's report, worst first: the peak a run should report, field by
+/// field (the largest counts, every step settled, any flag).
+fn by_hand(peak: ImpulseReport, r: ImpulseReport) -> ImpulseReport {
+    ImpulseReport {
+        rows: peak.rows.max(r.rows),
+        speculative: peak.speculative.max(r.speculative),
+        frictional: peak.frictional.max(r.frictional),
+        rounds: peak.rounds.max(r.rounds),
+        settled: peak.settled && r.settled,
+        corrected: peak.corrected || r.corrected,
+        drift_rounds: peak.drift_rounds.max(r.drift_rounds),
+        held_back: peak.held_back || r.held_back,
+        energy_guard: peak.energy_guard || r.energy_guard,
+    }
+}
+
+/// What a stepper tells of its steps. The block held on the incline by friction (`mu = 0.8`)
+/// at 120 Hz: every step's impulses are the ones that hold it, `m g cos(a) dt` along the
+/// normal and `m g sin(a) dt` up the slope (to the rounding of the velocities, a few ulps of
+/// `g dt`); the peak report of a ball's bounces is the worst of every step's report, field by
+/// field; clearing it leaves the report of no step, and one step later it is that step's; the
+/// work of a step is the inner method's (semi-implicit Euler: one evaluation).
+fn reports_peaks_and_impulses<T: Real>() -> Result<(), Error> {
+    let dt = 1.0 / 120.0;
+    let point = EulerLagrange::new(Point);
+    let model = ContactModel::new(T::zero(), T::from_f64(0.1), T::one())?
+        .with_friction(T::from_f64(0.8))?;
+    let settings = ImpulseSettings::new(T::from_f64(1e-4), 8)?;
+    let mut block = ImpulseStepper::new(SemiImplicitEuler, Incline, model, settings);
+    let (none_n, none_t) = block.impulses();
+    assert!(none_n[0] == T::zero() && none_t[0] == T::zero());
+    let mut s = State::at_rest([T::zero(); 2]);
+    let tolerance = pick::<T>(1e-8, 1e-16) * 8.0;
+    for _ in 0..10 {
+        s = block.step(&point, &s, T::from_f64(dt))?;
+        let (normal, tangent) = block.impulses();
+        let (normal, tangent) = (normal[0].to_f64(), tangent[0].to_f64());
+        assert!(
+            (normal - G * ALPHA.cos() * dt).abs() <= tolerance,
+            "{normal:e}"
+        );
+        assert!(
+            (tangent - G * ALPHA.sin() * dt).abs() <= tolerance,
+            "{tangent:e}"
+        );
+    }
+    assert_eq!(
+        Method::last_step(&block),
+        Method::last_step(&SemiImplicitEuler)
+    );
+    assert_eq!(Method::last_step(&block).evaluations, 1);
+
+    let ball = FallingParticle::new(T::one(), T::from_f64(G))?;
+    let model = ContactModel::new(T::from_f64(0.5), T::from_f64(0.05), T::one())?;
+    let settings = ImpulseSettings::new(T::from_f64(1e-3), 8)?;
+    let mut stepper =
+        ImpulseStepper::new(SemiImplicitEuler, Holonomic::new(Ground), model, settings);
+    let mut s = State::at_rest([T::one()]);
+    let mut peak = ImpulseReport::default();
+    for _ in 0..240 {
+        s = stepper.step(&ball, &s, T::from_f64(dt))?;
+        peak = by_hand(peak, stepper.last_report());
+        assert_eq!(stepper.peak_report(), peak);
+    }
+    assert!(peak.rows == 1 && peak.rounds > 0, "{peak:?}");
+    stepper.clear_peak();
+    assert_eq!(stepper.peak_report(), ImpulseReport::default());
+    stepper.step(&ball, &s, T::from_f64(dt))?;
+    assert_eq!(stepper.peak_report(), stepper.last_report());
+    assert_eq!(stepper.last_report().rows, 1);
+    Ok(())
+}
+
+/// `with_bilateral` holds its rows both ways, and starts afresh. The ball on the ground
+/// moving up at 1 m/s: as a contact it leaves (`y = dt (1 - g dt)` after a semi-implicit
+/// Euler step), held bilaterally it stays at `y = 0` at rest (to the rounding of `g dt^2`).
+/// A stepper that has stepped, made bilateral, reports no step and no impulse, and its next
+/// step is a fresh stepper's, bit for bit (no warm start carried over).
+fn with_bilateral_holds_and_starts_afresh<T: Real>() -> Result<(), Error> {
+    let dt = 1.0 / 120.0;
+    let ball = FallingParticle::new(T::one(), T::from_f64(G))?;
+    let model = ContactModel::new(T::from_f64(0.5), T::from_f64(0.05), T::one())?;
+    let settings = ImpulseSettings::new(T::from_f64(1e-3), 8)?;
+    let fresh = ImpulseStepper::new(SemiImplicitEuler, Holonomic::new(Ground), model, settings);
+    let rising = State::new(T::zero(), [T::zero()], [T::one()]);
+    let mut unilateral = fresh;
+    let left = unilateral.step(&ball, &rising, T::from_f64(dt))?;
+    let flight = dt * (1.0 - G * dt);
+    let rounding = pick::<T>(1e-6, 1e-15);
+    assert!((left.q[0].to_f64() - flight).abs() <= rounding, "{left:?}");
+    let mut bilateral = fresh.with_bilateral([true]);
+    let held = bilateral.step(&ball, &rising, T::from_f64(dt))?;
+    assert!(
+        held.q[0].to_f64().abs() <= rounding && held.qd[0].to_f64().abs() <= rounding,
+        "{held:?}"
+    );
+
+    let mut used = fresh;
+    let mut s = State::at_rest([T::from_f64(0.01)]);
+    for _ in 0..30 {
+        s = used.step(&ball, &s, T::from_f64(dt))?;
+    }
+    assert_eq!(used.last_report().rows, 1);
+    let mut renewed = used.with_bilateral([false]);
+    assert_eq!(renewed.last_report(), ImpulseReport::default());
+    assert_eq!(renewed.peak_report(), ImpulseReport::default());
+    assert!(renewed.impulses().0[0] == T::zero());
+    let mut new = fresh.with_bilateral([false]);
+    assert_eq!(
+        renewed.step(&ball, &s, T::from_f64(dt))?,
+        new.step(&ball, &s, T::from_f64(dt))?
+    );
+    assert_eq!(renewed.last_report(), new.last_report());
+    Ok(())
+}
+
+/// The sleep test's reading, `law_acceleration`: what a step from the state at rest does to
+/// the velocities, over the step. Before any step, the mechanism's own acceleration. After a
+/// step of 1/120 s: a ball in flight at 3 m/s reads `-g`, whatever its speed; the block on
+/// the incline with `mu = 0.2`, moving up the slope at 2 m/s, reads the slide from rest,
+/// `(mu g cos a - g sin a)` along the slope (Coulomb's law); held by `mu = 0.8`, zero. To the
+/// rounding of the step's velocities (a few ulps of `g dt`) over `dt`.
+fn law_acceleration_reads_a_step_from_rest<T: Real>() -> Result<(), Error> {
+    let dt = T::from_f64(1.0 / 120.0);
+    let rounding = pick::<T>(1e-4, 1e-12);
+    let ball = FallingParticle::new(T::one(), T::from_f64(G))?;
+    let model = ContactModel::new(T::from_f64(0.5), T::from_f64(0.05), T::one())?;
+    let settings = ImpulseSettings::new(T::from_f64(1e-3), 8)?;
+    let mut stepper =
+        ImpulseStepper::new(SemiImplicitEuler, Holonomic::new(Ground), model, settings);
+    let flying = State::new(T::zero(), [T::one()], [T::from_f64(3.0)]);
+    let before = stepper.law_acceleration(&ball, &flying)?[0].to_f64();
+    assert!((before + G).abs() <= rounding, "{before}");
+    stepper.step(&ball, &State::at_rest([T::one()]), dt)?;
+    let after = stepper.law_acceleration(&ball, &flying)?[0].to_f64();
+    assert!((after + G).abs() <= rounding, "{after}");
+
+    let point = EulerLagrange::new(Point);
+    let up = [ALPHA.cos(), ALPHA.sin()];
+    for (mu, along_slope) in [(0.2, 0.2 * G * ALPHA.cos() - G * ALPHA.sin()), (0.8, 0.0)] {
+        let model = ContactModel::new(T::zero(), T::from_f64(0.1), T::one())?
+            .with_friction(T::from_f64(mu))?;
+        let settings = ImpulseSettings::new(T::from_f64(1e-4), 8)?;
+        let mut block = ImpulseStepper::new(SemiImplicitEuler, Incline, model, settings);
+        block.step(&point, &State::at_rest([T::zero(); 2]), dt)?;
+        let sliding = State::new(T::zero(), [T::zero(); 2], up.map(|u| T::from_f64(2.0 * u)));
+        let a = block.law_acceleration(&point, &sliding)?;
+        for k in 0..2 {
+            let want = along_slope * up[k];
+            assert!((a[k].to_f64() - want).abs() <= rounding, "mu {mu}: {a:?}");
+        }
+    }
+    Ok(())
+}
+
+/// A unit point mass in the plane under gravity whose potential has an offset and grows in
+/// time: `V = g y + offset + growth t`. The offset and the growth change no force (the
+/// motion is the unit point's), but the energy `T + V` rises at `growth`: `-dL/dt`.
+struct Raised {
+    offset: f64,
+    growth: f64,
+}
+
+impl<T: Real> Lagrangian<T, 2> for Raised {
+    fn kinetic<S: Scalar<Real = T>>(&self, _: S, _: &SVector<S, 2>, qd: &SVector<S, 2>) -> S {
+        (qd[0] * qd[0] + qd[1] * qd[1]) * S::from_f64(0.5)
+    }
+    fn potential<S: Scalar<Real = T>>(&self, t: S, q: &SVector<S, 2>) -> S {
+        q[1] * S::from_f64(G) + S::from_f64(self.offset) + t * S::from_f64(self.growth)
+    }
+}
+
+/// The floor `y >= 0` of a point in the plane.
+#[derive(Clone, Copy)]
+struct Floor;
+
+impl<T: Real> HolonomicConstraints<T, 2, 1> for Floor {
+    fn phi<S: Scalar<Real = T> + 'static>(&self, q: &SVector<S, 2>) -> SVector<S, 1> {
+        SVector::from([q[1]])
+    }
+}
+
+/// The energy guard allows what time dependence adds. The block from rest on the
+/// frictionless incline under `V = g y - 100 + t` (J): the energy rises by 1 J/s, all of it
+/// `-dL/dt`, and the guard lets every step keep it (never acting), so the block slides
+/// exactly as without the growth: `s = -g sin(a) t^2 / 2` at 1 s by velocity Verlet at 120 Hz
+/// (exact for the slide, to rounding: 1e-9 m in f64, 1e-4 m in f32).
+fn energy_that_time_adds_is_allowed<T: Real>() -> Result<(), Error> {
+    let mechanism = EulerLagrange::new(Raised {
+        offset: -100.0,
+        growth: 1.0,
+    });
+    let model = ContactModel::new(T::zero(), T::from_f64(0.1), T::one())?;
+    let settings = ImpulseSettings::new(T::from_f64(1e-4), 8)?;
+    let mut stepper = ImpulseStepper::new(VelocityVerlet, Incline, model, settings);
+    let mut s = State::at_rest([T::zero(); 2]);
+    for _ in 0..120 {
+        s = stepper.step(&mechanism, &s, T::from_f64(1.0 / 120.0))?;
+        let r = stepper.last_report();
+        assert!(r.rows == 1 && !r.energy_guard, "{r:?} at {:?}", s.t);
+    }
+    let exact = -G * ALPHA.sin() / 2.0;
+    let error = (along(&s) - exact).abs();
+    assert!(
+        error <= pick::<T>(1e-4, 1e-9),
+        "{} against {exact}",
+        along(&s)
+    );
+    Ok(())
+}
+
+/// A ball at rest 10 cm deep in the floor (slop 1 mm): its drift correction would lift it
+/// 9.9 cm, 0.97 J for a unit mass, and the energy guard does not pay for it, so it stays
+/// where it began (to the rounding of the share of the move the guard finds, 1e-12 m in f64
+/// and 1e-5 m in f32) at rest, step after step, its energy never above the start's plus
+/// what the forces and time dependence give. For a 1 kg ball, for a 1 ug grain (energies of
+/// 1e-9 J: the guard's rounding allowance is relative to them), and for a ball whose
+/// potential grows at 1 J/s (the growth pays for its own rise, not for a lift).
+fn a_lift_is_not_paid_for<T: Real>() -> Result<(), Error> {
+    let dt = 1.0 / 120.0;
+    let model = ContactModel::new(T::zero(), T::from_f64(0.05), T::one())?;
+    let settings = ImpulseSettings::new(T::from_f64(1e-3), 8)?;
+    let near = pick::<T>(1e-5, 1e-12);
+    for mass in [1.0, 1e-9] {
+        let ball = FallingParticle::new(T::from_f64(mass), T::from_f64(G))?;
+        let mut stepper =
+            ImpulseStepper::new(SemiImplicitEuler, Holonomic::new(Ground), model, settings);
+        let mut s = State::at_rest([T::from_f64(-0.1)]);
+        for _ in 0..5 {
+            let next = stepper.step(&ball, &s, T::from_f64(dt))?;
+            let (e0, e1) = (ball.energy(&s).to_f64(), ball.energy(&next).to_f64());
+            assert!(e1 <= e0 + 16.0 * T::EPSILON.to_f64() * (e0.abs() + e1.abs()));
+            s = next;
+        }
+        assert!(
+            (s.q[0].to_f64() + 0.1).abs() <= near && s.qd[0] == T::zero(),
+            "{mass}: {s:?}"
+        );
+        assert!(stepper.last_report().energy_guard);
+    }
+    let growing = EulerLagrange::new(Raised {
+        offset: 0.0,
+        growth: 1.0,
+    });
+    let mut stepper =
+        ImpulseStepper::new(SemiImplicitEuler, Holonomic::new(Floor), model, settings);
+    let mut s = State::at_rest([T::zero(), T::from_f64(-0.1)]);
+    for _ in 0..5 {
+        let next = stepper.step(&growing, &s, T::from_f64(dt))?;
+        let (e0, e1) = (growing.energy(&s).to_f64(), growing.energy(&next).to_f64());
+        assert!(e1 <= e0 + dt + 64.0 * T::EPSILON.to_f64(), "{e0} -> {e1}");
+        s = next;
+    }
+    assert!(
+        (s.q[1].to_f64() + 0.1).abs() <= near && s.qd[1] == T::zero(),
+        "{s:?}"
+    );
+    Ok(())
+}
+
+/// A ball driven into the floor at 0.5 m/s, 10 cm deep (slop 1 mm, no restitution): the
+/// drift correction would lift it 9.9 cm (0.97 J), and the guard lets the step spend on it
+/// the kinetic energy it had, 0.125 J, and no more: it ends at rest `v^2 / 2 g` = 1.27 cm
+/// higher (to the rounding of the share of the move, 1e-12 m in f64 and 1e-5 m in f32),
+/// never deeper than it began.
+fn a_lift_is_paid_from_the_start_energy<T: Real>() -> Result<(), Error> {
+    let ball = FallingParticle::new(T::one(), T::from_f64(G))?;
+    let model = ContactModel::new(T::zero(), T::from_f64(0.05), T::one())?;
+    let settings = ImpulseSettings::new(T::from_f64(1e-3), 8)?;
+    let mut stepper =
+        ImpulseStepper::new(SemiImplicitEuler, Holonomic::new(Ground), model, settings);
+    let start = State::new(T::zero(), [T::from_f64(-0.1)], [T::from_f64(-0.5)]);
+    let end = stepper.step(&ball, &start, T::from_f64(1.0 / 120.0))?;
+    let want = -0.1 + 0.5 * 0.5 / (2.0 * G);
+    assert!(
+        (end.q[0].to_f64() - want).abs() <= pick::<T>(1e-5, 1e-12) && end.qd[0] == T::zero(),
+        "{end:?} against {want}"
+    );
+    assert!(stepper.last_report().energy_guard);
+    Ok(())
+}
+
+/// The guard's rounding allowance, both sides of it. A unit point sliding along the floor at
+/// 1 m/s under `V = g y + 32` (J), 1 mm + `d` deep (slop 1 mm): the drift lifts it by `d`,
+/// a gain of `g d`. The guard allows the start's energy plus 16 ulps of each of the sizes
+/// of the energies compared and twice the potential, `16 eps (2 |E| + 2 |V|)` = 2063 eps J
+/// (`E` = 32.49 J, `V` = 31.99 J); it acts on no step within the quick check's 16 eps
+/// `2 |E|` = 1040 eps J either. A gain of 1800 eps J is left alone: lifted to the slop, the
+/// speed kept. A gain of 2350 eps J is guarded: lifted, and the speed scaled down to pay for
+/// it (by about the gain, a part in 1e12 in f64, 1e-4 in f32), never stopped.
+fn the_guard_allows_rounding_only<T: Real>() -> Result<(), Error> {
+    let slop = 1e-3;
+    let mechanism = EulerLagrange::new(Raised {
+        offset: 32.0,
+        growth: 0.0,
+    });
+    let model = ContactModel::new(T::zero(), T::from_f64(0.05), T::one())?;
+    let settings = ImpulseSettings::new(T::from_f64(slop), 8)?;
+    let eps = T::EPSILON.to_f64();
+    for (gain, guarded) in [(1800.0, false), (2350.0, true)] {
+        let mut stepper =
+            ImpulseStepper::new(SemiImplicitEuler, Holonomic::new(Floor), model, settings);
+        let deep = -(slop + gain * eps / G);
+        let start = State::new(
+            T::zero(),
+            [T::zero(), T::from_f64(deep)],
+            [T::one(), T::zero()],
+        );
+        let end = stepper.step(&mechanism, &start, T::from_f64(1.0 / 120.0))?;
+        assert_eq!(
+            stepper.last_report().energy_guard,
+            guarded,
+            "{gain}: {end:?}"
+        );
+        let lift = end.q[1].to_f64() + slop;
+        assert!(lift.abs() <= 64.0 * eps * slop, "{gain}: {end:?}");
+        let speed = end.qd[0].to_f64();
+        if guarded {
+            assert!(
+                speed < 1.0 && speed > 1.0 - 4.0 * gain * eps,
+                "{gain}: {end:?}"
+            );
+        } else {
+            assert_eq!(speed, 1.0);
+        }
+    }
+    Ok(())
+}
+
 for_f32_and_f64!(
+    reports_peaks_and_impulses,
+    with_bilateral_holds_and_starts_afresh,
+    law_acceleration_reads_a_step_from_rest,
+    energy_that_time_adds_is_allowed,
+    a_lift_is_not_paid_for,
+    a_lift_is_paid_from_the_start_energy,
+    the_guard_allows_rounding_only,
     pushed_up_the_incline,
     sixty_hertz_throws_are_never_pumped,
     a_cycling_landing_still_steps,
