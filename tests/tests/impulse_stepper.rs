@@ -1280,7 +1280,44 @@ fn the_guard_allows_rounding_only<T: Real>() -> Result<(), Error> {
     Ok(())
 }
 
+/// The settings keep what they are given, and `max_iterations` caps the rounds of a solve.
+/// The block from rest on the incline with `mu = 0.2`: the first step's solve takes two
+/// rounds (the normal row, then the friction sweeps, which change the tangent's impulse from
+/// zero to `mu` times the normal one; the second round's first sweep changes nothing: settled)
+/// where eight are allowed; capped at one, it stops after the first, not settled, and the
+/// next step, warm-started from that tangent impulse, settles in one.
+fn max_iterations_caps_the_rounds<T: Real>() -> Result<(), Error> {
+    let settings = ImpulseSettings::new(T::from_f64(1e-4), 8)?
+        .with_tolerance(T::from_f64(1e-7))?
+        .with_max_rows(3)?;
+    assert_eq!(settings.slop(), T::from_f64(1e-4));
+    assert_eq!(settings.max_iterations(), 8);
+    assert_eq!(settings.tolerance(), T::from_f64(1e-7));
+    assert_eq!(settings.max_rows(), Some(3));
+    let point = EulerLagrange::new(Point);
+    let model = ContactModel::new(T::zero(), T::from_f64(0.1), T::one())?
+        .with_friction(T::from_f64(0.2))?;
+    let dt = T::from_f64(1.0 / 120.0);
+    let start = State::at_rest([T::zero(); 2]);
+    for (cap, rounds, settled) in [(8, 2, true), (1, 1, false)] {
+        let settings = ImpulseSettings::new(T::from_f64(1e-4), cap)?;
+        let mut block = ImpulseStepper::new(SemiImplicitEuler, Incline, model, settings);
+        let s = block.step(&point, &start, dt)?;
+        let r = block.last_report();
+        assert_eq!(
+            (r.rows, r.rounds, r.settled),
+            (1, rounds, settled),
+            "cap {cap}: {r:?}"
+        );
+        block.step(&point, &s, dt)?;
+        let r = block.last_report();
+        assert_eq!((r.rounds, r.settled), (1, true), "cap {cap}: {r:?}");
+    }
+    Ok(())
+}
+
 for_f32_and_f64!(
+    max_iterations_caps_the_rounds,
     reports_peaks_and_impulses,
     with_bilateral_holds_and_starts_afresh,
     law_acceleration_reads_a_step_from_rest,
