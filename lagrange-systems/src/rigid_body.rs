@@ -26,7 +26,7 @@ use lagrange_core::{
 /// use lagrange_core::{links::Links, Mechanism, State};
 /// use lagrange_systems::RigidBody;
 /// // A 2 kg crate, 0.5 m by 0.3 m, turning at 1 rad/s.
-/// let crate_ = RigidBody::rectangle(2.0, 0.5, 0.3, 9.81)?;
+/// let crate_ = RigidBody::rectangle(2.0_f64, 0.5, 0.3, 9.81)?;
 /// let s = State::new(0.0, [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]);
 /// assert_eq!(crate_.acceleration(&s)?.as_slice(), &[0.0, -9.81, 0.0]);
 /// // Its corner (0.25, 0.15) moves at (-0.15, 0.25) m/s.
