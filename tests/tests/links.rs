@@ -4,9 +4,9 @@
 //! energy of the masses on the links equal to the mechanism's own at random states: the
 //! Jacobians are the velocities the mechanism's equations use. Both precisions.
 
-use lagrange_core::links::Links;
+use lagrange_core::links::{Links, Pose};
 use lagrange_core::nalgebra::SVector;
-use lagrange_core::{Error, Lagrangian, Real, State};
+use lagrange_core::{Error, Lagrangian, Real, Scalar, State};
 use lagrange_systems::{
     Acrobot, CartPole, DoublePendulum, NLinkPendulum, Ragdoll, RagdollBody, SimplePendulum,
     RAGDOLL_LINKS,
@@ -234,8 +234,84 @@ fn the_ragdoll_agrees<T: Real>() -> Result<(), Error> {
     Ok(())
 }
 
+/// A mechanism's poses alone, so that `Links::point` is the dual-number default.
+struct Poses<'a, L>(&'a L);
+
+impl<T: Real, L: Links<T, N>, const N: usize> Links<T, N> for Poses<'_, L> {
+    const LINKS: usize = L::LINKS;
+    fn pose<S: Scalar<Real = T> + 'static>(&self, q: &SVector<S, N>, link: usize) -> Pose<S> {
+        self.0.pose(q, link)
+    }
+}
+
+/// The largest difference of the hand-derived points of `l` from the dual-number default,
+/// over 100 random states and points on every link, relative to `1 + |q|`.
+fn hand_against_duals<T: Real, L: Links<T, N>, const N: usize>(l: &L, rng: &mut Rng) -> f64 {
+    let mut worst: f64 = 0.0;
+    for _ in 0..100 {
+        let q = random_state::<T, N>(rng, (-3.2, 3.2), (0.0, 0.0)).q;
+        let size = 1.0 + q.iter().map(|x| x.to_f64().abs()).sum::<f64>();
+        for link in 0..L::LINKS {
+            let local = [rng.uniform(-1.0, 1.0), rng.uniform(-1.0, 1.0)];
+            let (hand, auto) = (l.point(&q, link, local), Poses(l).point(&q, link, local));
+            for i in 0..2 {
+                worst = worst.max((hand.position[i] - auto.position[i]).to_f64().abs() / size);
+                for k in 0..N {
+                    let d = (hand.jacobian[(i, k)] - auto.jacobian[(i, k)])
+                        .to_f64()
+                        .abs();
+                    worst = worst.max(d / size);
+                }
+            }
+        }
+    }
+    worst
+}
+
+/// The chains' hand-derived points and Jacobians equal the dual-number default's, to 8 ulps of
+/// the sizes (the same sums in another order).
+fn hand_points_agree_with_duals<T: Real>() -> Result<(), Error> {
+    let mut rng = Rng::new(345);
+    let g = T::from_f64(G);
+    let (h, l) = (T::from_f64(0.7), T::from_f64(1.1));
+    let acrobot = Acrobot::new(
+        T::one(),
+        T::one(),
+        h,
+        l,
+        T::from_f64(0.35),
+        T::from_f64(0.55),
+        T::from_f64(0.1),
+        T::from_f64(0.1),
+        g,
+    )?;
+    let worst = [
+        hand_against_duals(
+            &SimplePendulum::new(T::one(), T::from_f64(0.8), g, T::zero())?,
+            &mut rng,
+        ),
+        hand_against_duals(&DoublePendulum::new(T::one(), T::one(), h, l, g)?, &mut rng),
+        hand_against_duals(
+            &NLinkPendulum::new([T::one(); 4], [0.4, 0.9, 0.6, 0.3].map(T::from_f64), g)?,
+            &mut rng,
+        ),
+        hand_against_duals(
+            &CartPole::new(T::one(), T::one(), T::from_f64(0.6), g)?,
+            &mut rng,
+        ),
+        hand_against_duals(&acrobot, &mut rng),
+    ];
+    println!("{}: {worst:?}", core::any::type_name::<T>());
+    assert!(
+        worst.iter().all(|&w| w <= 8.0 * T::EPSILON.to_f64()),
+        "{worst:?}"
+    );
+    Ok(())
+}
+
 for_f32_and_f64!(
     energies_agree,
     positions_follow_the_conventions,
-    the_ragdoll_agrees
+    the_ragdoll_agrees,
+    hand_points_agree_with_duals
 );
