@@ -968,7 +968,8 @@ fn by_hand(peak: ImpulseReport, r: ImpulseReport) -> ImpulseReport {
 }
 
 /// What a stepper tells of its steps. The block held on the incline by friction (`mu = 0.8`)
-/// at 120 Hz: every step's impulses are the ones that hold it, `m g cos(a) dt` along the
+/// at 120 Hz: every step's report is one row with friction, settled, no drift correction (it
+/// rests within the slop), and its impulses are the ones that hold it, `m g cos(a) dt` along the
 /// normal and `m g sin(a) dt` up the slope (to the rounding of the velocities, a few ulps of
 /// `g dt`); the peak report of a ball's bounces is the worst of every step's report, field by
 /// field; clearing it leaves the report of no step, and one step later it is that step's; the
@@ -986,6 +987,13 @@ fn reports_peaks_and_impulses<T: Real>() -> Result<(), Error> {
     let tolerance = pick::<T>(1e-8, 1e-16) * 8.0;
     for _ in 0..10 {
         s = block.step(&point, &s, T::from_f64(dt))?;
+        let r = block.last_report();
+        assert_eq!(
+            (r.rows, r.speculative, r.frictional, r.settled),
+            (1, 0, 1, true),
+            "{r:?}"
+        );
+        assert!(!r.corrected && r.drift_rounds == 0 && !r.held_back, "{r:?}");
         let (normal, tangent) = block.impulses();
         let (normal, tangent) = (normal[0].to_f64(), tangent[0].to_f64());
         assert!(
@@ -1260,11 +1268,11 @@ fn the_guard_allows_rounding_only<T: Real>() -> Result<(), Error> {
             [T::one(), T::zero()],
         );
         let end = stepper.step(&mechanism, &start, T::from_f64(1.0 / 120.0))?;
-        assert_eq!(
-            stepper.last_report().energy_guard,
-            guarded,
-            "{gain}: {end:?}"
-        );
+        let r = stepper.last_report();
+        assert_eq!(r.energy_guard, guarded, "{gain}: {end:?}");
+        // Lifted by the drift correction, which leaves nothing for more rounds (a floor's
+        // gap is linear).
+        assert!(r.corrected && r.drift_rounds == 0 && !r.held_back, "{r:?}");
         let lift = end.q[1].to_f64() + slop;
         assert!(lift.abs() <= 64.0 * eps * slop, "{gain}: {end:?}");
         let speed = end.qd[0].to_f64();
