@@ -1309,7 +1309,8 @@ impl<T: Real> Lagrangian<T, 2> for Massive {
 /// where eight are allowed, whatever the block's mass (1 g, 1 kg, 1 t: the sweeps' change is
 /// measured in speed, 0.014 m/s here, against the tolerance, not in impulse); capped at one,
 /// it stops after the first, not settled, and the next step, warm-started from that tangent
-/// impulse, settles in one.
+/// impulse, settles in one. A landing's step is settled only when both its plastic and its
+/// rebound's solves are.
 fn max_iterations_caps_the_rounds<T: Real>() -> Result<(), Error> {
     let settings = ImpulseSettings::new(T::from_f64(1e-4), 8)?
         .with_tolerance(T::from_f64(1e-7))?
@@ -1336,6 +1337,24 @@ fn max_iterations_caps_the_rounds<T: Real>() -> Result<(), Error> {
         block.step(&point, &s, dt)?;
         let r = block.last_report();
         assert_eq!((r.rounds, r.settled), (1, true), "cap {cap}: {r:?}");
+    }
+    // A landing that rebounds (e = 0.5, falling at 2 m/s onto the slope; it sticks, mu = 0.8):
+    // the plastic solve and then the rebound's, warm-started from it. Capped at one round,
+    // the plastic solve stops unsettled and the rebound's settles (the tangent impulse that
+    // stops the slide does not depend on the normal one): the step is not settled.
+    let bouncy =
+        ContactModel::new(T::HALF, T::from_f64(0.1), T::one())?.with_friction(T::from_f64(0.8))?;
+    let falling = State::new(T::zero(), [T::zero(); 2], [T::zero(), -T::TWO]);
+    for (cap, rounds, settled) in [(8, 3, true), (1, 2, false)] {
+        let settings = ImpulseSettings::new(T::from_f64(1e-4), cap)?;
+        let mut block = ImpulseStepper::new(SemiImplicitEuler, Incline, bouncy, settings);
+        block.step(&point, &falling, dt)?;
+        let r = block.last_report();
+        assert_eq!(
+            (r.rows, r.rounds, r.settled),
+            (1, rounds, settled),
+            "landing, cap {cap}: {r:?}"
+        );
     }
     for mass in [1e-3, 1e3] {
         let heavy = EulerLagrange::new(Massive { mass });
