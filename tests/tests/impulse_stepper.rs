@@ -1467,7 +1467,55 @@ fn the_sweeps_allow_the_rounding_of_the_speed<T: Real>() -> Result<(), Error> {
     Ok(())
 }
 
+/// The incline of [`Incline`] (row 0) and a wall at `x = X_WALL` (row 1, `x >= X_WALL`).
+#[derive(Clone, Copy)]
+struct InclineAndWall;
+
+/// Where the wall stands, m: 2 mm left of the point that falls onto the incline at `x = -1`.
+const X_WALL: f64 = -1.002;
+
+impl<T: Real> HolonomicConstraints<T, 2, 2> for InclineAndWall {
+    fn phi<S: Scalar<Real = T> + 'static>(&self, q: &SVector<S, 2>) -> SVector<S, 2> {
+        let (s, c) = (S::from_f64(ALPHA.sin()), S::from_f64(ALPHA.cos()));
+        SVector::from([q[1] * c - q[0] * s, q[0] - S::from_f64(X_WALL)])
+    }
+}
+
+/// A contact still open that the step's move would close joins the solve (speculative). The
+/// point falls at 2 m/s onto the incline at `x = -1`, 2 mm right of the wall; the plastic
+/// impulse turns it down the slope, a move of `dt` times 0.9 m/s to the left: 7.5 mm, past the
+/// wall. The wall's row joins with the speed that closes its 2 mm over the step, and the
+/// solve is done again: two rows, one speculative, two rounds (one each: no friction), and
+/// the step ends with neither row deeper than the slop.
+fn a_contact_the_move_would_close_joins<T: Real>() -> Result<(), Error> {
+    let point = EulerLagrange::new(Point);
+    let model = ContactModel::new(T::zero(), T::from_f64(0.1), T::one())?;
+    let slop = 1e-4;
+    let settings = ImpulseSettings::new(T::from_f64(slop), 8)?;
+    let mut stepper = ImpulseStepper::new(
+        SemiImplicitEuler,
+        Holonomic::new(InclineAndWall),
+        model,
+        settings,
+    );
+    let x0 = -1.0;
+    let start = State::new(
+        T::zero(),
+        [T::from_f64(x0), T::from_f64(x0 * ALPHA.tan())],
+        [T::zero(), -T::TWO],
+    );
+    let end = stepper.step(&point, &start, T::from_f64(1.0 / 120.0))?;
+    let r = stepper.last_report();
+    assert_eq!((r.rows, r.speculative, r.rounds), (2, 1, 2), "{r:?}");
+    let gaps = Holonomic::new(InclineAndWall).position_residual(&end.q);
+    for g in gaps.iter() {
+        assert!(g.to_f64() >= -slop * (1.0 + 1.0 / 1024.0), "{gaps:?}");
+    }
+    Ok(())
+}
+
 for_f32_and_f64!(
+    a_contact_the_move_would_close_joins,
     the_sweeps_allow_the_rounding_of_the_speed,
     a_cycling_solve_still_pushes_apart,
     max_iterations_caps_the_rounds,
