@@ -1514,7 +1514,76 @@ fn a_contact_the_move_would_close_joins<T: Real>() -> Result<(), Error> {
     Ok(())
 }
 
+/// A unit point mass in the plane with no forces: a drift correction costs it no energy.
+struct Drifting;
+
+impl<T: Real> Lagrangian<T, 2> for Drifting {
+    fn kinetic<S: Scalar<Real = T>>(&self, _: S, _: &SVector<S, 2>, qd: &SVector<S, 2>) -> S {
+        (qd[0] * qd[0] + qd[1] * qd[1]) * S::from_f64(0.5)
+    }
+    fn potential<S: Scalar<Real = T>>(&self, _: S, _: &SVector<S, 2>) -> S {
+        S::zero()
+    }
+}
+
+/// A contact the drift correction would take below the slop joins it. The point with no
+/// forces, at rest 1 cm inside the incline, 2 mm right of the wall: the correction moves it
+/// out along the incline's normal, 5 mm to the left, past the wall, so the wall's row joins
+/// and both end at the slop (to 2^-10 of it), neither left deeper nor the move held back.
+/// And a bilateral row is corrected onto zero from either side: the ball held to the ground
+/// from 1 cm above it ends on it (to 1e-12 m in f64, 1e-6 m in f32).
+fn the_drift_correction_takes_in_what_it_closes<T: Real>() -> Result<(), Error> {
+    let slop = 1e-4;
+    let model = ContactModel::new(T::zero(), T::from_f64(0.1), T::one())?;
+    let settings = ImpulseSettings::new(T::from_f64(slop), 8)?;
+    let mut stepper = ImpulseStepper::new(
+        SemiImplicitEuler,
+        Holonomic::new(InclineAndWall),
+        model,
+        settings,
+    );
+    // Where the incline's normal through the point meets the surface: 3 mm past the wall.
+    let x_surface = X_WALL + 0.002 - 0.01 * ALPHA.sin();
+    let inside = [
+        x_surface + 0.01 * ALPHA.sin(),
+        x_surface * ALPHA.tan() - 0.01 * ALPHA.cos(),
+    ];
+    let start = State::at_rest(inside.map(T::from_f64));
+    let contacts = Holonomic::new(InclineAndWall);
+    let before = contacts.position_residual(&start.q);
+    assert!((before[0].to_f64() + 0.01).abs() < 1e-6 && before[1].to_f64() > 0.0);
+    let end = stepper.step(
+        &EulerLagrange::new(Drifting),
+        &start,
+        T::from_f64(1.0 / 120.0),
+    )?;
+    let r = stepper.last_report();
+    assert!(r.corrected && !r.held_back, "{r:?}");
+    let gaps = contacts.position_residual(&end.q);
+    for g in gaps.iter() {
+        let g = g.to_f64();
+        assert!(g >= -slop * (1.0 + 1.0 / 1024.0) && g <= 1e-6, "{gaps:?}");
+    }
+
+    let ball = FallingParticle::new(T::one(), T::from_f64(G))?;
+    let mut held = ImpulseStepper::new(
+        SemiImplicitEuler,
+        Holonomic::new(Ground),
+        model,
+        ImpulseSettings::new(T::from_f64(1e-3), 8)?,
+    )
+    .with_bilateral([true]);
+    let end = held.step(
+        &ball,
+        &State::at_rest([T::from_f64(0.01)]),
+        T::from_f64(1.0 / 120.0),
+    )?;
+    assert!(end.q[0].to_f64().abs() <= pick::<T>(1e-6, 1e-12), "{end:?}");
+    Ok(())
+}
+
 for_f32_and_f64!(
+    the_drift_correction_takes_in_what_it_closes,
     a_contact_the_move_would_close_joins,
     the_sweeps_allow_the_rounding_of_the_speed,
     a_cycling_solve_still_pushes_apart,
