@@ -87,16 +87,8 @@ impl<T: Real> RigidBody<T> {
                 ("height", height, 2),
             ],
         )?;
-        Self::new(mass, inertia, gravity).map_err(|e| match e {
-            Error::InvalidParameter {
-                name: "inertia",
-                reason,
-            } => Error::InvalidParameter {
-                name: if width >= height { "width" } else { "height" },
-                reason,
-            },
-            e => e,
-        })
+        Self::new(mass, inertia, gravity)
+            .map_err(|e| blame_inertia(e, if width >= height { "width" } else { "height" }))
     }
 
     /// A uniform disk (a ball, a wheel) of `mass` and `radius` (m, > 0): `I = m r^2 / 2`.
@@ -111,16 +103,7 @@ impl<T: Real> RigidBody<T> {
             mass * radius * radius * T::HALF,
             &[("mass", mass, 1), ("radius", radius, 2)],
         )?;
-        Self::new(mass, inertia, gravity).map_err(|e| match e {
-            Error::InvalidParameter {
-                name: "inertia",
-                reason,
-            } => Error::InvalidParameter {
-                name: "radius",
-                reason,
-            },
-            e => e,
-        })
+        Self::new(mass, inertia, gravity).map_err(|e| blame_inertia(e, "radius"))
     }
 
     /// Mass, kg.
@@ -137,6 +120,17 @@ impl<T: Real> RigidBody<T> {
     #[must_use]
     pub fn gravity(&self) -> T {
         self.gravity
+    }
+}
+
+/// `e`, with an inertia refused named as the dimension `name` that gave it.
+fn blame_inertia(e: Error, name: &'static str) -> Error {
+    match e {
+        Error::InvalidParameter {
+            name: "inertia",
+            reason,
+        } => Error::InvalidParameter { name, reason },
+        e => e,
     }
 }
 
