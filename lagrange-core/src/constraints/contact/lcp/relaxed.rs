@@ -41,7 +41,11 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
             let (lo, hi) = kinds[i].bounds();
             self.candidate[i] && lambda[i] != T::zero() && lambda[i] > lo && lambda[i] < hi
         });
-        Complementary { lambda, active }
+        Complementary {
+            lambda,
+            active,
+            passes: sweeps,
+        }
     }
 }
 
