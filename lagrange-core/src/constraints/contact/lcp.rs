@@ -272,12 +272,17 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
     /// the ray that leaves `W lambda` unchanged, as far as the first bound: the row that
     /// reaches it is held there (the program falls along the ray at the rate of the row's
     /// pull). Where no bound ends the ray (held rows, with no bounds, that disagree), the
-    /// row is left out.
+    /// row is left out. A row whose part independent of the rows solved for is too small
+    /// for the pivot test to tell (below `EPSILON^(1/4)` of its size) and that pulls by no
+    /// more than that share of its terms is left at its bound: the conditions hold to that
+    /// share on such near-dependent sets.
     ///
     /// # Errors
     /// [`Error::InvalidParameter`] `bound` for a bounded row's bound that is negative or not
     /// finite; [`Error::RedundantConstraints`] when bilateral rows depend on each other;
-    /// [`Error::NoConvergence`] after `4 C + 4` passes (a degenerate set that cycles);
+    /// [`Error::NoConvergence`] where no multipliers meet the conditions (a contact whose
+    /// ray no bound ends: the program falls without end, as for two opposed rows that both
+    /// approach), or after `4 C + 4` passes (a degenerate set that cycles);
     /// [`Error::NonFiniteState`] for non-finite multipliers.
     pub fn complementary(
         &mut self,
@@ -340,8 +345,9 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
         let mut kept = 0;
         let mut blocked = [false; C];
         let mut lambda = SVector::<T, C>::zeros();
-        // The row that joined last, and the way it moves off its bound.
-        let mut joined: Option<(usize, T)> = None;
+        // The row that joined last, the way it moves off its bound, and whether its pull was
+        // beyond what a dependence the pivot test cannot tell from near-dependence explains.
+        let mut joined: Option<(usize, T, bool)> = None;
         let passes = 4 * C + 4;
         for pass in 1..=passes {
             // The rows held at a bound push on the rows solved for.
@@ -358,25 +364,39 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
                 // it off its bound and them so that W lambda is unchanged, the program falls
                 // at the rate of its pull; as far as the first bound, where that row is held.
                 Err(Error::RedundantConstraints { row })
-                    if joined.is_some_and(|(j, _)| j == row) =>
+                    if joined.is_some_and(|(j, _, _)| j == row) =>
                 {
                     let row = within::<C>(row);
-                    let way = joined.map_or(T::zero(), |(_, w)| w);
+                    let (way, pulls) = joined.map_or((T::zero(), false), |(_, w, p)| (w, p));
                     joined = None;
-                    match self.ray(
-                        &mut order,
-                        &mut n,
-                        &mut free,
-                        &mut lambda,
-                        &bounds,
-                        row,
-                        way,
-                    )? {
+                    let ray = if pulls {
+                        self.ray(
+                            &mut order,
+                            &mut n,
+                            &mut free,
+                            &mut lambda,
+                            &bounds,
+                            row,
+                            way,
+                        )?
+                    } else {
+                        None
+                    };
+                    match ray {
                         Some(at) => {
                             kept = at;
                             blocked = [false; C];
                         }
-                        // No bound ends the ray: the row is left out at its bound.
+                        // No bound ends the ray of a contact that pulls beyond rounding: the
+                        // program falls along it without end, and no multipliers meet the
+                        // conditions (two opposed rows that both approach). The caller's
+                        // fallback, at once rather than after the passes' cap.
+                        None if pulls && kinds[row] == Row::Unilateral => {
+                            return Err(Error::NoConvergence {
+                                iterations: u32::try_from(pass).unwrap_or(u32::MAX),
+                            });
+                        }
+                        // Else the row is left out at its bound.
                         None => {
                             kept = remove(&mut order, &mut n, row);
                             free[row] = false;
@@ -433,7 +453,7 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
             }
             // Every multiplier within its bounds: the held row whose a would lower the
             // program most by moving off its bound is solved for.
-            let mut join: Option<(usize, T)> = None;
+            let mut join: Option<(usize, T, T)> = None;
             for i in listed.clone().filter(|&i| !free[i] && !blocked[i]) {
                 let (lo, hi) = bounds[i];
                 if lo == hi {
@@ -458,13 +478,13 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
                     a.abs()
                 };
                 if pull > T::from_f64(64.0) * T::EPSILON * size
-                    && join.is_none_or(|(_, most)| pull > most)
+                    && join.is_none_or(|(_, most, _)| pull > most)
                 {
-                    join = Some((i, pull));
+                    join = Some((i, pull, size));
                 }
             }
             match join {
-                Some((row, _)) if n < C => {
+                Some((row, pull, size)) if n < C => {
                     let row = within::<C>(row);
                     free[row] = true;
                     order[within::<C>(n)] = row;
@@ -480,7 +500,13 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
                     } else {
                         T::one()
                     };
-                    joined = Some((row, way));
+                    // The pivot test takes a row whose part independent of the rows solved
+                    // for is below EPSILON^(1/4) of its size for dependent; a pull within that
+                    // share of its terms is what such a part can leave, not a pull to follow
+                    // along a ray (which assumes W lambda unchanged, and moved by 1 / that
+                    // part, cycled: the next solve left the row out again at zero).
+                    let beyond = pull > T::EPSILON.sqrt().sqrt() * size;
+                    joined = Some((row, way, beyond));
                 }
                 None if lambda.iter().all(|x| x.is_finite()) => {
                     return Ok(Complementary {
@@ -969,7 +995,49 @@ mod tests {
             let s = d.complementary_from(&b, &kinds, &guess)?;
             let exact = SVector::<f64, 3>::new(2.0, 1.0, 0.0);
             assert!((s.lambda - exact).amax() < 1e-15, "{guess:?}: {s:?}");
-            assert_eq!((s.active, s.passes), ([true, true, false], passes), "{guess:?}");
+            assert_eq!(
+                (s.active, s.passes),
+                ([true, true, false], passes),
+                "{guess:?}"
+            );
+        }
+        Ok(())
+    }
+
+    /// Near-dependent rows: three contacts nearly parallel, one unit mass pressed onto them
+    /// (a body resting on three points of one line: `J` rows `(1, 0)` each turned by a few
+    /// micro-radians, `b = -0.4` each), and two nearly opposed rows beside a third. The pivot
+    /// test takes such a row for dependent, but its part independent of the others is not
+    /// zero, so a ray along which `W lambda` is unchanged is not one: followed, it moved the
+    /// multipliers by the inverse of that part, the next solve left the row out again at
+    /// zero, and the method cycled to its cap (`NoConvergence` after 16 passes). Now a pull
+    /// within `EPSILON^(1/4)` of the row's terms leaves it at its bound: the method ends,
+    /// and the conditions hold to that share of the terms.
+    #[test]
+    fn near_dependent_rows_do_not_cycle() -> Result<(), Error> {
+        let sets = [
+            (
+                SMatrix::<f64, 3, 2>::new(1.000003, 8e-6, 0.999994, -2e-6, 0.999994, 3e-6),
+                SVector::<f64, 3>::new(-0.4, -0.4, -0.4),
+            ),
+            (
+                SMatrix::<f64, 3, 2>::new(-1.000009, 4e-6, 0.999994, -2e-6, -0.999993, 0.999994),
+                SVector::<f64, 3>::new(0.8, -0.8, -2.0),
+            ),
+        ];
+        for (j, b) in sets {
+            let mut d = Delassus::new(&j, |_| Ok(()), &[true; 3])?;
+            let kinds = [Row::Unilateral; 3];
+            let s = d.complementary_from(&b, &kinds, &[false; 3])?;
+            let a = d.w * s.lambda + b;
+            for i in 0..3 {
+                let terms = (0..3).fold(b[i].abs(), |t, k| t + (d.w[(i, k)] * s.lambda[k]).abs());
+                let tol = f64::EPSILON.sqrt().sqrt() * terms;
+                assert!(
+                    holds(kinds[i], s.lambda[i], a[i], tol),
+                    "row {i}: {s:?}, a {a}"
+                );
+            }
         }
         Ok(())
     }
