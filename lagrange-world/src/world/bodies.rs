@@ -1,6 +1,9 @@
 //! A [`World`](super::World)'s bodies and the shapes on them.
 
 use crate::shape::Shape;
+use crate::vec2::{add, Vec2};
+use lagrange_core::links::{Links, Pose};
+use lagrange_core::nalgebra::SVector;
 use lagrange_core::{Error, Mechanism, Real, State};
 
 /// An instance of the world's mechanism: its state and whether it sleeps.
@@ -9,6 +12,8 @@ pub(crate) struct Body<T: Real, M, const N: usize> {
     pub(crate) key: u32,
     pub(crate) mechanism: M,
     pub(crate) state: State<T, N>,
+    /// Where its mechanism's origin is in the world (a pendulum's pivot).
+    pub(crate) origin: Vec2<T>,
     pub(crate) asleep: bool,
     /// How long it has moved slower than the sleep speed, s.
     pub(crate) still: T,
@@ -17,12 +22,13 @@ pub(crate) struct Body<T: Real, M, const N: usize> {
 }
 
 impl<T: Real, M: Mechanism<T, N>, const N: usize> Body<T, M, N> {
-    /// Awake, never still.
-    pub(crate) fn new(key: u32, mechanism: M, state: State<T, N>) -> Self {
+    /// Awake, never still, its mechanism's origin at `origin`.
+    pub(crate) fn new(key: u32, mechanism: M, state: State<T, N>, origin: Vec2<T>) -> Self {
         Self {
             key,
             mechanism,
             state,
+            origin,
             asleep: false,
             still: T::zero(),
             island: key,
@@ -34,6 +40,18 @@ impl<T: Real, M: Mechanism<T, N>, const N: usize> Body<T, M, N> {
         let a = self.mechanism.acceleration(&self.state)?;
         self.state.qd += a * dt;
         self.state.check_finite()
+    }
+
+    /// Link `link`'s pose in the world at coordinates `q`.
+    pub(crate) fn pose(&self, q: &SVector<T, N>, link: usize) -> Pose<T>
+    where
+        M: Links<T, N>,
+    {
+        let pose = self.mechanism.pose(q, link);
+        Pose {
+            origin: add(pose.origin, self.origin),
+            ..pose
+        }
     }
 
     /// Awake, its time at rest started again.

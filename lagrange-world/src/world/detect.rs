@@ -150,10 +150,8 @@ where
         if body.asleep {
             return T::zero();
         }
-        let now = body.mechanism.pose(&body.state.q, link);
-        let next = body
-            .mechanism
-            .pose(&(body.state.q + body.state.qd * dt), link);
+        let now = body.pose(&body.state.q, link);
+        let next = body.pose(&(body.state.q + body.state.qd * dt), link);
         let extent = s
             .shape
             .vertices()
@@ -183,7 +181,7 @@ where
             else {
                 continue;
             };
-            let pose = body.mechanism.pose(&body.state.q, link);
+            let pose = body.pose(&body.state.q, link);
             let (sin, cos) = pose.angle.sin_cos();
             let local = rotate(sub(p.point, pose.origin), (-sin, cos));
             let j = body.mechanism.point(&body.state.q, link, local).jacobian;

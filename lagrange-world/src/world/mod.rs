@@ -191,18 +191,40 @@ where
         &self.settings
     }
 
-    /// A body: `mechanism` at `state`, known by `key`, awake.
+    /// A body: `mechanism` at `state`, known by `key`, awake, its links where the
+    /// mechanism puts them.
     ///
     /// # Errors
     /// [`Error::InvalidParameter`] `key` when taken, `capacity` when `B` bodies are there;
     /// [`Error::NonFiniteState`] for a state that is not finite.
     pub fn add_body(&mut self, key: u32, mechanism: M, state: State<T, N>) -> Result<(), Error> {
+        self.add_body_at(key, mechanism, state, [T::zero(); 2])
+    }
+
+    /// As [`World::add_body`], the mechanism's origin moved to `origin` (a pendulum whose
+    /// pivot is there: the five of a Newton's cradle).
+    ///
+    /// # Errors
+    /// As [`World::add_body`], and `origin` when not finite.
+    pub fn add_body_at(
+        &mut self,
+        key: u32,
+        mechanism: M,
+        state: State<T, N>,
+        origin: Vec2<T>,
+    ) -> Result<(), Error> {
         state.check_finite()?;
+        if !origin.iter().all(|x| x.is_finite()) {
+            return Err(Error::InvalidParameter {
+                name: "origin",
+                reason: "must be finite",
+            });
+        }
         if self.body(key).is_some() {
             return Err(taken());
         }
         self.bodies
-            .push(Body::new(key, mechanism, state))
+            .push(Body::new(key, mechanism, state, origin))
             .map_err(|_| full())
     }
 
@@ -632,7 +654,7 @@ where
     /// Shape `s` where its body's link is now (a static shape where it is).
     fn placed(&self, s: &Attached<T>) -> Shape<T> {
         match s.on.and_then(|(i, link)| Some((self.bodies.get(i)?, link))) {
-            Some((body, link)) => s.shape.placed(&body.mechanism.pose(&body.state.q, link)),
+            Some((body, link)) => s.shape.placed(&body.pose(&body.state.q, link)),
             None => s.shape,
         }
     }
