@@ -64,4 +64,7 @@ pub use query::RayHit;
 pub use shape::{Shape, MAX_VERTICES};
 pub use shape_pairs::{OnLink, ShapePairs};
 pub use vec2::Vec2;
-pub use world::{ContactEvent, World, WorldHit, WorldReport, WorldSettings, MAX_PLANES};
+pub use world::{
+    ContactEvent, CoordinateLimits, Limits, NoLimits, World, WorldHit, WorldReport, WorldSettings,
+    MAX_OWN_ROWS, MAX_PLANES,
+};

@@ -819,7 +819,7 @@ const AREAS: [Area; 29] = [
             "lagrange-world/src/world/solve.rs",
         ],
         only: None,
-        tests: &["--test", "world"],
+        tests: &["--test", "world", "--test", "world_pile"],
         unit_tests: true,
         optimised: false,
     },

@@ -8,9 +8,11 @@ use lagrange_core::{Error, Mechanism, Real, State};
 
 /// An instance of the world's mechanism: its state and whether it sleeps.
 #[derive(Debug, Clone, Copy)]
-pub(crate) struct Body<T: Real, M, const N: usize> {
+pub(crate) struct Body<T: Real, M, L, const N: usize> {
     pub(crate) key: u32,
     pub(crate) mechanism: M,
+    /// Its own rows (joint limits).
+    pub(crate) limits: L,
     pub(crate) state: State<T, N>,
     /// Where its mechanism's origin is in the world (a pendulum's pivot).
     pub(crate) origin: Vec2<T>,
@@ -21,12 +23,19 @@ pub(crate) struct Body<T: Real, M, const N: usize> {
     pub(crate) island: u32,
 }
 
-impl<T: Real, M: Mechanism<T, N>, const N: usize> Body<T, M, N> {
+impl<T: Real, M: Mechanism<T, N>, L, const N: usize> Body<T, M, L, N> {
     /// Awake, never still, its mechanism's origin at `origin`.
-    pub(crate) fn new(key: u32, mechanism: M, state: State<T, N>, origin: Vec2<T>) -> Self {
+    pub(crate) fn new(
+        key: u32,
+        mechanism: M,
+        limits: L,
+        state: State<T, N>,
+        origin: Vec2<T>,
+    ) -> Self {
         Self {
             key,
             mechanism,
+            limits,
             state,
             origin,
             asleep: false,

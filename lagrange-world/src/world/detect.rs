@@ -2,15 +2,16 @@
 //! rows in the bodies' coordinates; sleeping bodies an awake one touches are woken.
 
 use super::bodies::Attached;
+use super::limits::{Limits, MAX_OWN_ROWS};
 use super::rows::{Contact, Row};
-use super::World;
+use super::{World, OWN_ROWS};
 use crate::broad::Proxy;
 use crate::collide::{collide, collide_half_plane};
 use crate::manifold::ContactPoint;
 use crate::vec2::{length, rotate, sub, Vec2};
 use heapless::Vec;
 use lagrange_core::links::Links;
-use lagrange_core::nalgebra::SVector;
+use lagrange_core::nalgebra::{SMatrix, SVector};
 use lagrange_core::{Error, Mechanism, Real};
 
 /// One side of a contact: a shape's key and the body and link it is on (none: static).
@@ -20,10 +21,12 @@ struct Side {
     on: Option<(usize, usize)>,
 }
 
-impl<T, M, const N: usize, const B: usize, const S: usize, const K: usize> World<T, M, N, B, S, K>
+impl<T, M, L, const N: usize, const B: usize, const S: usize, const K: usize>
+    World<T, M, N, B, S, K, L>
 where
     T: Real,
     M: Mechanism<T, N> + Links<T, N> + Clone,
+    L: Limits<T, N>,
 {
     /// The step's contacts, sorted by key, warm-started from the last step's impulses; the
     /// number of bodies woken.
@@ -113,7 +116,84 @@ where
                 }
             }
         }
+        for i in 0..self.bodies.len() {
+            self.own_rows(i, dt)?;
+        }
         Ok(woken)
+    }
+
+    /// The rows of awake body `i`'s own (its limits), as contacts with nothing on their
+    /// other side (no friction), their mobilities from one call of the mass solve.
+    fn own_rows(&mut self, i: usize, dt: T) -> Result<(), Error> {
+        let Some(body) = self.bodies.get(i).filter(|b| !b.asleep) else {
+            return Ok(());
+        };
+        let mut rows: Vec<(u32, T), MAX_OWN_ROWS> = Vec::new();
+        let mut jacobians = SMatrix::<T, N, MAX_OWN_ROWS>::zeros();
+        let mut full = false;
+        body.limits.rows(&body.state.q, |row, gap, j| {
+            let k = rows.len();
+            full |= rows.push((row, gap)).is_err();
+            if k < MAX_OWN_ROWS {
+                jacobians.set_column(k, &j);
+            }
+        });
+        if full {
+            return Err(Error::InvalidParameter {
+                name: "limits",
+                reason: "a body has more own rows than MAX_OWN_ROWS",
+            });
+        }
+        let mut mobilities = jacobians;
+        body.mechanism
+            .velocity_jumps(&body.state, &mut mobilities)?;
+        let zero = SVector::<T, N>::zeros();
+        let key = body.key;
+        let mut found: Vec<Contact<T, N>, MAX_OWN_ROWS> = Vec::new();
+        for (k, &(row, gap)) in rows.iter().enumerate() {
+            let (j, b) = (
+                jacobians.column(k).into_owned(),
+                mobilities.column(k).into_owned(),
+            );
+            let approach = j.dot(&body.state.qd);
+            let _ = found.push(Contact {
+                key: (OWN_ROWS, key, row),
+                bodies: [Some(i), None],
+                normal: Row::new([j, zero], [b, zero]),
+                tangent: Row::new([zero; 2], [zero; 2]),
+                gap,
+                lower: self.lowest(gap, approach, dt),
+                approach,
+                drift: T::zero(),
+                reach: T::zero(),
+                point: [T::zero(); 2],
+                direction: [T::zero(); 2],
+            });
+        }
+        for c in found {
+            self.contacts.push(c).map_err(|_| capacity())?;
+        }
+        Ok(())
+    }
+
+    /// The lowest speed of a row of gap `gap` closing at `-approach` (see `Contact::lower`).
+    fn lowest(&self, gap: T, approach: T, dt: T) -> T {
+        let model = self.settings.model;
+        // Open: it may close in the step, no more; touching: it may not close further.
+        let lower = if gap > T::zero() {
+            -gap / dt
+        } else {
+            T::zero()
+        };
+        // Striking (closing in the step, and fast enough to leave at the rest speed or
+        // more): Newton's rebound. Slower, it rests: a body on the floor gains g dt a step,
+        // which must not bounce it.
+        let rebound = -model.restitution() * approach;
+        if rebound >= model.rest_speed() && gap + approach * dt <= T::zero() {
+            lower.max(rebound)
+        } else {
+            lower
+        }
     }
 
     /// Wakes the island body `i` fell asleep with, each body with its free step: how many.
@@ -198,21 +278,8 @@ where
                 *y = body.mechanism.velocity_jump(&body.state, &tangent)?;
             }
         }
-        let model = self.settings.model;
         let gap = p.gap;
-        // Open: it may close in the step, no more; touching: it may not close further.
-        let mut lower = if gap > T::zero() {
-            -gap / dt
-        } else {
-            T::zero()
-        };
-        // Striking (closing in the step, and fast enough to leave at the rest speed or
-        // more): Newton's rebound. Slower, it rests: a body on the floor gains g dt a step,
-        // which must not bounce it.
-        let rebound = -model.restitution() * approach;
-        if rebound >= model.rest_speed() && gap + approach * dt <= T::zero() {
-            lower = lower.max(rebound);
-        }
+        let lower = self.lowest(gap, approach, dt);
         self.contacts
             .push(Contact {
                 key: (a.key, b.key, p.id),
@@ -223,13 +290,19 @@ where
                 lower,
                 approach,
                 drift: T::zero(),
+                reach: T::zero(),
                 point: p.point,
                 direction: n,
             })
-            .map_err(|_| Error::InvalidParameter {
-                name: "capacity",
-                reason: "more contact points than K",
-            })
+            .map_err(|_| capacity())
+    }
+}
+
+/// More contact points than the world holds.
+fn capacity() -> Error {
+    Error::InvalidParameter {
+        name: "capacity",
+        reason: "more contact points than K",
     }
 }
 

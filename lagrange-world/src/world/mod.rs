@@ -4,10 +4,12 @@
 mod bodies;
 mod detect;
 mod islands;
+mod limits;
 mod rows;
 mod settings;
 mod solve;
 
+pub use limits::{CoordinateLimits, Limits, NoLimits, MAX_OWN_ROWS};
 pub use settings::WorldSettings;
 
 use crate::broad::BroadPhase;
@@ -22,6 +24,17 @@ use lagrange_core::links::Links;
 use lagrange_core::nalgebra::SVector;
 use lagrange_core::{Error, Mechanism, Real, State};
 use rows::{Contact, Kept};
+
+/// The first key of a body's own rows' contacts, `(OWN_ROWS, body, row)`: a key no shape
+/// or half-plane may take.
+pub(crate) const OWN_ROWS: u32 = u32::MAX;
+
+/// The sweeps over the bodies' own rows alone after each solve, per sweep of the settings: a
+/// body's rows are coupled through its mass matrix (a ragdoll's hand and torso differ 20
+/// times in mass), and they are few and cheap (one dot product of `N` a row). Measured on
+/// ten ragdolls thrown into a pile at 60 Hz, 8 sweeps: limits passed by 0.038 rad at worst
+/// with one, 0.0051 with four (the slop is 0.005).
+const OWN_SWEEPS: u32 = 4;
 
 /// Static half-planes a world holds at most (floors and walls).
 pub const MAX_PLANES: usize = 8;
@@ -96,8 +109,9 @@ pub struct WorldHit<T> {
 ///               -e J v* for a contact that strikes (and would leave at the rest speed
 ///               or faster)
 /// 4. move       q+ = q + dt v+                                v+ the solved velocities
-/// 5. drift      q+ += dt p, pseudo-velocities p that bring every contact deeper than the
-///               slop back to it (split impulses: the velocities are untouched)
+/// 5. drift      q+ += dt p, pseudo-velocities p that bring every row the move leaves
+///               deeper than the slop back to it, and close no other past it (split
+///               impulses: the velocities are untouched)
 /// 6. sleep      islands (bodies joined by contacts) at rest for the set time fall asleep
 /// ```
 ///
@@ -145,8 +159,16 @@ pub struct WorldHit<T> {
 /// # Ok::<(), lagrange_core::Error>(())
 /// ```
 #[derive(Debug, Clone)]
-pub struct World<T: Real, M, const N: usize, const B: usize, const S: usize, const K: usize> {
-    bodies: Vec<Body<T, M, N>, B>,
+pub struct World<
+    T: Real,
+    M,
+    const N: usize,
+    const B: usize,
+    const S: usize,
+    const K: usize,
+    L = NoLimits,
+> {
+    bodies: Vec<Body<T, M, L, N>, B>,
     /// Sorted by key.
     shapes: Vec<Attached<T>, S>,
     /// Sorted by key.
@@ -163,10 +185,12 @@ pub struct World<T: Real, M, const N: usize, const B: usize, const S: usize, con
     report: WorldReport,
 }
 
-impl<T, M, const N: usize, const B: usize, const S: usize, const K: usize> World<T, M, N, B, S, K>
+impl<T, M, L, const N: usize, const B: usize, const S: usize, const K: usize>
+    World<T, M, N, B, S, K, L>
 where
     T: Real,
     M: Mechanism<T, N> + Links<T, N> + Clone,
+    L: Limits<T, N>,
 {
     /// No bodies, shapes or planes.
     #[must_use]
@@ -192,13 +216,16 @@ where
     }
 
     /// A body: `mechanism` at `state`, known by `key`, awake, its links where the
-    /// mechanism puts them.
+    /// mechanism puts them, with the world's default limits (none, for [`NoLimits`]).
     ///
     /// # Errors
     /// [`Error::InvalidParameter`] `key` when taken, `capacity` when `B` bodies are there;
     /// [`Error::NonFiniteState`] for a state that is not finite.
-    pub fn add_body(&mut self, key: u32, mechanism: M, state: State<T, N>) -> Result<(), Error> {
-        self.add_body_at(key, mechanism, state, [T::zero(); 2])
+    pub fn add_body(&mut self, key: u32, mechanism: M, state: State<T, N>) -> Result<(), Error>
+    where
+        L: Default,
+    {
+        self.add_body_with(key, mechanism, L::default(), state, [T::zero(); 2])
     }
 
     /// As [`World::add_body`], the mechanism's origin moved to `origin` (a pendulum whose
@@ -210,6 +237,25 @@ where
         &mut self,
         key: u32,
         mechanism: M,
+        state: State<T, N>,
+        origin: Vec2<T>,
+    ) -> Result<(), Error>
+    where
+        L: Default,
+    {
+        self.add_body_with(key, mechanism, L::default(), state, origin)
+    }
+
+    /// A body with its own rows `limits` (a ragdoll's joint limits), its mechanism's origin
+    /// at `origin`.
+    ///
+    /// # Errors
+    /// As [`World::add_body_at`].
+    pub fn add_body_with(
+        &mut self,
+        key: u32,
+        mechanism: M,
+        limits: L,
         state: State<T, N>,
         origin: Vec2<T>,
     ) -> Result<(), Error> {
@@ -224,7 +270,7 @@ where
             return Err(taken());
         }
         self.bodies
-            .push(Body::new(key, mechanism, state, origin))
+            .push(Body::new(key, mechanism, limits, state, origin))
             .map_err(|_| full())
     }
 
@@ -232,7 +278,8 @@ where
     /// collision group 1 colliding with every group.
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] `key` when taken (by a shape or a half-plane), `body` when
+    /// [`Error::InvalidParameter`] `key` when taken (by a shape or a half-plane; `u32::MAX`
+    /// is the world's own), `body` when
     /// no body has that key, `link` when the mechanism has no such link, `capacity` when `S`
     /// shapes are there.
     pub fn add_shape(
@@ -410,7 +457,7 @@ where
                 reason: "must be positive and finite",
             });
         }
-        let saved: Vec<Body<T, M, N>, B> = self.bodies.clone();
+        let saved: Vec<Body<T, M, L, N>, B> = self.bodies.clone();
         let kept = self.kept.clone();
         let result = self.advance(dt);
         if result.is_err() {
@@ -439,13 +486,21 @@ where
         report.woke = self.detect(dt)?;
         report.guarded = self.solve();
         let mut pseudo = [SVector::<T, N>::zeros(); B];
+        let velocities: [SVector<T, N>; B] =
+            core::array::from_fn(|i| self.bodies.get(i).map_or(SVector::zeros(), |b| b.state.qd));
         solve::drift(
             &mut pseudo,
+            &velocities,
             &mut self.contacts,
             self.settings.slop,
             dt,
             self.settings.sweeps,
         );
+        // The bodies' own rows have the last word here too.
+        let own = self.contacts.partition_point(|c| c.key.0 != OWN_ROWS);
+        if let Some(rows) = self.contacts.get_mut(own..) {
+            solve::pseudo(&mut pseudo, rows, OWN_SWEEPS * self.settings.sweeps);
+        }
         for (body, p) in self
             .bodies
             .iter_mut()
@@ -465,16 +520,15 @@ where
         Ok(report)
     }
 
-    /// Steps 3 of the scheme: the impulses, into the awake bodies' velocities. Whether the
+    /// Step 3 of the scheme: the impulses, into the awake bodies' velocities. Whether the
     /// guard solved again (see [`WorldReport::guarded`]).
     fn solve(&mut self) -> bool {
-        let free: [SVector<T, N>; B] =
-            core::array::from_fn(|i| self.bodies.get(i).map_or(SVector::zeros(), |b| b.state.qd));
+        let free = self.velocities();
         let before = self.kinetic(&free);
         let mut v = free;
         solve::warm_start(&mut v, &self.contacts);
         let (friction, sweeps) = (self.settings.model.friction(), self.settings.sweeps);
-        solve::velocities(&mut v, &mut self.contacts, friction, sweeps);
+        sweep(&mut v, &mut self.contacts, friction, sweeps);
         let after = self.kinetic(&v);
         // 16 ulps of the energies: the rounding of sums of a few products.
         let rounding = T::from_f64(16.0) * T::EPSILON * (before.abs() + after.abs());
@@ -486,12 +540,22 @@ where
                 c.tangent.lambda = T::zero();
                 c.lower = c.lower.min(T::zero());
             }
-            solve::velocities(&mut v, &mut self.contacts, friction, sweeps);
+            sweep(&mut v, &mut self.contacts, friction, sweeps);
         }
-        for (body, v) in self.bodies.iter_mut().zip(&v).filter(|(b, _)| !b.asleep) {
+        self.set_velocities(&v);
+        guarded
+    }
+
+    /// The bodies' velocities by index (zero past the last).
+    fn velocities(&self) -> [SVector<T, N>; B] {
+        core::array::from_fn(|i| self.bodies.get(i).map_or(SVector::zeros(), |b| b.state.qd))
+    }
+
+    /// The awake bodies' velocities set to `v`.
+    fn set_velocities(&mut self, v: &[SVector<T, N>; B]) {
+        for (body, v) in self.bodies.iter_mut().zip(v).filter(|(b, _)| !b.asleep) {
             body.state.qd = *v;
         }
-        guarded
     }
 
     /// The kinetic energy of the awake bodies at velocities `v`.
@@ -559,7 +623,11 @@ where
         // Each pushing pair once, its impulses summed, at its first point (contacts are in
         // their keys' order, so a pair's points are together).
         let mut now: Vec<ContactEvent<T>, K> = Vec::new();
-        for c in self.contacts.iter().filter(|c| c.normal.lambda > T::zero()) {
+        for c in self
+            .contacts
+            .iter()
+            .filter(|c| c.normal.lambda > T::zero() && c.key.0 != OWN_ROWS)
+        {
             let pair = (c.key.0.min(c.key.1), c.key.0.max(c.key.1));
             match now.last_mut() {
                 Some(e) if e.shapes == pair => {
@@ -623,7 +691,7 @@ where
         self.bodies.iter().position(|b| b.key == key)
     }
 
-    fn body_mut(&mut self, key: u32) -> Result<&mut Body<T, M, N>, Error> {
+    fn body_mut(&mut self, key: u32) -> Result<&mut Body<T, M, L, N>, Error> {
         let i = self.body(key).ok_or(Error::InvalidParameter {
             name: "body",
             reason: "no body has that key",
@@ -640,7 +708,7 @@ where
     }
 
     fn key_taken(&self, key: u32) -> bool {
-        self.shape(key).is_some() || self.planes.iter().any(|(k, _)| *k == key)
+        key == OWN_ROWS || self.shape(key).is_some() || self.planes.iter().any(|(k, _)| *k == key)
     }
 
     fn insert_shape(&mut self, shape: Attached<T>) -> Result<(), Error> {
@@ -657,6 +725,23 @@ where
             Some((body, link)) => s.shape.placed(&body.pose(&body.state.q, link)),
             None => s.shape,
         }
+    }
+}
+
+/// The impulse solve over `contacts` (sorted by key, the bodies' own rows last), then as
+/// many sweeps over the own rows alone: a joint's limit has the last word over the contacts
+/// that strike its limb (their leftover depth is the drift's to remove; a limit passed is
+/// what a viewer sees).
+fn sweep<T: Real, const N: usize>(
+    v: &mut [SVector<T, N>],
+    contacts: &mut [Contact<T, N>],
+    friction: T,
+    sweeps: u32,
+) {
+    solve::velocities(v, contacts, friction, sweeps);
+    let own = contacts.partition_point(|c| c.key.0 != OWN_ROWS);
+    if let Some(rows) = contacts.get_mut(own..) {
+        solve::velocities(v, rows, friction, OWN_SWEEPS * sweeps);
     }
 }
 

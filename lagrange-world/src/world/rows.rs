@@ -70,6 +70,8 @@ pub(crate) struct Contact<T: Real, const N: usize> {
     pub(crate) approach: T,
     /// The drift correction's impulse (on pseudo-velocities; see `solve::drift`).
     pub(crate) drift: T,
+    /// The drift correction's lowest pseudo-speed (see `solve::drift`).
+    pub(crate) reach: T,
     /// Where it is and the normal, world coordinates (for events and queries).
     pub(crate) point: Vec2<T>,
     pub(crate) direction: Vec2<T>,

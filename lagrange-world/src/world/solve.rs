@@ -75,22 +75,43 @@ pub(crate) fn velocities<T: Real, const N: usize>(
     }
 }
 
-/// Pseudo-velocities `p` (zero at first) that move each contact deeper than `slop` back to
-/// `slop` over the step `dt`: `sweeps` sweeps of the normal rows alone to no less than
-/// `-(gap + slop) / dt` where that is positive. They move the coordinates only, never the
-/// velocities: the drift is removed without kinetic energy (split impulses).
+/// Pseudo-velocities `p` (zero at first) that leave no row deeper than `slop` where the
+/// velocities `v` take it over the step `dt`: each row's gap there, linearised (`gap + dt J
+/// v`), and `sweeps` sweeps of the normal rows to `J p >= -(that + slop) / dt` with pushes
+/// only. A row the velocities leave open takes no push but may not be closed past the slop
+/// by the others' (a joint's limit while its limb is pushed out of another body). They move
+/// the coordinates only, never the velocities: the drift is removed without kinetic energy
+/// (split impulses).
 pub(crate) fn drift<T: Real, const N: usize>(
     p: Velocities<'_, T, N>,
+    v: &[SVector<T, N>],
     contacts: &mut [Contact<T, N>],
     slop: T,
     dt: T,
     sweeps: u32,
 ) {
+    for c in contacts.iter_mut() {
+        let reach = c.gap + dt * speed(v, c.bodies, &c.normal);
+        c.drift = T::zero();
+        c.reach = -(reach + slop) / dt;
+    }
+    // Nothing deeper than the slop: no row pushes, and the others only hold.
+    if contacts.iter().all(|c| c.reach <= T::zero()) {
+        return;
+    }
+    pseudo(p, contacts, sweeps);
+}
+
+/// `sweeps` sweeps of the drift's rows (see [`drift`]).
+pub(crate) fn pseudo<T: Real, const N: usize>(
+    p: Velocities<'_, T, N>,
+    contacts: &mut [Contact<T, N>],
+    sweeps: u32,
+) {
     for _ in 0..sweeps {
-        for c in contacts.iter_mut().filter(|c| c.gap < -slop) {
-            let lower = -(c.gap + slop) / dt;
+        for c in contacts.iter_mut() {
             let a = speed(p, c.bodies, &c.normal);
-            let lambda = (c.drift + (lower - a) * c.normal.inverse).max(T::zero());
+            let lambda = (c.drift + (c.reach - a) * c.normal.inverse).max(T::zero());
             let d = lambda - c.drift;
             c.drift = lambda;
             apply(p, c.bodies, &c.normal, d);
