@@ -62,15 +62,18 @@ where
             let (lo, hi) = self.placed(s).bounds();
             let grow = margin + self.reach(s, dt);
             let body = s.on.map(|(i, _)| i);
-            self.broad.add(Proxy {
-                bounds: ([lo[0] - grow, lo[1] - grow], [hi[0] + grow, hi[1] + grow]),
-                body: body.map_or(u32::MAX, |i| u32::try_from(i).unwrap_or(u32::MAX)),
-                key: s.key,
-                group: s.group,
-                mask: s.mask,
-                fixed: body.is_none(),
-                asleep: body.is_some_and(|i| self.bodies.get(i).is_some_and(|b| b.asleep)),
-            })?;
+            self.broad
+                .add(Proxy {
+                    bounds: ([lo[0] - grow, lo[1] - grow], [hi[0] + grow, hi[1] + grow]),
+                    body: body.map_or(u32::MAX, |i| u32::try_from(i).unwrap_or(u32::MAX)),
+                    key: s.key,
+                    group: s.group,
+                    mask: s.mask,
+                    fixed: body.is_none(),
+                    asleep: body.is_some_and(|i| self.bodies.get(i).is_some_and(|b| b.asleep)),
+                })
+                // A box that is not finite: a body so far out that its shape's place overflows.
+                .map_err(|_| Error::NonFiniteState)?;
         }
         let mut pairs: Vec<(u32, u32), K> = Vec::new();
         self.broad.pairs(&mut pairs)?;

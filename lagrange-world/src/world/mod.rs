@@ -279,7 +279,7 @@ where
     ///
     /// # Errors
     /// [`Error::InvalidParameter`] `key` when taken (by a shape or a half-plane; `u32::MAX`
-    /// is the world's own), `body` when
+    /// is the world's own), `shape` when not finite (offset by a NaN), `body` when
     /// no body has that key, `link` when the mechanism has no such link, `capacity` when `S`
     /// shapes are there.
     pub fn add_shape(
@@ -409,11 +409,13 @@ where
         let planes = self.planes.iter().filter_map(|&(key, p)| {
             let (n, along) = (p.normal(), dot(p.normal(), direction));
             let t = (p.offset() - dot(n, origin)) / along;
-            (along < T::zero() && t >= T::zero() && t <= t_max).then(|| WorldHit {
+            let point = [origin[0] + direction[0] * t, origin[1] + direction[1] * t];
+            let met = along < T::zero() && t >= T::zero() && t <= t_max;
+            (met && point.iter().all(|x| x.is_finite())).then_some(WorldHit {
                 shape: key,
                 hit: RayHit {
                     t,
-                    point: [origin[0] + direction[0] * t, origin[1] + direction[1] * t],
+                    point,
                     normal: n,
                 },
             })
@@ -714,6 +716,14 @@ where
     fn insert_shape(&mut self, shape: Attached<T>) -> Result<(), Error> {
         if self.key_taken(shape.key) {
             return Err(taken());
+        }
+        // A shape offset or placed by values that are not finite.
+        let s = &shape.shape;
+        if !(s.vertices().iter().flatten().all(|x| x.is_finite()) && s.radius().is_finite()) {
+            return Err(Error::InvalidParameter {
+                name: "shape",
+                reason: "its vertices and radius must be finite",
+            });
         }
         let at = self.shapes.partition_point(|s| s.key < shape.key);
         self.shapes.insert(at, shape).map_err(|_| full())
