@@ -844,6 +844,13 @@ mod tests {
         assert_eq!(d.w(), rebuilt.w());
         assert_eq!(d.candidates(), &[true, false, true]);
         assert!(d.insert(3, &SVector::zeros(), &SVector::zeros()).is_err());
+        // Extended by the wall alone: it joins, the third row (no candidate, not asked) does
+        // not, and the floor and the third stay as they were.
+        let mut e = Delassus::new(&j, |_| Ok(()), &[true, false, false])?;
+        e.extend(&j, |b| Ok(*b), &[false, true, false])?;
+        assert_eq!(e.candidates(), &[true, true, false]);
+        let two = Delassus::new(&j, |_| Ok(()), &[true, true, false])?;
+        assert_eq!(e.w(), two.w());
         Ok(())
     }
 
@@ -1025,7 +1032,10 @@ mod tests {
                 SVector::<f64, 3>::new(0.8, -0.8, -2.0),
             ),
         ];
-        for (j, b) in sets {
+        // The same sets with right sides a thousand times larger: the pull is judged against
+        // the row's terms, whatever their size.
+        let scaled = sets.map(|(j, b)| (j, b * 1000.0));
+        for (j, b) in sets.into_iter().chain(scaled) {
             let mut d = Delassus::new(&j, |_| Ok(()), &[true; 3])?;
             let kinds = [Row::Unilateral; 3];
             let s = d.complementary_from(&b, &kinds, &[false; 3])?;

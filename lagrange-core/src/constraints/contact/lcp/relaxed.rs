@@ -120,6 +120,27 @@ mod tests {
         Ok(())
     }
 
+    /// A row is active where its multiplier is strictly inside its bounds and not zero: a
+    /// contact that pushes, not a friction row held at either bound, not a row that is no
+    /// candidate (four independent rows of one unit mass in four freedoms, `W = I`, so one
+    /// sweep lands each at its clamped minimum `-b`).
+    #[test]
+    fn active_rows_are_inside_their_bounds() -> Result<(), Error> {
+        let j = SMatrix::<f64, 4, 4>::identity();
+        let d = Delassus::new(&j, |_| Ok(()), &[true, true, true, false])?;
+        let kinds = [
+            Row::Unilateral,
+            Row::Bounded(0.5),
+            Row::Bounded(0.5),
+            Row::Bounded(0.5),
+        ];
+        let b = SVector::<f64, 4>::new(-1.0, -5.0, 5.0, -0.1);
+        let r = d.relaxed(&b, &kinds, 1);
+        assert_eq!(r.lambda, SVector::<f64, 4>::new(1.0, 0.5, -0.5, 0.0));
+        assert_eq!(r.active, [true, false, false, false]);
+        Ok(())
+    }
+
     /// Rows that are not candidates take no part, and no row is active at zero.
     #[test]
     fn only_candidates_take_part() -> Result<(), Error> {
