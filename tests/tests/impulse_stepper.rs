@@ -2039,7 +2039,53 @@ fn a_lift_along_a_curve_is_paid_to_the_start_energy<T: Real>() -> Result<(), Err
     Ok(())
 }
 
+/// The centre of a ball of radius 10 cm in a slot 1 cm narrower than the ball: the floor
+/// keeps it at `y >= 0.1`, the ceiling at `y <= 0.09`.
+#[derive(Clone, Copy)]
+struct Slot;
+
+impl<T: Real> HolonomicConstraints<T, 1, 2> for Slot {
+    fn phi<S: Scalar<Real = T> + 'static>(&self, q: &SVector<S, 1>) -> SVector<S, 2> {
+        SVector::from([q[0] - S::from_f64(0.1), S::from_f64(0.09) - q[0]])
+    }
+}
+
+/// Targets no impulses reach fall back to projected Gauss-Seidel, `4 C` sweeps. A unit ball
+/// jammed in [`Slot`], halfway (both contacts 5 mm deep, within the 1 cm slop), moving down
+/// at 0.1 m/s, restitution 0.5: at the free step's end it approaches the floor at
+/// `u = 0.1 + g dt` and both contacts touch. The plastic solve stops it; the rebound asks the
+/// floor for `e u` upwards while the ceiling, which the ball leaves at `u`, holds: no impulses
+/// reach both (the ball would have to go up and not up), so the round is projected
+/// Gauss-Seidel's and the step is not settled. Its sweeps over (floor, ceiling), by hand:
+/// each adds `e u` to both impulses after the first, which gives the floor `(1 + e) u` and the
+/// ceiling `e u`, and each ends with the ceiling's row met, the ball at rest. After `4 C = 8`
+/// sweeps: floor `(1 + 8 e) u`, ceiling `8 e u`, the ball at rest where it began (the impulses
+/// undo the free step's fall). To 64 ulps of the impulses (eight sweeps of a few roundings).
+fn targets_no_impulses_reach_fall_back_to_gauss_seidel<T: Real>() -> Result<(), Error> {
+    let (e, dt) = (0.5, 1.0 / 120.0);
+    let ball = FallingParticle::new(T::one(), T::from_f64(G))?;
+    let model = ContactModel::new(T::from_f64(e), T::from_f64(0.05), T::one())?;
+    let settings = ImpulseSettings::new(T::from_f64(0.01), 8)?;
+    let mut stepper = ImpulseStepper::new(SemiImplicitEuler, Holonomic::new(Slot), model, settings);
+    let start = State::new(T::zero(), [T::from_f64(0.095)], [T::from_f64(-0.1)]);
+    let end = stepper.step(&ball, &start, T::from_f64(dt))?;
+    let r = stepper.last_report();
+    assert!(r.rows == 2 && !r.settled && !r.corrected, "{r:?}");
+    let u = 0.1 + G * dt;
+    let sweeps = 4.0 * 2.0;
+    let (normal, _) = stepper.impulses();
+    let rounding = 64.0 * T::EPSILON.to_f64();
+    let near = |got: T, want: f64| (got.to_f64() - want).abs() <= rounding * want.abs().max(u);
+    assert!(
+        near(normal[0], (1.0 + sweeps * e) * u) && near(normal[1], sweeps * e * u),
+        "{normal:?}"
+    );
+    assert!(near(end.qd[0], 0.0) && near(end.q[0], 0.095), "{end:?}");
+    Ok(())
+}
+
 for_f32_and_f64!(
+    targets_no_impulses_reach_fall_back_to_gauss_seidel,
     a_lift_along_a_curve_is_paid_to_the_start_energy,
     the_guard_evaluates_the_energy_once_a_step,
     more_tangents_than_spare_columns,
