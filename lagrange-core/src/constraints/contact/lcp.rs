@@ -1011,6 +1011,81 @@ mod tests {
         Ok(())
     }
 
+    /// The method's path where rows depend on each other and bounded rows meet their
+    /// bounds along a ray: five small sets of integer rows (one unit mass) on which each
+    /// step of the ray (the row's own reach, each partner's, the first bound, the moves)
+    /// decides which of the many multipliers of equal `W lambda` the method ends at, and in
+    /// how many passes. The figures are those of a reference of the documented method in
+    /// plain Python (`tests/reference/lcp_reference.py`, IEEE doubles), to 1e-12 (it sums
+    /// in another order), the passes exactly; and every kind's conditions hold.
+    #[test]
+    fn a_dependent_row_joins_along_the_ray_as_documented() -> Result<(), Error> {
+        fn check<const C: usize>(
+            j: &[f64],
+            b: [f64; C],
+            kinds: [Row<f64>; C],
+            guess: [bool; C],
+            expected: [f64; C],
+            passes: u32,
+        ) -> Result<(), Error> {
+            let j = SMatrix::<f64, C, 2>::from_row_slice(j);
+            let mut d = Delassus::new(&j, |_| Ok(()), &[true; C])?;
+            let b = SVector::<f64, C>::from(b);
+            let s = d.complementary_from(&b, &kinds, &guess)?;
+            let a = d.w * s.lambda + b;
+            for i in 0..C {
+                assert!(holds(kinds[i], s.lambda[i], a[i], 1e-12), "row {i}: {s:?}");
+                assert!(
+                    (s.lambda[i] - expected[i]).abs() < 1e-12,
+                    "{s:?} against {expected:?}"
+                );
+            }
+            assert_eq!(s.passes, passes, "{s:?}");
+            Ok(())
+        }
+        let (u, bounded) = (Row::Unilateral, Row::Bounded);
+        check(
+            &[-1.0, 0.0, 1.0, 1.0, 2.0, 0.0, 1.0, 0.0],
+            [-0.3, -2.0, 0.9, 0.6],
+            [u, u, bounded(1.5), bounded(0.6)],
+            [true, false, false, true],
+            [0.0, 2.45, -1.15, -0.6],
+            8,
+        )?;
+        check(
+            &[1.0, 1.0, 2.0, 1.0, 0.0, 1.0],
+            [-2.0, -3.0, -1.5],
+            [bounded(0.5), bounded(0.3), bounded(0.9)],
+            [true, false, false],
+            [0.1, 0.3, 0.9],
+            7,
+        )?;
+        check(
+            &[1.0, 1.0, 1.0, 0.0, 1.0, 0.0, 1.0, 1.0],
+            [-3.8, -2.2, -2.7, -3.9],
+            [bounded(2.0), bounded(1.5), u, bounded(0.5)],
+            [true, false, false, false],
+            [0.6, -1.5, 3.1, 0.5],
+            6,
+        )?;
+        check(
+            &[1.0, 0.0, 0.0, 1.0, -1.0, 0.0, 1.0, 0.0],
+            [-1.1, -2.1, 1.2, -1.2],
+            [bounded(1.5), u, bounded(1.8), u],
+            [false, false, false, true],
+            [-1.5, 2.1, -1.8, 0.9],
+            8,
+        )?;
+        check(
+            &[1.0, 1.0, 2.0, 2.0, 2.0, 1.0],
+            [-1.2, -2.6, -0.5],
+            [u, bounded(0.3), u],
+            [true, false, false],
+            [0.0, 0.3, 0.0],
+            4,
+        )
+    }
+
     /// Near-dependent rows: three contacts nearly parallel, one unit mass pressed onto them
     /// (a body resting on three points of one line: `J` rows `(1, 0)` each turned by a few
     /// micro-radians, `b = -0.4` each), and two nearly opposed rows beside a third. The pivot
