@@ -244,6 +244,21 @@ impl<T: Real, L: Links<T, N>, const N: usize> Links<T, N> for Poses<'_, L> {
     }
 }
 
+/// The acrobot of these tests: links `h` and `l` long, their centres at 0.35 and 0.55 m.
+fn acrobot<T: Real>(h: T, l: T, g: T) -> Result<Acrobot<T>, Error> {
+    Acrobot::new(
+        T::one(),
+        T::one(),
+        h,
+        l,
+        T::from_f64(0.35),
+        T::from_f64(0.55),
+        T::from_f64(0.1),
+        T::from_f64(0.1),
+        g,
+    )
+}
+
 /// The largest difference of the hand-derived points of `l` from the dual-number default,
 /// over 100 random states and points on every link, relative to `1 + |q|`.
 fn hand_against_duals<T: Real, L: Links<T, N>, const N: usize>(l: &L, rng: &mut Rng) -> f64 {
@@ -297,17 +312,7 @@ fn hand_points_agree_with_duals<T: Real>() -> Result<(), Error> {
     let mut rng = Rng::new(345);
     let g = T::from_f64(G);
     let (h, l) = (T::from_f64(0.7), T::from_f64(1.1));
-    let acrobot = Acrobot::new(
-        T::one(),
-        T::one(),
-        h,
-        l,
-        T::from_f64(0.35),
-        T::from_f64(0.55),
-        T::from_f64(0.1),
-        T::from_f64(0.1),
-        g,
-    )?;
+    let acrobot = acrobot(h, l, g)?;
     let worst = [
         hand_against_duals(
             &SimplePendulum::new(T::one(), T::from_f64(0.8), g, T::zero())?,
@@ -341,17 +346,7 @@ fn out_of_range_links<T: Real>() -> Result<(), Error> {
     out_of_range_is_no_panic(&DoublePendulum::new(T::one(), T::one(), h, l, g)?, &mut rng);
     out_of_range_is_no_panic(&NLinkPendulum::new([T::one(); 3], [h; 3], g)?, &mut rng);
     out_of_range_is_no_panic(&CartPole::new(T::one(), T::one(), h, g)?, &mut rng);
-    let acrobot = Acrobot::new(
-        T::one(),
-        T::one(),
-        h,
-        l,
-        T::from_f64(0.35),
-        T::from_f64(0.55),
-        T::from_f64(0.1),
-        T::from_f64(0.1),
-        g,
-    )?;
+    let acrobot = acrobot(h, l, g)?;
     out_of_range_is_no_panic(&acrobot, &mut rng);
     out_of_range_is_no_panic(&Ragdoll::new(RagdollBody::<T>::adult())?, &mut rng);
     out_of_range_is_no_panic(&RigidBody::disk(T::one(), h, g)?, &mut rng);
