@@ -5,8 +5,8 @@
 //! `lagrange-core/tests/fast_trig.rs`.)
 
 use lagrange_core::nalgebra::SVector;
-use lagrange_core::{check_finite, divergences, Error, Lanes, Mechanism, Real, Scalar, State};
-use lagrange_integrators::scene::{Bank, NeverSleeps, Scene};
+use lagrange_core::{check_finite, divergences, Error, Gather, Lanes, Real, Scalar, State};
+use lagrange_integrators::scene::{Bank, InLanes, NeverSleeps, Scene};
 use lagrange_integrators::{
     ExplicitEuler, FixedTimestep, Integrator, Rk4, SemiImplicitEuler, VelocityVerlet,
 };
@@ -32,16 +32,13 @@ fn lanes_equal_alone<T, const N: usize, M, I>(
 ) -> Result<(), Error>
 where
     T: Real,
-    M: Mechanism<T, N>,
+    M: Gather<T, N>,
     I: Integrator<T, N, M> + Clone,
 {
     let mut rng = Rng::new(seed);
     let built: Vec<(M, State<T, N>)> = (0..L).map(|_| make(&mut rng)).collect::<Result<_, _>>()?;
     let instances: [&M; L] = core::array::from_fn(|i| &built[i].0);
-    let lanes = M::gather(instances).ok_or(Error::InvalidParameter {
-        name: "mechanism",
-        reason: "gathers no lanes",
-    })?;
+    let lanes = M::gather(instances);
     let dt = T::from_f64(dt);
     let mut alone: Vec<State<T, N>> = built.iter().map(|(_, s)| *s).collect();
     let states: [&State<T, N>; L] = core::array::from_fn(|i| &built[i].1);
@@ -79,7 +76,7 @@ fn every_method<T, const N: usize, M>(
 ) -> Result<(), Error>
 where
     T: Real,
-    M: Mechanism<T, N>,
+    M: Gather<T, N>,
 {
     lanes_equal_alone(Rk4, dt, make, 1)?;
     lanes_equal_alone(ExplicitEuler, dt, make, 2)?;
@@ -158,7 +155,8 @@ fn a_bank_in_lanes_equals_its_instances_alone<T: Real>() -> Result<(), Error> {
     const K: usize = 3 * L + 5;
     let mut rng = Rng::new(11);
     let dt = T::from_f64(1.0 / 120.0);
-    let mut bank: Bank<T, 2, K, DoublePendulum<T>, Rk4> = Bank::new(Rk4, NeverSleeps)?;
+    let mut bank: Bank<T, 2, K, DoublePendulum<T>, Rk4, NeverSleeps, InLanes> =
+        Bank::new(Rk4, NeverSleeps)?;
     let mut alone = Vec::new();
     for _ in 0..K {
         let p = DoublePendulum::new(
@@ -258,12 +256,7 @@ fn a_lane_that_blows_up_fails_the_group<T: Real>() -> Result<(), Error> {
             ))
         })
         .collect::<Result<_, Error>>()?;
-    let lanes = SimplePendulum::gather(core::array::from_fn(|i| &built[i].0)).ok_or(
-        Error::InvalidParameter {
-            name: "mechanism",
-            reason: "gathers no lanes",
-        },
-    )?;
+    let lanes = SimplePendulum::gather(core::array::from_fn(|i| &built[i].0));
     let states: [&State<T, 1>; L] = core::array::from_fn(|i| &built[i].1);
     let side = State {
         t: Lanes::gather(&states, |s| s.t),

@@ -179,7 +179,7 @@ where
     /// The main instance's current state.
     fn main_state(&self) -> Result<State<T, N>, Error> {
         let id = *self.ids.first().ok_or(Error::NoSuchInstance)?;
-        self.scene.banks().state(id).copied()
+        self.scene.banks().state(id)
     }
 
     /// Keeps `error` and resets.
@@ -305,7 +305,7 @@ where
     fn set_dt(&mut self, dt: f64) -> Result<(), Error> {
         let bank = self.scene.banks();
         let states: Result<Vec<State<T, N>>, Error> =
-            self.ids.iter().map(|&id| bank.state(id).copied()).collect();
+            self.ids.iter().map(|&id| bank.state(id)).collect();
         let rebuilt = states.and_then(|states| self.rebuild(&states, dt));
         rebuilt.map_err(|e| self.fail(e))?;
         // The exact solution no longer shares the clock's start.

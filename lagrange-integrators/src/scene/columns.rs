@@ -1,0 +1,104 @@
+//! [`Columns`]: the states of a bank's instances as structure of arrays, one array per
+//! component, so that a group of instances side by side is a window of each array.
+
+use lagrange_core::nalgebra::SVector;
+use lagrange_core::{Lanes, Real, State};
+
+/// The states of up to `K` instances, by place: the time of each, then each coordinate's and
+/// each velocity's array. A group of `L` places is `L` consecutive values of each array, which
+/// a step in [`Lanes`] loads and stores whole, where a state per instance would have to be
+/// gathered and scattered component by component (on x86_64 that cost a bank of pendulums half
+/// again their step in lanes).
+///
+/// Places at or past `K` read as zero and take no write: the bank never asks for them.
+#[derive(Debug, Clone)]
+pub struct Columns<T, const N: usize, const K: usize> {
+    t: Lanes<T, K>,
+    q: [Lanes<T, K>; N],
+    qd: [Lanes<T, K>; N],
+}
+
+impl<T: Real, const N: usize, const K: usize> Columns<T, N, K> {
+    /// Every state zero.
+    pub fn new() -> Self {
+        Self {
+            t: Lanes::splat(T::zero()),
+            q: [Lanes::splat(T::zero()); N],
+            qd: [Lanes::splat(T::zero()); N],
+        }
+    }
+
+    /// The state at `place`.
+    #[inline(always)]
+    pub fn get(&self, place: usize) -> State<T, N> {
+        let at = |column: &Lanes<T, K>| column.0.get(place).copied().unwrap_or_else(T::zero);
+        State {
+            t: at(&self.t),
+            q: SVector::from_fn(|j, _| self.q.get(j).map_or_else(T::zero, at)),
+            qd: SVector::from_fn(|j, _| self.qd.get(j).map_or_else(T::zero, at)),
+        }
+    }
+
+    /// Writes the state at `place`.
+    #[inline(always)]
+    pub fn set(&mut self, place: usize, s: &State<T, N>) {
+        self.t.set(place, s.t);
+        for (column, &x) in self.q.iter_mut().zip(s.q.iter()) {
+            column.set(place, x);
+        }
+        for (column, &x) in self.qd.iter_mut().zip(s.qd.iter()) {
+            column.set(place, x);
+        }
+    }
+
+    /// Sets the time at `place`.
+    pub fn set_time(&mut self, place: usize, t: T) {
+        self.t.set(place, t);
+    }
+
+    /// Swaps the states at two places.
+    pub fn swap(&mut self, a: usize, b: usize) {
+        let (x, y) = (self.get(a), self.get(b));
+        self.set(a, &y);
+        self.set(b, &x);
+    }
+
+    /// The states of places `at..at + count` side by side (`count` at most `L`), the lanes
+    /// past `count` copies of the first, so that they take the branches it takes and fail
+    /// where it fails.
+    #[inline(always)]
+    pub fn window<const L: usize>(&self, at: usize, count: usize) -> State<Lanes<T, L>, N> {
+        let lanes = |column: &Lanes<T, K>| {
+            let mut lanes = column.window::<L>(at);
+            if count < L {
+                let first = lanes.0.first().copied().unwrap_or_else(T::zero);
+                for x in lanes.0.iter_mut().skip(count) {
+                    *x = first;
+                }
+            }
+            lanes
+        };
+        State {
+            t: lanes(&self.t),
+            q: SVector::from_fn(|j, _| self.q.get(j).map_or_else(Lanes::default, lanes)),
+            qd: SVector::from_fn(|j, _| self.qd.get(j).map_or_else(Lanes::default, lanes)),
+        }
+    }
+
+    /// Writes the first `count` lanes of `s` into places `at..at + count`.
+    #[inline(always)]
+    pub fn set_window<const L: usize>(&mut self, at: usize, count: usize, s: &State<Lanes<T, L>, N>) {
+        let write = |column: &mut Lanes<T, K>, lanes: &Lanes<T, L>| {
+            for (place, &x) in column.0.iter_mut().skip(at).zip(lanes.0.iter().take(count)) {
+                *place = x;
+            }
+        };
+        write(&mut self.t, &s.t);
+        for (column, lanes) in self.q.iter_mut().zip(s.q.iter()) {
+            write(column, lanes);
+        }
+        for (column, lanes) in self.qd.iter_mut().zip(s.qd.iter()) {
+            write(column, lanes);
+        }
+    }
+}
