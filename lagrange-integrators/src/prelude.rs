@@ -5,8 +5,10 @@
 
 pub use crate::scene::{Bank, NeverSleeps, Scene, Sleeps};
 pub use crate::{
-    AdaptiveSettings, DormandPrince54, DormandPrince853, DormandPrinceNystrom1210,
-    DormandPrinceNystrom64, DormandPrinceNystrom86, FixedTimestep, GaussLegendre2, Integrator,
-    Method, Projected, Rk4, StormerVerlet, VariationalMidpoint, Verner76, Verner98, Yoshida4,
+    AdaptiveSettings, ContactModel, ContactStepper, DormandPrince54, DormandPrince853,
+    DormandPrinceNystrom1210, DormandPrinceNystrom64, DormandPrinceNystrom86, FixedTimestep,
+    GaussLegendre2, ImpulseSettings, ImpulseStepper, Integrator, Method, Projected, Rk4,
+    SemiImplicitEuler, StormerVerlet, VariationalMidpoint, VelocityVerlet, Verner76, Verner98,
+    Yoshida4,
 };
 pub use lagrange_core::prelude::*;

@@ -264,3 +264,32 @@ fn the_parameter_to_blame_is_named() {
         Some(("mass", small))
     );
 }
+
+/// The Kepler orbit names the parameter most responsible when a quantity it forms overflows,
+/// by the powers the quantity holds it to. The mean anomaly `n t` (`(n t)^2 = mu a^-3 t^2`)
+/// of `mu = 1e-15`, `a = 10^(-320/3)` (its cube a subnormal 1e-320, so that `mu / a^3 =
+/// 1e305` and `n = 1e152.5` are finite) and `t = 1e157.5` is 1e310: its logarithm's shares are
+/// `mu` -34.5, `a` +736.8 (`a^-3`, the largest), `t` +725.3 (`t^2`), so the error names
+/// `semi_major_axis` (too small: it is divided by), not `t`. The product `mu a` under
+/// `sqrt(mu a)` (the rates' scale) of `mu = 1e250`, `a = 1e100` overflows (1e350) where `a^3`,
+/// `n` and `n t` do not: `mu`, its larger factor, is named, rather than a rate overflowing to
+/// a non-finite state.
+#[test]
+fn the_kepler_orbit_blames_the_factor_most_responsible() {
+    let named = |r: Result<lagrange_core::State<f64, 2>, Error>| match r {
+        Err(Error::InvalidParameter { name, reason }) => Some((name, reason)),
+        other => panic!("expected an invalid parameter, got {other:?}"),
+    };
+    let large = "too large: a quantity formed from the parameters overflows";
+    let small = "too small: a quantity formed from the parameters (divided by it) overflows";
+    let a = 10f64.powf(-320.0 / 3.0);
+    assert!((a * a * a) > 0.0 && (1e-15 / (a * a * a)).is_finite());
+    assert_eq!(
+        named(kepler_orbit(1e-15, a, 0.5, 10f64.powf(157.5))),
+        Some(("semi_major_axis", small))
+    );
+    assert_eq!(
+        named(kepler_orbit(1e250, 1e100, 0.5, 1.0)),
+        Some(("mu", large))
+    );
+}

@@ -78,8 +78,11 @@ pub type InputFn<T, const N: usize, M, I> =
 /// The bank of a [`Sim`].
 type SimBank<T, const N: usize, M, I> = Bank<T, N, 2, M, I, Sleeps<T>>;
 
-/// A scene over a [`SimBank`] and the ids of its instances (main, then twin).
-type Built<T, const N: usize, M, I> = (Scene<T, SimBank<T, N, M, I>>, Vec<Id>);
+/// A scene over a [`SimBank`] and the ids of its instances (main, then twin). The scene is
+/// boxed where it is made: a bank of two ragdoll impulse steppers in `f64` is 100 kB, and each
+/// frame that moved it by value kept a copy (unoptimised, the page's tests overflowed a 2 MB
+/// thread stack).
+type Built<T, const N: usize, M, I> = (Box<Scene<T, SimBank<T, N, M, I>>>, Vec<Id>);
 
 /// The exact solution's points at time `t`, s.
 pub type ExactFn = fn(f64) -> Vec<[f64; 2]>;
@@ -114,7 +117,7 @@ pub struct Recipe<T: Real, const N: usize, M, I> {
 /// One mechanism in its scene.
 pub struct Sim<T: Real, const N: usize, M, I> {
     recipe: Recipe<T, N, M, I>,
-    scene: Scene<T, SimBank<T, N, M, I>>,
+    scene: Box<Scene<T, SimBank<T, N, M, I>>>,
     ids: Vec<Id>,
     dt: f64,
     e0: f64,
@@ -140,7 +143,7 @@ where
     for s in states {
         ids.push(bank.add(recipe.mechanism.clone(), *s)?);
     }
-    let scene = Scene::new(bank, T::from_f64(dt), MAX_STEPS_PER_FRAME)?;
+    let scene = Box::new(Scene::new(bank, T::from_f64(dt), MAX_STEPS_PER_FRAME)?);
     Ok((scene, ids))
 }
 

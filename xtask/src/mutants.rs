@@ -256,9 +256,11 @@ const AREAS: [Area; 24] = [
         files: &[
             "lagrange-integrators/src/contact_stepper.rs",
             "lagrange-integrators/src/impulse_stepper/mod.rs",
+            "lagrange-integrators/src/impulse_stepper/step.rs",
             "lagrange-integrators/src/impulse_stepper/rows.rs",
-            "lagrange-integrators/src/impulse_stepper/settings.rs",
             "lagrange-integrators/src/impulse_stepper/solve.rs",
+            "lagrange-integrators/src/impulse_stepper/energy.rs",
+            "lagrange-integrators/src/impulse_stepper/settings.rs",
             "lagrange-integrators/src/impulse_stepper/report.rs",
         ],
         only: None,

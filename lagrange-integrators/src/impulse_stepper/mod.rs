@@ -57,15 +57,22 @@ use step::{Memory, Setup};
 ///
 /// ```text
 /// the inner method's step                      (Method::COST of the inner method)
-/// 1 position_residual; with R > 0: 1 jacobian, 1 tangent_jacobian (with friction),
-///   2 velocity_jumps of R and F columns (and one velocity_jump per speculative row)
+/// 1 position_residual; with R > 0: 1 jacobians (normal and tangent rows),
+///   1 velocity_jumps of the R + F columns (2 where R + F > C), one velocity_jump per
+///   speculative row
 /// at most 4 solves of the impulses (plastic, twice more with speculative rows, rebound),
 ///   each at most K rounds of: one exact solve of the R normal rows (the active-set method
-///   of Delassus::complementary: a Cholesky factorisation of at most R rows per pass, at most
-///   4 C + 4 passes, one or two from the last step's active rows), one sweep of F tangents
+///   of Delassus::complementary: per pass, the Cholesky rows of the rows that joined, at most
+///   4 C + 4 passes, one or two from the last step's rows), then sweeps of the F tangents
+///   until one changes nothing, at most K
 /// at most 3 exact solves of the R rows for the drift
-/// 2 to 4 evaluations of T and V
+/// 1 evaluation of T + V (2 after a flight); where the end would pass the allowance, 2 to 3
+///   more and at most 4 of V
 /// ```
+///
+/// The stepper keeps the storage of its rows from step to step (about `2 C^2 + 5 C N`
+/// numbers: 15 kB for the ragdoll's 31 rows in `f32`), so that a step neither makes nor
+/// clears it.
 ///
 /// A step with no row in contact is the inner step and one `position_residual`. The report
 /// of the last step ([`ImpulseStepper::last_report`]) gives `R`, `F`, the rounds taken and
@@ -82,9 +89,11 @@ use step::{Memory, Setup};
 ///
 /// **Which contact stepper.** This one for real time: bounded work, no hitch when a ragdoll
 /// lands, resting bodies quiet (they fall asleep in a scene), first order through contacts.
+/// The ragdoll thrown onto the floor at 240 Hz (`cargo xtask bench --contacts`, `f32`): a
+/// mean step 3.0 times a free RK4 step, the slowest 7.8 times, 2 mm deep at most.
 /// [`ContactStepper`](crate::ContactStepper) for accuracy: it locates every contact inside
 /// the step and keeps the inner method's order between them, at a cost that grows with the
-/// events (a thrown ragdoll: hundreds of times a free step).
+/// events (the same throw: about 90 times a free step on average, thousands in a landing).
 ///
 /// The same rows and [`ContactModel`] as [`ContactStepper`](crate::ContactStepper): a
 /// mechanism switches by changing one line. The model's time tolerance is not used.

@@ -12,7 +12,7 @@ pub struct ImpulseReport {
     pub speculative: u32,
     /// Contacts with a tangent (friction).
     pub frictional: u32,
-    /// Exact solves of the normal rows, each followed by a friction sweep: at most the
+    /// Exact solves of the normal rows, each followed by friction sweeps: at most the
     /// settings' `max_iterations` per solve, and at most four solves (the plastic one, two
     /// more with speculative rows, the rebound).
     pub rounds: u32,

@@ -2,8 +2,8 @@
 
 use lagrange_core::{validate, Error, Real};
 
-/// Most sweeps a step may be allowed: beyond a thousand a projected Gauss-Seidel solve that
-/// has not settled never will, and the cap bounds the cost of a step whatever is asked.
+/// Most rounds a solve may be allowed: beyond a thousand a friction solve that has not
+/// settled never will, and the cap bounds the cost of a step whatever is asked.
 const MAX_ITERATIONS_CAP: u32 = 1000;
 
 /// How deep a contact may rest and how much work a step of an
@@ -15,10 +15,11 @@ const MAX_ITERATIONS_CAP: u32 = 1000;
 ///                 it. A little slop keeps a resting contact in touch from step to step
 ///                 (quiet, and warm-started); none makes every resting step lift it. Choose
 ///                 it above a step's free fall, dt^2 g (0.17 mm at 240 Hz, 2.7 mm at 60 Hz)
-/// max_iterations  projected Gauss-Seidel sweeps, at most, for the impulses (and as many
-///                 for the position correction): the cap on a step's work
-/// tolerance       a sweep that changes no row's velocity by more than this (gap units per
-///                 second, plus the rounding of the row's speed) ends the solve early
+/// max_iterations  rounds of each impulse solve, at most (each an exact solve of the normal
+///                 rows, then Gauss-Seidel sweeps of the friction tangents until one changes
+///                 nothing, at most this many): the cap on a step's work
+/// tolerance       a round whose first sweep changes no tangent's speed by more than this
+///                 (gap units per second, plus the rounding of the speed) ends the solve
 /// max_rows        rows in contact at once, at most (default: every row of the set): the
 ///                 cap on a step's work in rows; more is an error naming it
 /// ```
@@ -33,7 +34,7 @@ pub struct ImpulseSettings<T> {
 
 impl<T: Real> ImpulseSettings<T> {
     /// A slop of `slop` (gap units, >= 0, finite) and at most `max_iterations` (1 to 1000)
-    /// sweeps per solve, ending early below a tolerance of 1e-6 gap units per second.
+    /// rounds per solve, ending early below a tolerance of 1e-6 gap units per second.
     ///
     /// # Errors
     /// [`Error::InvalidParameter`] `slop` when negative or not finite; `max_iterations` when
@@ -53,7 +54,7 @@ impl<T: Real> ImpulseSettings<T> {
         })
     }
 
-    /// The same settings with the sweeps ending early at `tolerance` (gap units per second,
+    /// The same settings with the rounds ending early at `tolerance` (gap units per second,
     /// > 0, finite).
     ///
     /// # Errors
@@ -88,13 +89,13 @@ impl<T: Real> ImpulseSettings<T> {
         self.slop
     }
 
-    /// The most sweeps per solve.
+    /// The most rounds per solve.
     #[must_use]
     pub fn max_iterations(&self) -> u32 {
         self.max_iterations
     }
 
-    /// The sweeps' early-end tolerance, gap units per second.
+    /// The rounds' early-end tolerance, gap units per second.
     #[must_use]
     pub fn tolerance(&self) -> T {
         self.tolerance
