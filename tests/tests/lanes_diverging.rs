@@ -4,8 +4,7 @@
 
 use lagrange_core::nalgebra::SVector;
 use lagrange_core::{
-    divergences, Error, Gather, GeneralizedForce, Lagrangian, Lanes, Mechanism, Real, Scalar,
-    State,
+    divergences, Error, Gather, GeneralizedForce, Lagrangian, Lanes, Mechanism, Real, Scalar, State,
 };
 use lagrange_integrators::scene::{Bank, InLanes, NeverSleeps, Scene, LANES};
 use lagrange_integrators::{FixedTimestep, Rk4};

@@ -93,7 +93,12 @@ fn what_wakes_a_sleeper<T: Real>() -> Result<(), Error> {
         "the same input",
     );
     carts.set_input(cart, -T::zero())?;
-    still_asleep(carts.status(cart)?, &carts.state(cart)?, &before, "-0 for 0");
+    still_asleep(
+        carts.status(cart)?,
+        &carts.state(cart)?,
+        &before,
+        "-0 for 0",
+    );
     carts.set_input(cart, T::from_f64(0.1))?;
     assert_eq!(carts.status(cart)?, Status::Awake);
     assert_eq!(carts.mechanism(cart)?.force(), T::from_f64(0.1));

@@ -23,10 +23,7 @@ const DT: f32 = 1.0 / 120.0;
 const LANE_GOAL: f64 = 3.0;
 
 /// A scene of one bank of `built`, laid out by `Y`, and the instances' ids in order.
-type Built<const N: usize, M, Y> = (
-    Scene<f32, Bank<f32, N, K, M, Rk4, NeverSleeps, Y>>,
-    Vec<Id>,
-);
+type Built<const N: usize, M, Y> = (Scene<f32, Bank<f32, N, K, M, Rk4, NeverSleeps, Y>>, Vec<Id>);
 
 /// The bank of `built`, laid out by `Y`, in a scene of one step per frame.
 fn scene<M, const N: usize, Y>(built: &[(M, State<f32, N>)]) -> Result<Built<N, M, Y>, Error>

@@ -414,7 +414,11 @@ where
             });
         }
         let mut state = self.current.get(place);
-        let mechanism = &self.slots.get(place).ok_or(Error::NoSuchInstance)?.mechanism;
+        let mechanism = &self
+            .slots
+            .get(place)
+            .ok_or(Error::NoSuchInstance)?
+            .mechanism;
         let qd = state.qd + mechanism.velocity_jump(&state, impulse)?;
         if !all_finite(qd.as_slice()) {
             return Err(Error::NonFiniteState);

@@ -87,7 +87,12 @@ impl<T: Real, const N: usize, const K: usize> Columns<T, N, K> {
 
     /// Writes the first `count` lanes of `s` into places `at..at + count`.
     #[inline(always)]
-    pub fn set_window<const L: usize>(&mut self, at: usize, count: usize, s: &State<Lanes<T, L>, N>) {
+    pub fn set_window<const L: usize>(
+        &mut self,
+        at: usize,
+        count: usize,
+        s: &State<Lanes<T, L>, N>,
+    ) {
         let write = |column: &mut Lanes<T, K>, lanes: &Lanes<T, L>| {
             for (place, &x) in column.0.iter_mut().skip(at).zip(lanes.0.iter().take(count)) {
                 *place = x;
