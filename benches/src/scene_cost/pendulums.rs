@@ -37,13 +37,16 @@ fn rule<T: Real>() -> Result<Sleeps<T>, Error> {
 /// The pendulum bank with sleeping by `Z`, laid out by `Y`.
 type Pendulums<T, I, Z, Y = OneByOne> = Bank<T, 1, INSTANCES, SimplePendulum<T>, I, Z, Y>;
 
+/// A scene of one [`Pendulums`] bank.
+type PendulumScene<T, I, Z, Y> = Scene<T, Pendulums<T, I, Z, Y>>;
+
 /// A scene of [`INSTANCES`] pendulums, `awake` of them swinging from 1 rad and the rest
 /// asleep at the bottom, the two kinds added interleaved.
 fn scene<T, I, Z, Y>(
     integrator: I,
     sleep: Z,
     awake: usize,
-) -> Result<Scene<T, Pendulums<T, I, Z, Y>>, Error>
+) -> Result<PendulumScene<T, I, Z, Y>, Error>
 where
     T: Real,
     I: Integrator<T, 1, SimplePendulum<T>> + Clone,
@@ -66,7 +69,7 @@ where
 }
 
 /// Steps the scene's frames until the resting ones are asleep (a second of frames).
-fn settle<T, I, Z, Y>(scene: &mut Scene<T, Pendulums<T, I, Z, Y>>) -> Result<(), Error>
+fn settle<T, I, Z, Y>(scene: &mut PendulumScene<T, I, Z, Y>) -> Result<(), Error>
 where
     T: Real,
     I: Integrator<T, 1, SimplePendulum<T>> + Clone,

@@ -94,8 +94,16 @@ impl<T: Real, const N: usize, const K: usize> Columns<T, N, K> {
         s: &State<Lanes<T, L>, N>,
     ) {
         let write = |column: &mut Lanes<T, K>, lanes: &Lanes<T, L>| {
-            for (place, &x) in column.0.iter_mut().skip(at).zip(lanes.0.iter().take(count)) {
-                *place = x;
+            // A whole group is one store of `L` lanes; a short one goes value by value.
+            let whole = column.0.get_mut(at..).and_then(|rest| rest.get_mut(..L));
+            match whole.filter(|_| count == L) {
+                Some(places) => places.copy_from_slice(&lanes.0),
+                None => {
+                    for (place, &x) in column.0.iter_mut().skip(at).zip(lanes.0.iter().take(count))
+                    {
+                        *place = x;
+                    }
+                }
             }
         };
         write(&mut self.t, &s.t);
