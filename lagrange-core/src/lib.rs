@@ -2,6 +2,10 @@
 //!
 //! The core of lagrange: `no_std`, allocation-free Lagrangian mechanics.
 //!
+//! The guide to the three crates, by task (your own mechanism, choosing an integrator,
+//! contacts, scenes, firmware), is the book in the repository's `guide/` folder
+//! (`cargo xtask guide` builds it).
+//!
 //! - [`Real`] (`f32`, `f64`) and [`Scalar`] (those and [`Dual`] numbers): every computation is
 //!   generic over the scalar, and all math goes through `libm`.
 //! - [`State`]: time, coordinates and velocities, `N` a const generic.

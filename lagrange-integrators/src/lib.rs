@@ -3,6 +3,10 @@
 //! `no_std`, allocation-free integrators for any [`Mechanism`](lagrange_core::Mechanism),
 //! generic over `f32`/`f64` and the number of degrees of freedom.
 //!
+//! The guide to the three crates, by task (your own mechanism, choosing an integrator,
+//! contacts, scenes, firmware), is the book in the repository's `guide/` folder
+//! (`cargo xtask guide` builds it).
+//!
 //! | integrator | order | kind | symplectic (energy behaviour) | accelerations per step | use it for |
 //! |---|---|---|---|---|---|
 //! | [`ExplicitEuler`] | 1 | explicit | no: gains energy | 1 | a baseline only |

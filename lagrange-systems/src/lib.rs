@@ -6,6 +6,10 @@
 //! Euler-Lagrange path can check it). Conventions: gravity `g > 0` along -y, angles in radians
 //! from the downward vertical.
 //!
+//! The guide to the three crates, by task (your own mechanism, choosing an integrator,
+//! contacts, scenes, firmware), is the book in the repository's `guide/` folder
+//! (`cargo xtask guide` builds it).
+//!
 //! | type | q | parameters |
 //! |---|---|---|
 //! | [`FallingParticle`] | `[y]` | mass, gravity |

@@ -92,6 +92,37 @@ macro_rules! for_f32_and_f64 {
 #[doc = include_str!("../../README.md")]
 pub struct ReadmeDoctests;
 
+/// Each chapter of the guide (`guide/src/`) whose Rust blocks are compiled and run as doc
+/// tests; `tests/tests/guide_blocks.rs` fails when a chapter is missing here or a block would
+/// be skipped.
+macro_rules! chapters {
+    ($($name:ident => $file:literal),* $(,)?) => {
+        $(
+            #[cfg(doctest)]
+            #[doc = include_str!(concat!("../../guide/src/", $file))]
+            pub struct $name;
+        )*
+        /// The chapters included above, by file name.
+        pub const GUIDE_CHAPTERS: &[&str] = &[$($file),*];
+    };
+}
+
+chapters! {
+    GuideIntroduction => "introduction.md",
+    GuidePendulum => "pendulum.md",
+    GuideOwnMechanism => "own-mechanism.md",
+    GuideDerive => "derive.md",
+    GuideIntegrators => "integrators.md",
+    GuideConstraints => "constraints.md",
+    GuideContacts => "contacts.md",
+    GuideScenes => "scenes.md",
+    GuideFirmware => "firmware.md",
+    GuidePage => "page.md",
+    GuideMechanisms => "mechanisms.md",
+    GuidePerformance => "performance.md",
+    GuideReliability => "reliability.md",
+}
+
 /// Problem P4's start: `mu = 1`, `e = 0.5`, `a = 1` (period `2 pi`, energy -1/2), at
 /// periapsis: `r = 0.5`, `phi = 0`, `r' = 0`, `phi' = 2 sqrt(3)`.
 #[must_use]

@@ -278,7 +278,7 @@ fn the_parameter_to_blame_is_named() {
 fn the_kepler_orbit_blames_the_factor_most_responsible() {
     let named = |r: Result<lagrange_core::State<f64, 2>, Error>| match r {
         Err(Error::InvalidParameter { name, reason }) => Some((name, reason)),
-        other => panic!("expected an invalid parameter, got {other:?}"),
+        _ => None,
     };
     let large = "too large: a quantity formed from the parameters overflows";
     let small = "too small: a quantity formed from the parameters (divided by it) overflows";

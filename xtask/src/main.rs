@@ -33,8 +33,10 @@
 //!   it in headless Chromium and compare its scenario's bits with the host's and QEMU's).
 //! - `publish`: the library crates' docs (rustdoc warnings denied) and packages, each verified
 //!   against the others' packaged files.
+//! - `guide [--figures]`: the user's guide (mdBook, `guide/`) built into `target/guide/`, its
+//!   links checked; `--figures` makes its plots and screenshot again.
 //! - `ci`: format check, clippy with `-D warnings`, the library crates' docs (warnings denied)
-//!   and packages, test, `derive --check`, cross, qemu, web --test.
+//!   and packages, test, `derive --check`, cross, qemu, web --test, guide.
 
 mod cdp;
 mod cmd;
@@ -42,9 +44,11 @@ mod cross;
 mod demo;
 mod derive;
 mod fuzz;
+mod guide;
 mod mutants;
 mod publish;
 mod qemu;
+mod tools;
 mod trig_fit;
 mod venv;
 mod web;
@@ -64,11 +68,12 @@ fn main() -> ExitCode {
         "fuzz" => fuzz::run(&std::env::args().skip(2).collect::<Vec<_>>()),
         "web" => web::run(&std::env::args().skip(2).collect::<Vec<_>>()),
         "publish" => publish::run(),
+        "guide" => guide::run(&std::env::args().skip(2).collect::<Vec<_>>()),
         "ci" => ci(),
         "trig-fit" => trig_fit::run(),
         _ => {
             eprintln!(
-                "usage: cargo xtask <demo | test | cross | bench | qemu | derive | web | mutants | fuzz | trig-fit | ci>"
+                "usage: cargo xtask <demo | test | cross | bench | qemu | derive | web | guide | mutants | fuzz | trig-fit | ci>"
             );
             return ExitCode::from(2);
         }
@@ -243,6 +248,7 @@ fn ci() -> Result<(), String> {
         cross::run(),
         qemu::run(),
         web::run(&["--test".to_string()]),
+        guide::run(&[]),
     ]
     .into_iter()
     .filter_map(Result::err)
