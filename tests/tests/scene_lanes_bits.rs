@@ -102,6 +102,9 @@ where
     Ok(())
 }
 
+/// Sets an instance's input.
+type SetInput<M, T> = fn(&mut M, T) -> Result<(), Error>;
+
 /// A scene of one bank of `M` with sleeping, laid out by `Y`.
 type Sleepy<T, const N: usize, M, I, Y> = Scene<T, Bank<T, N, K, M, I, Sleeps<T>, Y>>;
 
@@ -162,7 +165,7 @@ where
 fn in_lanes_equals_one_by_one_asleep_and_awake<T, const N: usize, M, I>(
     integrator: I,
     make: impl Fn(&mut Rng) -> Result<(M, State<T, N>), Error>,
-    input: Option<fn(&mut M, T) -> Result<(), Error>>,
+    input: Option<SetInput<M, T>>,
     seed: u64,
 ) -> Result<(), Error>
 where
@@ -321,7 +324,7 @@ fn lanes_as_alone<T: Real>() -> Result<(), Error> {
 /// Banks in lanes as banks one by one, through sleeping and waking: pendulums and cart-poles
 /// (with inputs), two methods, several seeds.
 fn lanes_as_one_by_one<T: Real>() -> Result<(), Error> {
-    let force: fn(&mut CartPole<T>, T) -> Result<(), Error> = |c, u| c.set_force(u);
+    let force: SetInput<CartPole<T>, T> = |c, u| c.set_force(u);
     for seed in [3, 4] {
         in_lanes_equals_one_by_one_asleep_and_awake(Rk4, pendulum::<T>, None, seed)?;
         in_lanes_equals_one_by_one_asleep_and_awake(Rk4, cart::<T>, Some(force), seed + 10)?;
