@@ -9,7 +9,7 @@ use super::frames::ratio;
 use super::{Ratio, Row};
 use lagrange_benches::timing::Budget;
 use lagrange_core::nalgebra::SVector;
-use lagrange_core::{Error, Gather, Lanes, State};
+use lagrange_core::{divergences, Error, Gather, Lanes, State};
 use lagrange_integrators::scene::{Bank, Id, InLanes, Layout, NeverSleeps, OneByOne, Scene, LANES};
 use lagrange_integrators::{Integrator, Rk4};
 use lagrange_systems::{DoublePendulum, SimplePendulum};
@@ -53,6 +53,7 @@ where
     let (mut lanes, lane_ids) = scene::<M, N, InLanes>(built)?;
     let (mut each, each_ids) = scene::<M, N, OneByOne>(built)?;
     let (mut r1, mut r2) = (Ok(()), Ok(()));
+    let diverged = divergences();
     let (bank_ratio, ns_each, ns_lanes) = ratio(
         budget,
         || {
@@ -68,6 +69,10 @@ where
     );
     r1?;
     r2?;
+    // Comparisons on which lanes disagreed while timed: each sent a group one by one.
+    let diverged = divergences()
+        .zip(diverged)
+        .map_or(0, |(after, before)| after.wrapping_sub(before));
     // The same frames were taken by both: the same bits.
     for (&a, &b) in lane_ids.iter().zip(&each_ids) {
         let (x, y) = (lanes.banks().state(a)?, each.banks().state(b)?);
@@ -83,7 +88,8 @@ where
     let per = |ns: f64| ns / K as f64;
     println!(
         "{name}: a bank {:.1} ns per instance-step one by one, {:.1} in lanes of {LANES} \
-         ({bank_ratio:.2}x); by hand {:.1} one by one, {:.1} in lanes ({hand_ratio:.2}x)",
+         ({bank_ratio:.2}x; {diverged} divergences while timed); by hand {:.1} one by one, {:.1} \
+         in lanes ({hand_ratio:.2}x)",
         per(ns_each),
         per(ns_lanes),
         per(ns_alone),

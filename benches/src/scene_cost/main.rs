@@ -116,10 +116,6 @@ fn run(args: &[String]) -> Result<(), String> {
     let budget = budget(quick);
     let mut rows = Vec::new();
     let mut ratios = Vec::new();
-    if std::env::var_os("LANES_ONLY").is_some() {
-        lanes::measure(budget, &mut rows, &mut ratios).map_err(|e| e.to_string())?;
-        return Ok(());
-    }
     println!("== 1000 damped pendulums at 1/120 s");
     pendulums::measure(budget, &mut rows, &mut ratios).map_err(|e| e.to_string())?;
     println!("\n== lanes");
