@@ -19,7 +19,14 @@
 //!   ([`Constrained`]), Baumgarte [`Stabilization`] and [`Projection`] against drift.
 //! - [`Jacobian`]: `d/dq` and `d/dq'` of the equations of motion, exact from dual numbers for
 //!   [`EulerLagrange`], by [`central_difference_jacobian`] otherwise (for implicit integrators).
+//! - [`links`]: where a mechanism's links are in the plane ([`links::Links`]), and the
+//!   Jacobian of a point fixed on one (by dual numbers, or by hand): what collision
+//!   detection needs of a mechanism.
 //! - [`Error`]: one small `Copy` error type for every crate.
+//! - [`closed_form`]: a mechanism given by its equations in closed form ([`ClosedForm`]: what
+//!   `lagrange-derive` generates from a SymPy spec) is a [`Mechanism`] by one generic impl;
+//!   [`parameters!`] writes a mechanism's parameter struct, validated constructor and defaults;
+//!   [`agreement`] checks any mechanism against the automatic path of its own Lagrangian.
 //!
 //! ```
 //! use lagrange_core::{EulerLagrange, Lagrangian, Mechanism, Scalar, State, ViscousDamping};
@@ -48,7 +55,9 @@
 #![no_std]
 #![forbid(unsafe_code)]
 
+pub mod agreement;
 mod cholesky;
+pub mod closed_form;
 pub mod constraints;
 mod controlled;
 mod dual;
@@ -61,7 +70,9 @@ mod jacobian;
 mod jet;
 mod lagrangian;
 mod lanes;
+pub mod links;
 mod mechanism;
+mod parameters;
 pub mod prelude;
 mod scalar;
 mod scalar_trig;
@@ -71,6 +82,7 @@ mod trig_memo;
 pub mod validate;
 
 pub use cholesky::{solve_spd, Cholesky};
+pub use closed_form::ClosedForm;
 pub use constraints::{
     Constrained, Constraints, Held, Holonomic, HolonomicConstraints, Pfaffian, PfaffianConstraints,
     Projection, Stabilization,

@@ -4,7 +4,7 @@
 
 use lagrange_core::constraints::contact::{ActiveRows, ContactModel, Contacts, Impact, Impacts};
 
-use crate::integrator::{check_run_step, check_step, continues, step_loop};
+use crate::integrator::{check_run_step, check_step, continues, finish, step_loop};
 use crate::{Cost, Failure, Integrator, Method, Work};
 use lagrange_core::constraints::Projection;
 use lagrange_core::nalgebra::SVector;
@@ -285,6 +285,7 @@ where
                 *r = *r && kept;
             }
         }
+        let s = finish(s)?;
         self.last = Some(s);
         Ok(s)
     }

@@ -24,6 +24,7 @@
 //! | [`Acrobot`] | `[th1, th2]`, th2 relative to link 1 | m1, m2, l1, l2, lc1, lc2, i1, i2, gravity; input torque |
 //! | [`SwingingAtwood`] | `[r, th]` | big_mass, small_mass, gravity |
 //! | [`Kepler`] | `[r, phi]` | mu |
+//! | [`RigidBody`] | `[x, y, th]`: centre of mass and angle | mass, inertia, gravity (or `rectangle`, `disk`); one link ([`Links`](lagrange_core::links::Links)) |
 //! | [`Ragdoll`] | `[x, y, th, 9 joints]`: torso centre and angle, joints relative | [`RagdollBody`]: ten segments, shoulder and hip widths, gravity, joint damping (`O(links)` accelerations; contacts: [`RagdollContacts`]) |
 //!
 //! Constrained mechanisms (Lagrange multipliers, see
@@ -62,9 +63,11 @@ pub mod exact;
 mod falling_particle;
 mod four_bar_linkage;
 mod kepler;
+mod links;
 mod n_link_pendulum;
 mod ragdoll;
 mod ragdoll_contacts;
+mod rigid_body;
 mod rolling_disk;
 mod simple_pendulum;
 mod small_solve;
@@ -77,6 +80,7 @@ pub use cartesian_pendulum::CartesianPendulum;
 pub use double_pendulum::DoublePendulum;
 pub use falling_particle::FallingParticle;
 pub use four_bar_linkage::{Branch, FourBarLinkage};
+pub use rigid_body::RigidBody;
 pub use rolling_disk::RollingDisk;
 pub use simple_pendulum::SimplePendulum;
 

@@ -487,18 +487,29 @@ impl<T: Real> Ragdoll<T> {
             origin: [[zero; 2]; RAGDOLL_LINKS],
             com: [[zero; 2]; RAGDOLL_LINKS],
         };
-        let mut angle = [zero; RAGDOLL_LINKS];
-        angle[TORSO] = q[2];
-        (pose.sin[TORSO], pose.cos[TORSO]) = q[2].sin_cos();
+        let angle = self.angles(q);
+        (pose.sin[TORSO], pose.cos[TORSO]) = angle[TORSO].sin_cos();
         for k in 1..RAGDOLL_LINKS {
             let j = self.joint[k];
-            angle[k] = angle[PARENT[k]] + q[k + 2] + self.rest[k];
             (pose.sin[k], pose.cos[k]) = angle[k].sin_cos();
             pose.origin[k] = pose.point(PARENT[k], S::from_real(j.along), S::from_real(j.across));
             let half = S::from_real(self.length[k] * T::HALF);
             pose.com[k] = pose.point(k, half, zero);
         }
         pose
+    }
+
+    /// Each link's absolute angle: a link points from its joint along `(sin a, -cos a)`.
+    pub(crate) fn angles<S: Scalar<Real = T>>(
+        &self,
+        q: &SVector<S, RAGDOLL_COORDINATES>,
+    ) -> [S; RAGDOLL_LINKS] {
+        let mut angle = [S::zero(); RAGDOLL_LINKS];
+        angle[TORSO] = q[2];
+        for k in 1..RAGDOLL_LINKS {
+            angle[k] = angle[PARENT[k]] + q[k + 2] + S::from_real(self.rest[k]);
+        }
+        angle
     }
 
     /// Each link's absolute angular rate.

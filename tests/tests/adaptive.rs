@@ -400,6 +400,48 @@ fn end_at_start<const S: usize, const R: usize, P: EmbeddedPair<S, R>, T: Real>(
     Ok(())
 }
 
+/// A state handed back an ulp before the end of the run it continues (a driver's clock
+/// rounding: the run goes on from it), and `next_step` to that end: one step's result and
+/// its dense interval, whether the run's last step reaches back past it (the landing, at the
+/// run's end exactly) or the run took no step (a step from the state). Both returned the
+/// run's state with no dense interval (found by `cargo xtask fuzz`, DOP853 at t = 1.9e-308).
+fn end_an_ulp_after_a_continued_state<const S: usize, const R: usize, P, T>() -> Result<(), Error>
+where
+    P: EmbeddedPair<S, R>,
+    T: Real,
+{
+    let p = SimplePendulum::new(T::one(), T::one(), T::from_f64(G), T::zero())?;
+    let settings = AdaptiveSettings::new(T::from_f64(1e-4), T::from_f64(1e-6))?;
+    let early = |s: State<T, 1>| State {
+        t: s.t - T::EPSILON,
+        ..s
+    };
+    let mut rk = EmbeddedRungeKutta::<T, 1, S, R, P>::new(settings);
+    let start = State::new(T::one(), [T::HALF], [T::zero()]);
+    let end = rk.integrate_to(&p, &start, T::from_f64(1.25))?;
+    let landed = rk.next_step(&p, &early(end), end.t)?;
+    assert_eq!(landed, end, "{}", P::NAME);
+    let interval = rk.dense_interval();
+    assert!(
+        interval.is_some_and(|(t0, t1)| t0 < end.t && t1 == end.t),
+        "{}: {interval:?}",
+        P::NAME
+    );
+
+    let mut rk = EmbeddedRungeKutta::<T, 1, S, R, P>::new(settings);
+    let at = State::new(T::from_f64(1.25), [T::HALF], [T::zero()]);
+    assert_eq!(rk.integrate_to(&p, &at, at.t).map_err(|f| f.error)?, at);
+    let stepped = rk.next_step(&p, &early(at), at.t)?;
+    assert_eq!(stepped.t, at.t, "{}", P::NAME);
+    assert_eq!(
+        rk.dense_interval(),
+        Some((early(at).t, at.t)),
+        "{}",
+        P::NAME
+    );
+    Ok(())
+}
+
 fn every_pair_refuses_a_step_to_its_start<T: Real>() -> Result<(), Error> {
     end_at_start::<7, 1, lagrange_integrators::Dopri5Pair, T>()?;
     end_at_start::<16, 4, lagrange_integrators::Dop853Pair, T>()?;
@@ -410,12 +452,23 @@ fn every_pair_refuses_a_step_to_its_start<T: Real>() -> Result<(), Error> {
     end_at_start::<17, 2, lagrange_integrators::Verner98Pair, T>()
 }
 
+fn every_pair_steps_to_an_end_an_ulp_after_a_continued_state<T: Real>() -> Result<(), Error> {
+    end_an_ulp_after_a_continued_state::<7, 1, lagrange_integrators::Dopri5Pair, T>()?;
+    end_an_ulp_after_a_continued_state::<16, 4, lagrange_integrators::Dop853Pair, T>()?;
+    end_an_ulp_after_a_continued_state::<6, 2, lagrange_integrators::Nystrom64Pair, T>()?;
+    end_an_ulp_after_a_continued_state::<9, 2, lagrange_integrators::Nystrom86Pair, T>()?;
+    end_an_ulp_after_a_continued_state::<18, 2, lagrange_integrators::Nystrom1210Pair, T>()?;
+    end_an_ulp_after_a_continued_state::<11, 2, lagrange_integrators::Verner76Pair, T>()?;
+    end_an_ulp_after_a_continued_state::<17, 2, lagrange_integrators::Verner98Pair, T>()
+}
+
 for_f32_and_f64!(
     adaptive_in_both_precisions,
     impossible_runs_are_errors,
     bad_settings_and_calls_are_refused,
     adaptive_overflow_is_rejected,
-    every_pair_refuses_a_step_to_its_start
+    every_pair_refuses_a_step_to_its_start,
+    every_pair_steps_to_an_end_an_ulp_after_a_continued_state
 );
 
 /// An input changed between calls: after `restart` the next call starts afresh from the

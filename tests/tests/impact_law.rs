@@ -5,7 +5,9 @@
 
 use lagrange_core::constraints::contact::{drop_dependent_contacts, ActiveRows, Impacts};
 use lagrange_core::nalgebra::{Matrix2, Matrix3, SMatrix, SVector, Vector2, Vector3};
-use lagrange_core::{Constraints, Error, EulerLagrange, Lagrangian, Mechanism, Scalar, State};
+use lagrange_core::{
+    Constraints, Error, EulerLagrange, Lagrangian, Mechanism, Real, Scalar, State,
+};
 use lagrange_integrators::{ContactModel, Contacts};
 
 /// Rounding of velocities of order 1 after a 2x2 solve.
@@ -366,4 +368,35 @@ fn sliding_friction_acts_at_resting_contacts_only() -> Result<(), Error> {
         "{a}"
     );
     Ok(())
+}
+
+/// A model gives back the figures it was made with, exactly (its accessors store and return,
+/// with no arithmetic between), in `f32` and `f64`; the event-location tolerance among them,
+/// which the stepper's crossing search stops at.
+fn a_model_keeps_its_figures<T: Real>() -> Result<(), Error> {
+    let (e, rest, tol, mu) = (
+        T::from_f64(0.25),
+        T::from_f64(0.3),
+        T::from_f64(1e-6),
+        T::from_f64(0.7),
+    );
+    let m = ContactModel::new(e, rest, tol)?.with_friction(mu)?;
+    assert!(
+        m.restitution() == e
+            && m.rest_speed() == rest
+            && m.time_tolerance() == tol
+            && m.friction() == mu,
+        "{m:?}"
+    );
+    Ok(())
+}
+
+#[test]
+fn a_model_keeps_its_figures_f32() -> Result<(), Error> {
+    a_model_keeps_its_figures::<f32>()
+}
+
+#[test]
+fn a_model_keeps_its_figures_f64() -> Result<(), Error> {
+    a_model_keeps_its_figures::<f64>()
 }

@@ -1,6 +1,8 @@
-//! `cargo xtask cross`: the library crates (and the generated mechanisms) built for a
-//! Cortex-M4F, and the size of a linked `no_std` binary that uses them with no global
-//! allocator.
+//! `cargo xtask cross`: the library crates (and the generated mechanisms) built for every
+//! core of [`TARGETS`] (Cortex-M4F, M0+, M33, RV32IMAC), and the size of a linked `no_std`
+//! binary that uses them with no global allocator (on the M4F). That no stepping code keeps a
+//! panic path on any of them is `cargo xtask qemu`'s check (the panic-free image, linked for
+//! each core).
 //!
 //! Each library crate is built on its own with `-p`, so that workspace feature unification (a
 //! `std` feature turned on by `tests` or `xtask`) cannot hide a `no_std` failure. The smoke
@@ -16,11 +18,29 @@ use crate::cmd;
 /// too: generated code must be `no_std` like the library (it has no features).
 const GENERATED: &str = "lagrange-generated";
 
-/// The embedded target every build in this task uses.
+/// The embedded target of the smoke binary (and of the Cortex-M4F firmware).
 pub(crate) const TARGET: &str = "thumbv7em-none-eabihf";
 
-/// The library crates, each built for [`TARGET`] with every entry of [`FEATURE_SETS`].
-const CRATES: [&str; 3] = ["lagrange-core", "lagrange-integrators", "lagrange-systems"];
+/// Every target the library crates are built for: the Cortex-M4F (single-precision FPU), the
+/// Cortex-M0+ (ARMv6-M: no FPU, no divide instruction), the Cortex-M33 (ARMv8-M mainline,
+/// single-precision FPU) and RV32IMAC (no FPU).
+pub(crate) const TARGETS: [&str; 4] = [
+    TARGET,
+    "thumbv6m-none-eabi",
+    "thumbv8m.main-none-eabihf",
+    "riscv32imac-unknown-none-elf",
+];
+
+/// The library crates, each built for [`TARGET`] with every entry of [`FEATURE_SETS`] and for
+/// the other [`TARGETS`] with the last (`defmt` on top of the defaults: the same code and the
+/// derives, so that a build more per target and crate would check nothing new there; the
+/// default set alone is built for them by `cargo xtask qemu`'s firmware).
+const CRATES: [&str; 4] = [
+    "lagrange-core",
+    "lagrange-integrators",
+    "lagrange-systems",
+    "lagrange-world",
+];
 
 /// The extra cargo arguments of each feature set: default features, then `defmt` on top.
 const FEATURE_SETS: [&[&str]; 2] = [&[], &["--features", "defmt"]];
@@ -31,6 +51,13 @@ const SMOKE_DIR: &str = "embedded/smoke";
 /// The smoke firmware's binary name (its package name).
 const SMOKE_BIN: &str = "lagrange-smoke";
 
+/// The embassy example's directory (an nRF52840 application: `cargo xtask cross` builds it,
+/// checks its format and lints it; QEMU has no nRF52 board to run it on).
+const EMBASSY_DIR: &str = "embedded/embassy-cartpole";
+
+/// The embassy example's binary name.
+const EMBASSY_BIN: &str = "lagrange-embassy-cartpole";
+
 /// The sections whose sizes are reported.
 const SECTIONS: [&str; 4] = [".text", ".rodata", ".data", ".bss"];
 
@@ -38,25 +65,33 @@ const SECTIONS: [&str; 4] = [".text", ".rodata", ".data", ".bss"];
 /// every step runs and every failure is reported at the end.
 pub fn run() -> Result<(), String> {
     let mut failures = Vec::new();
-    if let Err(e) = ensure_target() {
-        failures.push(e);
-    }
-    for krate in CRATES {
-        for features in FEATURE_SETS {
-            let built = cmd::run(
-                cmd::cargo()
-                    .args(["build", "--quiet", "-p", krate, "--target", TARGET])
-                    .args(features),
-            );
-            if let Err(e) = built {
-                failures.push(e);
+    for target in TARGETS {
+        if let Err(e) = ensure_rustup_target(target) {
+            failures.push(e);
+            continue;
+        }
+        let sets = if target == TARGET {
+            &FEATURE_SETS[..]
+        } else {
+            &FEATURE_SETS[FEATURE_SETS.len() - 1..]
+        };
+        for krate in CRATES {
+            for &features in sets {
+                let built = cmd::run(
+                    cmd::cargo()
+                        .args(["build", "--quiet", "-p", krate, "--target", target])
+                        .args(features),
+                );
+                if let Err(e) = built {
+                    failures.push(e);
+                }
             }
         }
-    }
-    if let Err(e) =
-        cmd::run(cmd::cargo().args(["build", "--quiet", "-p", GENERATED, "--target", TARGET]))
-    {
-        failures.push(e);
+        if let Err(e) =
+            cmd::run(cmd::cargo().args(["build", "--quiet", "-p", GENERATED, "--target", target]))
+        {
+            failures.push(e);
+        }
     }
     match build_smoke() {
         Ok(elf) => match section_sizes(&elf) {
@@ -65,6 +100,18 @@ pub fn run() -> Result<(), String> {
         },
         Err(e) => failures.push(e),
     }
+    let clock = std::time::Instant::now();
+    match build_embassy() {
+        Ok(elf) => match section_sizes(&elf) {
+            Ok(sizes) => print_sizes(&elf, &sizes),
+            Err(e) => failures.push(format!("{}: {e}", elf.display())),
+        },
+        Err(e) => failures.push(e),
+    }
+    println!(
+        "embassy example: linted and built in {:.0} s",
+        clock.elapsed().as_secs_f64()
+    );
     if failures.is_empty() {
         println!("xtask cross: all builds passed");
         Ok(())
@@ -131,6 +178,36 @@ fn build_smoke() -> Result<PathBuf, String> {
     Ok(target_dir.join(TARGET).join("release").join(SMOKE_BIN))
 }
 
+/// Checks the embassy example's format, lints it (`-D warnings`; it is outside the host
+/// workspace, so `cargo xtask ci`'s fmt and clippy do not see it) and builds it in release;
+/// the path of its ELF. Its target comes from its `.cargo/config.toml` and is passed too.
+fn build_embassy() -> Result<PathBuf, String> {
+    let dir = cmd::project_root().join(EMBASSY_DIR);
+    let target_dir = dir.join("target");
+    let fmt = cmd::run(
+        cmd::cargo()
+            .current_dir(&dir)
+            .args(["fmt", "--", "--check"]),
+    );
+    let clippy = cmd::run(
+        cmd::cargo()
+            .current_dir(&dir)
+            .args(["clippy", "--quiet", "--release", "--target", TARGET])
+            .arg("--target-dir")
+            .arg(&target_dir)
+            .args(["--", "-D", "warnings"]),
+    );
+    let build = cmd::run(
+        cmd::cargo()
+            .current_dir(&dir)
+            .args(["build", "--quiet", "--release", "--target", TARGET])
+            .arg("--target-dir")
+            .arg(&target_dir),
+    );
+    fmt.and(clippy).and(build)?;
+    Ok(target_dir.join(TARGET).join("release").join(EMBASSY_BIN))
+}
+
 /// Prints each of [`SECTIONS`] with its size in bytes.
 fn print_sizes(elf: &Path, sizes: &[(&str, Option<u32>)]) {
     println!("{} ({TARGET}, release):", elf.display());
@@ -145,10 +222,10 @@ fn print_sizes(elf: &Path, sizes: &[(&str, Option<u32>)]) {
 /// The size of each of [`SECTIONS`] in the ELF file at `path` (`None` when it has none).
 ///
 /// # Errors
-/// When the file cannot be read or parsed, or was not linked with cortex-m-rt's `link.x` (no
-/// `.vector_table`, or an empty `.text`): `RUSTFLAGS` in the environment, for one, replaces the
-/// `-Tlink.x` of `embedded/smoke/.cargo/config.toml`, and the linker then silently drops every
-/// section.
+/// When the file cannot be read or parsed, or was not linked with the runtime's `link.x` (no
+/// `.vector_table` of cortex-m-rt's nor `.init.rust` of riscv-rt's, or an empty `.text`):
+/// `RUSTFLAGS` in the environment, for one, replaces the `-Tlink.x` of
+/// `embedded/smoke/.cargo/config.toml`, and the linker then silently drops every section.
 pub(crate) fn section_sizes(path: &Path) -> Result<Vec<(&'static str, Option<u32>)>, String> {
     let bytes = std::fs::read(path).map_err(|e| format!("cannot read: {e}"))?;
     let sections = elf32_sections(&bytes)?;
@@ -158,10 +235,12 @@ pub(crate) fn section_sizes(path: &Path) -> Result<Vec<(&'static str, Option<u32
             .find(|(name, _)| name == wanted)
             .map(|&(_, size)| size)
     };
-    if size_of(".vector_table").is_none() || size_of(".text").unwrap_or(0) == 0 {
+    let runtime = size_of(".vector_table").or(size_of(".init.rust"));
+    if runtime.is_none() || size_of(".text").unwrap_or(0) == 0 {
         return Err(
-            "no .vector_table or an empty .text: not linked with cortex-m-rt's link.x \
-             (RUSTFLAGS, when set, overrides embedded/smoke/.cargo/config.toml's -Tlink.x)"
+            "no .vector_table (cortex-m-rt) or .init.rust (riscv-rt), or an empty .text: not \
+             linked with the runtime's link.x (RUSTFLAGS, when set, overrides \
+             embedded/smoke/.cargo/config.toml's -Tlink.x)"
                 .into(),
         );
     }

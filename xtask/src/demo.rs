@@ -1,13 +1,13 @@
 //! `cargo xtask demo`: runs the examples of `examples/`, optimised, one after the other: the
 //! origin's pendulum with every integrator, the chaotic double pendulum's energy, your own
 //! mechanism, every standard mechanism, a mechanism SymPy derived (`cargo xtask derive`),
-//! constraints, impacts, a game loop and a ragdoll thrown onto a floor (with its cost per step
+//! constraints, impacts, a game loop, a scene of sleeping lamps and a ragdoll thrown onto a floor (with its cost per step
 //! beside a chain's). Their figures go to `target/lagrange-demo/`.
 
 use crate::cmd;
 
 /// The examples, in the order the demo runs them.
-const EXAMPLES: [&str; 9] = [
+const EXAMPLES: [&str; 10] = [
     "origin_pendulum",
     "double_pendulum_energy",
     "own_mechanism",
@@ -16,6 +16,7 @@ const EXAMPLES: [&str; 9] = [
     "four_bar",
     "impacts",
     "game_loop",
+    "scene",
     "ragdoll",
 ];
 

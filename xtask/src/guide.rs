@@ -193,7 +193,13 @@ fn check_links(out: &Path) -> Result<(usize, usize), String> {
             let target = if path.is_empty() {
                 page.clone()
             } else {
-                let joined = page.parent().unwrap_or(out).join(path);
+                // A path from the site's root (mdBook's 404 page) is from the book's.
+                let base = if path.starts_with('/') {
+                    out
+                } else {
+                    page.parent().unwrap_or(out)
+                };
+                let joined = base.join(path.trim_start_matches('/'));
                 if path.ends_with('/') {
                     joined.join("index.html")
                 } else {

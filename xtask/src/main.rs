@@ -13,17 +13,21 @@
 //!   `--contacts`: ns per step of the contact steppers (thrown ragdoll, double pendulum on
 //!   the floor, bouncing ball) against a free RK4 step and against rapier2d, with depth and
 //!   energy gain (`contacts.csv`, `contacts.md`).
-//! - `cross`: thumbv7em-none-eabihf builds of the library crates, with and without `defmt`,
-//!   and a linked no_std binary with no allocator, with its size.
-//! - `qemu`: the firmware on an emulated Cortex-M4F (QEMU `mps2-an386`), its defmt log compared
-//!   bit for bit with the host, instructions per step, stack and `.text` sizes, the panic-free
-//!   image; installs QEMU and `defmt-print` when missing.
+//! - `cross`: builds of the library crates for the Cortex-M4F, M0+, M33 and RV32IMAC, with and
+//!   without `defmt`, a linked no_std binary with no allocator, with its size, and the embassy
+//!   example (`embedded/embassy-cartpole`, an nRF52840 application) linted and built.
+//! - `qemu`: the firmware on emulated cores (Cortex-M4F, M33, M0, RV32IMAC, RV32IMAFC), its
+//!   defmt log compared bit for bit with the host, instructions per step, stack and `.text`
+//!   sizes per core and side by side, the panic-free image on each; installs QEMU and
+//!   `defmt-print` when missing.
 //! - `trig-fit`: derives the polynomials and constants of `lagrange_core::fast_trig` and
 //!   checks the library's against them.
-//! - `derive SPEC.py [--out FILE.rs] [--name TypeName] [--tests]`: the origin's workflow,
-//!   SymPy derives the Euler-Lagrange equations of a spec's `T` and `V` and this writes a
-//!   `no_std` Rust mechanism (see `derive.rs`); `derive --check` regenerates the committed
-//!   ones under `derive/generated/` and checks that bad specs are refused.
+//! - `derive SPEC.py [--out FILE.rs] [--name TypeName] [--tests]`: the installable
+//!   `lagrange-derive` command (the same code, as a library): SymPy derives the
+//!   Euler-Lagrange equations of a spec's `T` and `V` and this writes a `no_std` Rust
+//!   mechanism; `derive --check` regenerates the committed ones under `derive/generated/`,
+//!   checks that bad specs and bad uses are refused, and builds the odd-name specs of
+//!   `derive/odd/` in a scratch crate with clippy, rustfmt and their tests.
 //! - `mutants`: mutation testing of the numerical core with `cargo-mutants`, a report per file
 //!   under `target/mutants/` (hours; not part of `ci`).
 //! - `fuzz [CALLS] [--seed S]`: the hostile-input campaign (`tests/tests/hostile`) in release,
@@ -50,7 +54,6 @@ mod publish;
 mod qemu;
 mod tools;
 mod trig_fit;
-mod venv;
 mod web;
 
 use std::process::ExitCode;

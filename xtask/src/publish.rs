@@ -1,4 +1,4 @@
-//! The library crates as they would be published: their documentation with rustdoc's
+//! The publishable crates as they would be published: their documentation with rustdoc's
 //! warnings denied, and their packages, each built from its packaged files against the
 //! others' packages.
 
@@ -6,14 +6,19 @@ use std::path::{Path, PathBuf};
 
 use crate::cmd;
 
-/// The publishable library crates, as `cargo -p` arguments.
-const LIBRARIES: [&str; 6] = [
+/// The publishable crates, as `cargo -p` arguments: the four libraries and the
+/// `lagrange-derive` command (its package must carry `derive.py`, which it includes).
+const LIBRARIES: [&str; 10] = [
     "-p",
     "lagrange-core",
     "-p",
     "lagrange-integrators",
     "-p",
     "lagrange-systems",
+    "-p",
+    "lagrange-world",
+    "-p",
+    "lagrange-derive",
 ];
 
 /// The crate names of [`LIBRARIES`].

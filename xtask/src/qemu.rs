@@ -1,23 +1,25 @@
-//! `cargo xtask qemu`: the firmware of `embedded/firmware` run on an emulated Cortex-M4F,
-//! compared bit for bit with the host, with its costs, sizes and stack.
+//! `cargo xtask qemu`: the firmware of `embedded/firmware` run on emulated cores (Cortex-M4F,
+//! M33, M0, RV32IMAC, RV32IMAFC: [`CORES`]), compared bit for bit with the host, with its
+//! costs, sizes and stack on each.
 //!
-//! 1. Installs what is missing: the `thumbv7em-none-eabihf` target (rustup), `qemu-system-arm`
-//!    (Debian's package, by `apt-get`), `defmt-print` (crates.io, `cargo install --locked` at a
-//!    pinned version).
-//! 2. Builds the firmware in release (opt-level 3, fat LTO): the lockstep image, the
-//!    one-mechanism image (also with `libm-trig`, for comparison), the panic-free image (whose
-//!    link fails if any panic path is left in the stepping code).
-//! 3. Runs each under `qemu-system-arm -machine mps2-an386` with `-icount shift=0` (one
-//!    instruction, one nanosecond of virtual time), semihosting on, inside a timeout: a hang, a
-//!    panic or a fault fails the run.
+//! 1. Installs what is missing: the targets (rustup), `qemu-system-arm` and
+//!    `qemu-system-riscv32` (Debian's `qemu-system-arm` and `qemu-system-misc`, by `apt-get`),
+//!    `defmt-print` (crates.io, `cargo install --locked` at a pinned version).
+//! 2. Builds the firmware in release (opt-level 3, fat LTO) for each core: the lockstep image,
+//!    the one-mechanism image, the panic-free image (whose link fails if any panic path is left
+//!    in the stepping code on that core; on every core but RV32IMAFC, which `cargo xtask cross`
+//!    does not build for); on the M4F also the one-mechanism image with `libm-trig` and the
+//!    size images (scene, loop, ragdoll).
+//! 3. Runs each under QEMU with `-icount shift=0` (one instruction, one nanosecond of virtual
+//!    time), semihosting on, inside a timeout: a hang, a panic or a fault fails the run.
 //! 4. Decodes the lockstep image's defmt log with `defmt-print`, runs the same
 //!    `lagrange_cases::CASES` on the host, and compares every final state bit for bit.
-//! 5. Reports instructions per step of every case (SysTick ticks of a run of `STEPS` steps less
+//! 5. Reports instructions per step of every case (counter ticks of a run of `STEPS` steps less
 //!    those of a run of none, times instructions per tick as the firmware's calibration loop
 //!    measures it), the worst single step of the cases that time their steps (the ragdoll
 //!    landing under the impulse stepper, beside its free RK4 step), stack high-water marks and
-//!    `.text` sizes (the ragdoll stepped with and without the impulse stepper among them), and
-//!    checks the budgets.
+//!    `.text` sizes, checks the M4F's budgets, and ends with one table of the cores side by
+//!    side and what it means for a Cortex-M0+ at 48 MHz stepping at 1 kHz.
 
 use std::collections::BTreeMap;
 use std::io::{Read, Write};
@@ -31,23 +33,103 @@ use lagrange_cases::{
 };
 
 use crate::cmd;
-use crate::cross::{self, TARGET};
+use crate::cross;
 
 /// The firmware crate, relative to the project root.
 const FIRMWARE_DIR: &str = "embedded/firmware";
 
-/// The emulator, from Debian's package of the same name.
-const QEMU: &str = "qemu-system-arm";
+/// A core the firmware runs on, and the QEMU board that emulates it.
+pub(crate) struct Core {
+    /// Its name in the tables.
+    name: &'static str,
+    /// The Rust target the firmware is built for.
+    target: &'static str,
+    /// The emulator.
+    qemu: &'static str,
+    /// The Debian package the emulator is in.
+    package: &'static str,
+    /// The board's arguments (machine, CPU, memory).
+    machine: &'static [&'static str],
+    /// The board and counter, for the tables' headings.
+    board: &'static str,
+    /// Whether the panic-free image is linked and run for it (every core that `cargo xtask
+    /// cross` builds the library for).
+    panic_free: bool,
+}
 
-/// The emulator's arguments before the ELF: the MPS2 board with the AN386 image (a Cortex-M4
-/// with FPU), no display, monitor or serial (the log goes through semihosting to stdout), and
-/// deterministic instruction counting: each instruction advances the virtual clock by 2^0 ns,
-/// with no alignment to real time and no sleeping.
-const QEMU_ARGS: [&str; 14] = [
-    "-machine",
-    "mps2-an386",
-    "-cpu",
-    "cortex-m4",
+/// The Cortex-M4F on the MPS2 board with the AN386 image: the core the budgets are for, and
+/// the one the size images and `cargo xtask web --test` use.
+const M4F: Core = Core {
+    name: "M4F",
+    target: cross::TARGET,
+    qemu: "qemu-system-arm",
+    package: "qemu-system-arm",
+    machine: &["-machine", "mps2-an386", "-cpu", "cortex-m4"],
+    board: "QEMU mps2-an386, SysTick at 25 MHz",
+    panic_free: true,
+};
+
+/// Every core `cargo xtask qemu` runs, the M4F first.
+///
+/// The M0 stands for the M0+ (both ARMv6-M: the same instructions, so the same counts; the
+/// M0+ takes fewer cycles for some). QEMU's micro:bit is an nRF51 with 256 KiB of flash and
+/// 16 KiB of SRAM: both are enlarged (`memory/microbit.x` says to what), so that it runs the
+/// lockstep image whole. Every case but the ragdoll landing fits the nRF51's own 16 KiB (7.1 kB
+/// of stack at most); the landing's 47.9 kB of stack needs an RP2040's or a larger STM32G0's
+/// RAM.
+/// The RISC-V cores run on QEMU's `virt` board with no firmware (`-bios none`), counting
+/// instructions with `minstret`.
+pub(crate) const CORES: [Core; 5] = [
+    M4F,
+    Core {
+        name: "M33",
+        target: "thumbv8m.main-none-eabihf",
+        qemu: "qemu-system-arm",
+        package: "qemu-system-arm",
+        machine: &["-machine", "mps2-an505", "-cpu", "cortex-m33"],
+        board: "QEMU mps2-an505, SysTick at 20 MHz",
+        panic_free: true,
+    },
+    Core {
+        name: "M0",
+        target: "thumbv6m-none-eabi",
+        qemu: "qemu-system-arm",
+        package: "qemu-system-arm",
+        machine: &[
+            "-machine",
+            "microbit",
+            "-global",
+            "nrf51-soc.flash-size=4194304",
+            "-global",
+            "nrf51-soc.sram-size=262144",
+        ],
+        board: "QEMU microbit (nRF51, memory enlarged), SysTick at 16 MHz",
+        panic_free: true,
+    },
+    Core {
+        name: "RV32IMAC",
+        target: "riscv32imac-unknown-none-elf",
+        qemu: "qemu-system-riscv32",
+        package: "qemu-system-misc",
+        machine: &["-machine", "virt", "-bios", "none"],
+        board: "QEMU virt, minstret",
+        panic_free: true,
+    },
+    Core {
+        name: "RV32IMAFC",
+        target: "riscv32imafc-unknown-none-elf",
+        qemu: "qemu-system-riscv32",
+        package: "qemu-system-misc",
+        machine: &["-machine", "virt", "-bios", "none"],
+        board: "QEMU virt, minstret",
+        panic_free: false,
+    },
+];
+
+/// The emulator's arguments after the board's: no display, monitor or serial (the log goes
+/// through semihosting to stdout), and deterministic instruction counting: each instruction
+/// advances the virtual clock by 2^0 ns, with no alignment to real time and no sleeping.
+const QEMU_ARGS: [&str; 10] = [
     "-display",
     "none",
     "-monitor",
@@ -85,63 +167,35 @@ const ONE_MECHANISM_TEXT_BUDGET: u32 = 8 * 1024;
 pub fn run() -> Result<(), String> {
     let clock = Instant::now();
     let mut failures = Vec::new();
-    let tools = [cross::ensure_target(), ensure_qemu(), ensure_defmt_print()];
+    let mut tools: Vec<Result<(), String>> = CORES
+        .iter()
+        .map(|core| cross::ensure_rustup_target(core.target))
+        .collect();
+    tools.extend(CORES.iter().map(ensure_qemu));
+    tools.push(ensure_defmt_print());
     let tools: Result<Vec<()>, String> = tools.into_iter().collect();
     let decoder = match tools.and_then(|_| defmt_print()) {
         Ok(decoder) => decoder,
         Err(e) => return Err(format!("xtask qemu: missing tools: {e}")),
     };
     failures.extend(lint().err());
-    // The libm-trig one-mechanism image first: the default build then overwrites its ELF.
-    let libm_text = build(&["--bin", "one-mechanism", "--features", "libm-trig"])
-        .and_then(|dir| text_size(&dir.join("one-mechanism")));
-    let dir = match build(&[
-        "--bin",
-        "lockstep",
-        "--bin",
-        "one-mechanism",
-        "--bin",
-        "scene-text",
-        "--bin",
-        "loop-text",
-        "--bin",
-        "ragdoll-text",
-        "--bin",
-        "ragdoll-impulse-text",
-    ]) {
-        Ok(dir) => dir,
-        Err(e) => return Err(format!("xtask qemu: {e}")),
-    };
-    // Its own build, so that a failure to link names the check that failed.
-    let panic_free = build(&["--bin", "panic-free"]).map_err(|e| {
-        format!("panic-free image: a panic path is left in the stepping code, or ({e})")
-    });
-    match &panic_free {
-        Ok(_) => println!(
-            "panic-free image linked: no panic path in the stepping code (the ragdoll's \
-             impulse stepper included)"
-        ),
-        Err(e) => failures.push(e.clone()),
-    }
-
-    match lockstep(&dir.join("lockstep"), &decoder) {
-        Ok(errors) => failures.extend(errors),
-        Err(e) => failures.push(e),
-    }
-    let images: &[&str] = if panic_free.is_ok() {
-        &["one-mechanism", "panic-free"]
-    } else {
-        &["one-mechanism"]
-    };
-    for image in images {
-        if let Err(e) = run_image(&dir.join(image)) {
-            failures.push(e);
+    let mut rows = Vec::new();
+    for core in &CORES {
+        let started = Instant::now();
+        match run_core(core, &decoder) {
+            Ok((row, errors)) => {
+                failures.extend(errors);
+                rows.push(row);
+            }
+            Err(e) => failures.push(format!("{}: {e}", core.name)),
         }
+        println!(
+            "{}: built and run in {:.0} s",
+            core.name,
+            started.elapsed().as_secs_f64()
+        );
     }
-    match sizes(&dir, images, libm_text) {
-        Ok(errors) => failures.extend(errors),
-        Err(e) => failures.push(e),
-    }
+    summary(&rows);
     println!("xtask qemu: {:.0} s", clock.elapsed().as_secs_f64());
     if failures.is_empty() {
         println!("xtask qemu: all checks passed");
@@ -151,15 +205,106 @@ pub fn run() -> Result<(), String> {
     }
 }
 
-/// The final-state words the firmware reports under QEMU for every lockstep case, by case
-/// id (`None`: the case returned an error): the lockstep image built (a no-op when `qemu`
-/// built it already), run and its log decoded. For `cargo xtask web --test`.
+/// The images every core builds and runs besides the lockstep image.
+const IMAGES: [&str; 2] = ["one-mechanism", "panic-free"];
+
+/// The M4F's images that are only measured (`.text`), not run.
+const SIZE_IMAGES: [&str; 4] = [
+    "scene-text",
+    "loop-text",
+    "ragdoll-text",
+    "ragdoll-impulse-text",
+];
+
+/// Builds, runs and reports one core: its row of the summary and its failed checks; `Err`
+/// when the lockstep image could not be built.
+fn run_core(core: &Core, decoder: &Path) -> Result<(Row, Vec<String>), String> {
+    let mut failures = Vec::new();
+    let is_m4f = core.target == M4F.target;
+    // The libm-trig one-mechanism image first: the default build then overwrites its ELF.
+    let libm_text = is_m4f.then(|| {
+        build(core, &["--bin", "one-mechanism", "--features", "libm-trig"])
+            .and_then(|dir| text_size(&dir.join("one-mechanism")))
+    });
+    let mut bins = vec!["lockstep", "one-mechanism"];
+    if is_m4f {
+        bins.extend(SIZE_IMAGES);
+    }
+    let args: Vec<&str> = bins.iter().flat_map(|bin| ["--bin", bin]).collect();
+    // Off the M4F, the panic-free image links beside the others (two links at a time on two
+    // cores); only if that fails are they built apart, so that the failure names its check.
+    let together = !is_m4f
+        && core.panic_free
+        && build(core, &[args.as_slice(), &["--bin", "panic-free"]].concat()).is_ok();
+    let dir = build(core, &args)?;
+    let panic_free = if together {
+        Ok(())
+    } else if core.panic_free {
+        build(core, &["--bin", "panic-free"]).map(|_| ())
+    } else {
+        Err(String::new())
+    };
+    match &panic_free {
+        Ok(()) => println!(
+            "{}: panic-free image linked: no panic path in the stepping code (the ragdoll's \
+             impulse stepper included)",
+            core.name
+        ),
+        Err(e) if core.panic_free => failures.push(format!(
+            "{}: panic-free image: a panic path is left in the stepping code, or ({e})",
+            core.name
+        )),
+        Err(_) => println!(
+            "{}: no panic-free image (a core of `cargo xtask qemu` only, not of `cargo xtask \
+             cross`: its link would cost CI a minute)",
+            core.name
+        ),
+    }
+    let mut row = match lockstep(core, &dir.join("lockstep"), decoder) {
+        Ok((row, errors)) => {
+            failures.extend(errors);
+            row
+        }
+        Err(e) => {
+            failures.push(format!("{}: {e}", core.name));
+            Row::default()
+        }
+    };
+    row.core = core.name;
+    let images: &[&str] = if panic_free.is_ok() {
+        &IMAGES
+    } else {
+        &IMAGES[..1]
+    };
+    for image in images {
+        if let Err(e) = run_image(core, &dir.join(image)) {
+            failures.push(e);
+        }
+    }
+    row.text = text_size(&dir.join("lockstep")).ok();
+    row.one_mechanism_text = text_size(&dir.join("one-mechanism")).ok();
+    if let Some(libm_text) = libm_text {
+        match sizes(&dir, images, libm_text) {
+            Ok(errors) => failures.extend(errors),
+            Err(e) => failures.push(e),
+        }
+    }
+    Ok((row, failures))
+}
+
+/// The final-state words the firmware reports under QEMU on the M4F for every lockstep case,
+/// by case id (`None`: the case returned an error): the lockstep image built (a no-op when
+/// `qemu` built it already), run and its log decoded. For `cargo xtask web --test`.
 pub fn lockstep_states() -> Result<BTreeMap<usize, Option<Vec<u64>>>, String> {
-    let tools = [cross::ensure_target(), ensure_qemu(), ensure_defmt_print()];
+    let tools = [
+        cross::ensure_target(),
+        ensure_qemu(&M4F),
+        ensure_defmt_print(),
+    ];
     tools.into_iter().collect::<Result<Vec<()>, String>>()?;
     let decoder = defmt_print()?;
-    let elf = build(&["--bin", "lockstep"])?.join("lockstep");
-    let log = decode(&elf, &decoder)?;
+    let elf = build(&M4F, &["--bin", "lockstep"])?.join("lockstep");
+    let log = decode(&M4F, &elf, &decoder)?;
     if !log.done {
         return Err("the firmware log ends before `done`".into());
     }
@@ -167,8 +312,8 @@ pub fn lockstep_states() -> Result<BTreeMap<usize, Option<Vec<u64>>>, String> {
 }
 
 /// Runs the lockstep image under QEMU and decodes and parses its log.
-fn decode(elf: &Path, decoder: &Path) -> Result<Log, String> {
-    let raw = run_in_qemu(elf)?;
+fn decode(core: &Core, elf: &Path, decoder: &Path) -> Result<Log, String> {
+    let raw = run_in_qemu(core, elf)?;
     let (status, decoded) = run_captured(
         Command::new(decoder)
             .arg("-e")
@@ -192,24 +337,34 @@ pub(crate) fn works(program: &Path, args: &[&str]) -> bool {
         .is_ok_and(|s| s.success())
 }
 
-/// Installs `qemu-system-arm` with `apt-get` when it is not on `PATH`.
-fn ensure_qemu() -> Result<(), String> {
-    if works(Path::new(QEMU), &["--version"]) {
+/// Installs the core's emulator with `apt-get` when it is not on `PATH`.
+fn ensure_qemu(core: &Core) -> Result<(), String> {
+    let qemu = core.qemu;
+    if works(Path::new(qemu), &["--version"]) {
         return Ok(());
     }
-    println!("{QEMU} is missing: installing Debian's package");
+    println!(
+        "{qemu} is missing: installing Debian's package {}",
+        core.package
+    );
     let clock = Instant::now();
     cmd::run(Command::new("apt-get").args(["update", "-qq"]))?;
     cmd::run(
         Command::new("apt-get")
             .env("DEBIAN_FRONTEND", "noninteractive")
-            .args(["install", "-y", "-qq", "--no-install-recommends", QEMU]),
+            .args([
+                "install",
+                "-y",
+                "-qq",
+                "--no-install-recommends",
+                core.package,
+            ]),
     )?;
-    if works(Path::new(QEMU), &["--version"]) {
-        println!("{QEMU} installed in {:.0} s", clock.elapsed().as_secs_f64());
+    if works(Path::new(qemu), &["--version"]) {
+        println!("{qemu} installed in {:.0} s", clock.elapsed().as_secs_f64());
         Ok(())
     } else {
-        Err(format!("{QEMU} still does not run after apt-get install"))
+        Err(format!("{qemu} still does not run after apt-get install"))
     }
 }
 
@@ -263,23 +418,27 @@ fn defmt_print() -> Result<PathBuf, String> {
 }
 
 /// The firmware crate is outside the host workspace, so `cargo xtask ci`'s fmt and clippy do
-/// not see it: format check and clippy with `-D warnings` for the target, here.
+/// not see it: format check, and clippy with `-D warnings` for a Cortex-M and a RISC-V target
+/// (each compiles its own counter module), here.
 fn lint() -> Result<(), String> {
     let dir = cmd::project_root().join(FIRMWARE_DIR);
-    let fmt = cmd::run(
+    let mut result = cmd::run(
         cmd::cargo()
             .current_dir(&dir)
             .args(["fmt", "--", "--check"]),
     );
-    let clippy = cmd::run(
-        cmd::cargo()
-            .current_dir(&dir)
-            .args(["clippy", "--quiet", "--release", "--target", TARGET])
-            .arg("--target-dir")
-            .arg(dir.join("target"))
-            .args(["--", "-D", "warnings"]),
-    );
-    fmt.and(clippy)
+    for target in [M4F.target, "riscv32imac-unknown-none-elf"] {
+        let clippy = cmd::run(
+            cmd::cargo()
+                .current_dir(&dir)
+                .args(["clippy", "--quiet", "--release", "--target", target])
+                .arg("--target-dir")
+                .arg(dir.join("target"))
+                .args(["--", "-D", "warnings"]),
+        );
+        result = result.and(clippy);
+    }
+    result
 }
 
 /// Builds the firmware's binaries in release with `extra` cargo arguments; the directory of
@@ -287,18 +446,18 @@ fn lint() -> Result<(), String> {
 ///
 /// As in `cargo xtask cross`, cargo runs from the crate's directory (so that its
 /// `.cargo/config.toml` applies) and the target and target directory are explicit.
-fn build(extra: &[&str]) -> Result<PathBuf, String> {
+fn build(core: &Core, extra: &[&str]) -> Result<PathBuf, String> {
     let dir = cmd::project_root().join(FIRMWARE_DIR);
     let target_dir = dir.join("target");
     cmd::run(
         cmd::cargo()
             .current_dir(&dir)
-            .args(["build", "--quiet", "--release", "--target", TARGET])
+            .args(["build", "--quiet", "--release", "--target", core.target])
             .arg("--target-dir")
             .arg(&target_dir)
             .args(extra),
     )?;
-    Ok(target_dir.join(TARGET).join("release"))
+    Ok(target_dir.join(core.target).join("release"))
 }
 
 /// Runs `command` with `input` on its stdin (none when empty), collecting stdout, and kills it
@@ -359,9 +518,13 @@ fn run_captured(command: &mut Command, input: Vec<u8>) -> Result<(ExitStatus, Ve
 }
 
 /// Runs `elf` under QEMU; its stdout (the semihosting output) when it exits with success.
-fn run_in_qemu(elf: &Path) -> Result<Vec<u8>, String> {
+fn run_in_qemu(core: &Core, elf: &Path) -> Result<Vec<u8>, String> {
     let (status, out) = run_captured(
-        Command::new(QEMU).args(QEMU_ARGS).arg("-kernel").arg(elf),
+        Command::new(core.qemu)
+            .args(core.machine)
+            .args(QEMU_ARGS)
+            .arg("-kernel")
+            .arg(elf),
         Vec::new(),
     )?;
     if status.success() {
@@ -372,8 +535,9 @@ fn run_in_qemu(elf: &Path) -> Result<Vec<u8>, String> {
 }
 
 /// Runs an image that only reports through its exit status.
-fn run_image(elf: &Path) -> Result<(), String> {
-    run_in_qemu(elf).map(|_| println!("{}: ran to success on the M4F", elf.display()))
+fn run_image(core: &Core, elf: &Path) -> Result<(), String> {
+    run_in_qemu(core, elf)
+        .map(|_| println!("{}: ran to success on the {}", elf.display(), core.name))
 }
 
 /// What the lockstep firmware logged.
@@ -481,51 +645,80 @@ fn parse_log(text: &str) -> Result<Log, String> {
     Ok(log)
 }
 
-/// Instructions per SysTick tick from the calibration: the nearest integer, checked to explain
-/// the count to within one tick.
-fn instructions_per_tick(calibration: Option<(u64, u64)>) -> Result<u64, String> {
+/// Instructions per counter tick from the calibration (SysTick counts at a fixed fraction of
+/// QEMU's instruction clock: 40, 50 and 62.5 instructions a tick on the M4F, M33 and M0 boards;
+/// `minstret` counts instructions), checked to be within 0.1% of a multiple of 1/8.
+fn instructions_per_tick(calibration: Option<(u64, u64)>) -> Result<f64, String> {
     let (instructions, ticks) = calibration.ok_or("no calibration line in the log")?;
     if ticks == 0 {
         return Err("the calibration loop took no ticks".into());
     }
-    let per_tick = (instructions + ticks / 2) / ticks;
-    if instructions.abs_diff(per_tick * ticks) > per_tick {
+    let measured = instructions as f64 / ticks as f64;
+    let per_tick = (measured * 8.0).round() / 8.0;
+    if per_tick == 0.0 || (measured / per_tick - 1.0).abs() > 1e-3 {
         return Err(format!(
             "calibration: {instructions} instructions in {ticks} ticks is not a whole number \
-             of instructions per tick"
+             of eighths of an instruction per tick"
         ));
     }
     Ok(per_tick)
 }
 
-/// Runs the lockstep image, decodes its log, compares with the host and prints the table;
-/// the list of failed checks.
-fn lockstep(elf: &Path, decoder: &Path) -> Result<Vec<String>, String> {
-    let log = decode(elf, decoder)?;
+/// One core's figures for the summary table.
+#[derive(Default)]
+struct Row {
+    /// The core's name.
+    core: &'static str,
+    /// Cases whose final state the firmware gave bit for bit as the host: `f32` ones, `f64`
+    /// ones.
+    identical: (usize, usize),
+    /// Cases run.
+    cases: usize,
+    /// Mean instructions per step by case id.
+    per_step: BTreeMap<usize, f64>,
+    /// Instructions of the slowest step by case id (the cases that time their steps).
+    worst: BTreeMap<usize, u64>,
+    /// Stack high-water mark by case id, bytes.
+    stacks: BTreeMap<usize, u64>,
+    /// `.text` of the lockstep image (every case and kernel), bytes.
+    text: Option<u32>,
+    /// `.text` of the one-mechanism image (one f32 RK4 pendulum), bytes.
+    one_mechanism_text: Option<u32>,
+}
+
+/// Runs the lockstep image, decodes its log, compares with the host and prints the core's
+/// table; its summary row and the list of failed checks (the budgets are checked on the M4F
+/// only).
+fn lockstep(core: &Core, elf: &Path, decoder: &Path) -> Result<(Row, Vec<String>), String> {
+    let name = core.name;
+    let log = decode(core, elf, decoder)?;
     let mut failures = Vec::new();
     if log.header != Some((CASES.len(), STEPS)) {
         failures.push(format!(
-            "firmware header {:?}, host has {} cases of {STEPS} steps",
+            "{name}: firmware header {:?}, host has {} cases of {STEPS} steps",
             log.header,
             CASES.len()
         ));
     }
     if !log.done {
-        failures.push("the firmware log ends before `done`".into());
+        failures.push(format!("{name}: the firmware log ends before `done`"));
     }
     let per_tick = instructions_per_tick(log.calibration)?;
     println!(
-        "\nlockstep on the M4F (QEMU mps2-an386, -icount shift=0: {per_tick} instructions per \
-         SysTick tick), {STEPS} steps (of 1 ms; the scenes' frames of 1/120 s, the ragdoll's \
-         steps of 1/240 s); instructions per step, the mean and, where a case times its steps, \
-         the worst:"
+        "\nlockstep on the {name} ({}, -icount shift=0: {per_tick} instructions per tick), \
+         {STEPS} steps (of 1 ms; the scenes' frames of 1/120 s, the ragdoll's steps of 1/240 s); \
+         instructions per step, the mean and, where a case times its steps, the worst:",
+        core.board
     );
+    let same = format!("host = {name}");
     println!(
-        "{:>3}  {:<28} {:<29} {:<5} {:<12} {:>12} {:>12} {:>8}",
-        "id", "system", "integrator", "type", "host = M4F", "instr/step", "worst step", "stack B"
+        "{:>3}  {:<28} {:<29} {:<5} {:<14} {:>12} {:>12} {:>8}",
+        "id", "system", "integrator", "type", same, "instr/step", "worst step", "stack B"
     );
-    let mut per_step = BTreeMap::new();
-    let mut worst_step = BTreeMap::new();
+    let mut row = Row {
+        cases: CASES.len(),
+        ..Row::default()
+    };
     let mut words = BTreeMap::new();
     for (id, case) in CASES.iter().enumerate() {
         let host = case.run(STEPS).ok().map(|o| o.words().to_vec());
@@ -539,36 +732,42 @@ fn lockstep(elf: &Path, decoder: &Path) -> Result<Vec<String>, String> {
             (None, _) => "missing",
             _ => "DIFFERENT",
         };
-        if verdict != "identical" {
+        if verdict == "identical" {
+            if case.precision == "f32" {
+                row.identical.0 += 1;
+            } else {
+                row.identical.1 += 1;
+            }
+        } else {
             failures.push(format!(
-                "case {id} ({} {} {}): {verdict}: M4F {firmware:?}, host {host:?}",
+                "{name}: case {id} ({} {} {}): {verdict}: firmware {firmware:?}, host {host:?}",
                 case.system, case.method, case.precision
             ));
         }
         let cost = match log.costs.get(&id) {
             Some(Some((setup, run))) => {
-                let instructions = run.saturating_sub(*setup) * per_tick;
-                let step = instructions as f64 / f64::from(STEPS);
-                per_step.insert(id, step);
+                let instructions = run.saturating_sub(*setup) as f64 * per_tick;
+                let step = instructions / f64::from(STEPS);
+                row.per_step.insert(id, step);
                 format!("{step:.1}")
             }
             _ => {
-                failures.push(format!("case {id}: no cost measured"));
+                failures.push(format!("{name}: case {id}: no cost measured"));
                 "-".into()
             }
         };
         let worst = match log.worst.get(&id) {
             Some(Some(ticks)) => {
-                let instructions = ticks * per_tick;
-                worst_step.insert(id, instructions);
+                let instructions = (*ticks as f64 * per_tick).round() as u64;
+                row.worst.insert(id, instructions);
                 instructions.to_string()
             }
             Some(None) => {
-                failures.push(format!("case {id}: a step wrapped the counter"));
+                failures.push(format!("{name}: case {id}: a step wrapped the counter"));
                 "wrapped".into()
             }
             None if case.times_steps() => {
-                failures.push(format!("case {id}: no worst step measured"));
+                failures.push(format!("{name}: case {id}: no worst step measured"));
                 "missing".into()
             }
             None => "-".into(),
@@ -580,24 +779,27 @@ fn lockstep(elf: &Path, decoder: &Path) -> Result<Vec<String>, String> {
         if let (Some(&bytes), Some(paint)) = (log.stacks.get(&id), log.paint) {
             if bytes >= paint {
                 failures.push(format!(
-                    "case {id}: its stack reached the probe's whole depth ({paint} B): deeper \
-                     than measured"
+                    "{name}: case {id}: its stack reached the probe's whole depth ({paint} B): \
+                     deeper than measured"
                 ));
             }
         }
         println!(
-            "{id:>3}  {:<28} {:<29} {:<5} {:<12} {cost:>12} {worst:>12} {stack:>8}",
+            "{id:>3}  {:<28} {:<29} {:<5} {:<14} {cost:>12} {worst:>12} {stack:>8}",
             case.system, case.method, case.precision, verdict
         );
     }
+    row.stacks = log.stacks.clone();
+    let per_step = &row.per_step;
     let find = |system: &str, method: &str| {
         CASES
             .iter()
             .position(|c| c.system == system && c.method == method && c.precision == "f32")
             .and_then(|id| per_step.get(&id).copied())
     };
+    let is_m4f = core.target == M4F.target;
     match (find("pendulum", "RK4"), find("pendulum (libm sinf)", "RK4")) {
-        (Some(fast), Some(libm)) => {
+        (Some(fast), Some(libm)) if is_m4f => {
             println!(
                 "f32 RK4 pendulum: {fast:.1} instructions per step with fast_trig, {libm:.1} \
                  with libm::sinf ({:.1}x); budget {PENDULUM_RK4_F32_BUDGET}",
@@ -610,13 +812,21 @@ fn lockstep(elf: &Path, decoder: &Path) -> Result<Vec<String>, String> {
                 ));
             }
         }
-        _ => failures.push("no f32 RK4 pendulum cost to check against its budget".into()),
+        (Some(fast), Some(libm)) => println!(
+            "f32 RK4 pendulum: {fast:.1} instructions per step with fast_trig, {libm:.1} with \
+             libm::sinf ({:.1}x)",
+            libm / fast
+        ),
+        _ => failures.push(format!("{name}: no f32 RK4 pendulum cost")),
     }
-    failures.extend(asleep_cost(&per_step));
-    lane_cost(&per_step);
-    failures.extend(ragdoll_cost(&per_step, &worst_step, &words, &log.stacks));
-    failures.extend(kernels(&log, per_tick));
-    Ok(failures)
+    let asleep = asleep_cost(per_step);
+    if is_m4f {
+        failures.extend(asleep);
+    }
+    lane_cost(name, per_step);
+    failures.extend(ragdoll_cost(per_step, &row.worst, &words, &log.stacks));
+    failures.extend(kernels(name, &log, per_tick));
+    Ok((row, failures))
 }
 
 /// What an asleep instance costs a frame: the difference between the scene cases with
@@ -635,7 +845,7 @@ fn asleep_cost(per_step: &BTreeMap<usize, f64>) -> Option<String> {
     let each = (many - none) / SLEEPERS as f64;
     println!(
         "scene frame: {none:.1} instructions with one pendulum awake, {many:.1} with {SLEEPERS} \
-         more asleep: {each:.2} per sleeper per frame; budget {ASLEEP_BUDGET}"
+         more asleep: {each:.2} per sleeper per frame; budget on the M4F {ASLEEP_BUDGET}"
     );
     (each > ASLEEP_BUDGET).then(|| {
         format!("an asleep instance costs {each:.2} instructions per frame, over {ASLEEP_BUDGET}")
@@ -643,8 +853,8 @@ fn asleep_cost(per_step: &BTreeMap<usize, f64>) -> Option<String> {
 }
 
 /// Prints what 16 pendulums cost per instance and step one by one, in lanes of 4, and in a
-/// scene's bank on the M4F.
-fn lane_cost(per_step: &BTreeMap<usize, f64>) {
+/// scene's bank on the core.
+fn lane_cost(core: &str, per_step: &BTreeMap<usize, f64>) {
     let find = |system: &str| {
         CASES
             .iter()
@@ -658,7 +868,7 @@ fn lane_cost(per_step: &BTreeMap<usize, f64>) {
     ) {
         let n = LANE_INSTANCES as f64;
         println!(
-            "f32 RK4 pendulums on the M4F: {:.1} instructions per instance and step one by one, \
+            "f32 RK4 pendulums on the {core}: {:.1} instructions per instance and step one by one, \
              {:.1} in lanes of 4 ({:.2}x), {:.1} in a scene's bank, one by one here ({:.2}x)",
             alone / n,
             lanes / n,
@@ -733,24 +943,27 @@ fn ragdoll_cost(
 
 /// Compares the kernels' digests with the host's and prints instructions per call (the
 /// kernel's ticks less those of the identity loop above it); the list of failed checks.
-fn kernels(log: &Log, per_tick: u64) -> Vec<String> {
+fn kernels(core: &str, log: &Log, per_tick: f64) -> Vec<String> {
     let mut failures = Vec::new();
-    println!("\nmath kernels on the M4F, {KERNEL_CALLS} calls each (results compared as digests):");
     println!(
-        "{:>3}  {:<26} {:<14} {:<12} {:>13}",
-        "id", "function", "inputs", "host = M4F", "instr/call"
+        "\nmath kernels on the {core}, {KERNEL_CALLS} calls each (results compared as digests):"
+    );
+    let same = format!("host = {core}");
+    println!(
+        "{:>3}  {:<26} {:<14} {:<14} {:>13}",
+        "id", "function", "inputs", same, "instr/call"
     );
     let mut identity = None;
     for (id, kernel) in KERNELS.iter().enumerate() {
         let Some(&(digest, ticks)) = log.kernels.get(&id) else {
-            failures.push(format!("kernel {id} ({}): missing", kernel.name));
+            failures.push(format!("{core}: kernel {id} ({}): missing", kernel.name));
             continue;
         };
         let verdict = if digest == kernel.run(KERNEL_CALLS) {
             "identical"
         } else {
             failures.push(format!(
-                "kernel {id} ({} on {}): results differ from the host's",
+                "{core}: kernel {id} ({} on {}): results differ from the host's",
                 kernel.name, kernel.inputs
             ));
             "DIFFERENT"
@@ -762,13 +975,13 @@ fn kernels(log: &Log, per_tick: u64) -> Vec<String> {
             identity.map_or_else(
                 || "-".into(),
                 |base| {
-                    let instructions = ticks.saturating_sub(base) * per_tick;
-                    format!("{:.1}", instructions as f64 / f64::from(KERNEL_CALLS))
+                    let instructions = ticks.saturating_sub(base) as f64 * per_tick;
+                    format!("{:.1}", instructions / f64::from(KERNEL_CALLS))
                 },
             )
         };
         println!(
-            "{id:>3}  {:<26} {:<14} {verdict:<12} {cost:>13}",
+            "{id:>3}  {:<26} {:<14} {verdict:<14} {cost:>13}",
             kernel.name, kernel.inputs
         );
     }
@@ -791,7 +1004,7 @@ fn sizes(
     libm_one_mechanism: Result<u32, String>,
 ) -> Result<Vec<String>, String> {
     let mut failures = Vec::new();
-    println!("\n.text of the firmware images (release, opt-level 3, fat LTO):");
+    println!("\n.text of the M4F's firmware images (release, opt-level 3, fat LTO):");
     for image in std::iter::once(&"lockstep").chain(images) {
         let text = text_size(&dir.join(image))?;
         println!("  {image:<40} {text:>8} B");
@@ -828,4 +1041,135 @@ fn sizes(
     }
     println!("  budget of the one-mechanism image: {ONE_MECHANISM_TEXT_BUDGET} B");
     Ok(failures)
+}
+
+/// The id of the case of `system` by `method` in `precision`.
+fn case_id(system: &str, method: &str, precision: &str) -> Option<usize> {
+    CASES
+        .iter()
+        .position(|c| c.system == system && c.method == method && c.precision == precision)
+}
+
+/// The summary's columns of mean instructions per step: heading, system, method, precision.
+const COLUMNS: [(&str, &str, &str, &str); 7] = [
+    ("pendulum", "pendulum", "RK4", "f32"),
+    ("double p.", "double pendulum", "RK4", "f32"),
+    ("cart-pole", "cart-pole", "RK4", "f32"),
+    ("c-p f64", "cart-pole", "RK4", "f64"),
+    ("c-p S-V", "cart-pole", "Stormer-Verlet", "f32"),
+    (
+        "c-p var.",
+        "cart-pole (automatic)",
+        "variational midpoint",
+        "f32",
+    ),
+    ("16 in scene", "16 pendulums, a scene's bank", "RK4", "f32"),
+];
+
+/// The cycles per instruction assumed for a Cortex-M0+ running soft-float code from
+/// zero-wait-state memory: most of its instructions take one cycle, loads, stores and taken
+/// branches two (an assumption: QEMU counts instructions, not cycles).
+const M0_PLUS_CPI: f64 = 1.5;
+
+/// The M0+ clock and loop rate the advice is for: cycles a step may take.
+const M0_PLUS_CYCLES_PER_STEP: f64 = 48e6 / 1e3;
+
+/// Prints the cores side by side (the lockstep verdicts, instructions per step of the chosen
+/// cases, the ragdoll landing's worst step and stack, `.text`), and what the M0's counts mean
+/// for an M0+ stepping at 1 kHz at 48 MHz.
+fn summary(rows: &[Row]) {
+    println!(
+        "\ncores side by side: lockstep cases bit-identical to the host (f32, f64, of all); mean \
+         instructions per step (f32 unless marked: RK4; the cart-pole also by Stormer-Verlet and \
+         the variational midpoint rule; a frame of 16 pendulums in a scene's bank); the ragdoll \
+         landing's worst step (impulse stepper, f32) and its stack; the deepest stack of any \
+         case; .text of the lockstep image and of the one-mechanism image:"
+    );
+    let mut heading = format!("{:<10} {:>11}", "core", "f32,f64 =");
+    for (title, ..) in COLUMNS {
+        heading.push_str(&format!(" {title:>11}"));
+    }
+    heading.push_str(&format!(
+        " {:>11} {:>9} {:>9} {:>9} {:>9}",
+        "ragdoll wst", "rd. stack", "max stack", ".text", "1-mech"
+    ));
+    println!("{heading}");
+    let landing = CASES.iter().position(|c| c.system == RAGDOLL_LANDING);
+    for row in rows {
+        let mut line = format!(
+            "{:<10} {:>11}",
+            row.core,
+            format!("{},{} of {}", row.identical.0, row.identical.1, row.cases)
+        );
+        for (_, system, method, precision) in COLUMNS {
+            let cost = case_id(system, method, precision).and_then(|id| row.per_step.get(&id));
+            line.push_str(&cost.map_or_else(|| format!(" {:>11}", "-"), |c| format!(" {c:>11.0}")));
+        }
+        let shown = |v: Option<u64>| v.map_or_else(|| "-".to_string(), |v| v.to_string());
+        line.push_str(&format!(
+            " {:>11} {:>9} {:>9} {:>9} {:>9}",
+            shown(landing.and_then(|id| row.worst.get(&id).copied())),
+            shown(landing.and_then(|id| row.stacks.get(&id).copied())),
+            shown(row.stacks.values().max().copied()),
+            shown(row.text.map(u64::from)),
+            shown(row.one_mechanism_text.map(u64::from)),
+        ));
+        println!("{line}");
+    }
+    if let Some(m0) = rows.iter().find(|r| r.core == "M0") {
+        m0_plus_advice(m0);
+    }
+}
+
+/// What the M0's instruction counts (the M0+'s: the same instruction set) mean for a 1 kHz loop
+/// on an M0+ at 48 MHz, for the cart-pole by each method and scalar: an estimate at
+/// [`M0_PLUS_CPI`] cycles per instruction.
+fn m0_plus_advice(m0: &Row) {
+    println!(
+        "\nCortex-M0+ at 48 MHz, one cart-pole step per 1 ms (48000 cycles), estimated at \
+         {M0_PLUS_CPI} cycles per instruction (an assumption; QEMU counts instructions):"
+    );
+    let mut fitting = Vec::new();
+    for (method, title) in [
+        ("RK4", "RK4"),
+        ("Stormer-Verlet", "Stormer-Verlet"),
+        ("variational midpoint", "variational midpoint"),
+    ] {
+        for precision in ["f32", "f64"] {
+            let system = if method == "variational midpoint" {
+                "cart-pole (automatic)"
+            } else {
+                "cart-pole"
+            };
+            let Some(&instructions) =
+                case_id(system, method, precision).and_then(|id| m0.per_step.get(&id))
+            else {
+                continue;
+            };
+            let share = instructions * M0_PLUS_CPI / M0_PLUS_CYCLES_PER_STEP;
+            println!(
+                "  {title:<22} {precision}: {instructions:>8.0} instructions, ~{:>7.0} cycles, \
+                 {:>4.0}% of the millisecond",
+                instructions * M0_PLUS_CPI,
+                100.0 * share
+            );
+            if share < 1.0 {
+                fitting.push((share, format!("{title} in {precision}")));
+            }
+        }
+    }
+    fitting.sort_by(|a, b| a.0.total_cmp(&b.0));
+    match fitting.first() {
+        None => println!("  none fits in the millisecond"),
+        Some((share, cheapest)) => println!(
+            "  fitting in the millisecond: {}; the choice: {cheapest}, leaving {:.0}% of it for \
+             the rest of the loop",
+            fitting
+                .iter()
+                .map(|(_, name)| name.as_str())
+                .collect::<Vec<_>>()
+                .join(", "),
+            100.0 * (1.0 - share)
+        ),
+    }
 }

@@ -6,8 +6,8 @@
 //! origin [`Origin::SciPy`]; the energy error is not measured for them (SciPy's solves are
 //! timed whole, with no observer).
 
-/// Virtual environments under `target/`, shared with xtask.
-#[path = "../../../xtask/src/venv.rs"]
+/// Virtual environments under `target/`.
+#[path = "venv.rs"]
 mod venv;
 
 use super::method::{Kind, Origin, Tableau};

@@ -1,6 +1,6 @@
 //! # lagrange-generated
 //!
-//! Mechanisms that `cargo xtask derive` generated from the SymPy specs in `derive/specs/`:
+//! Mechanisms that `lagrange-derive` (`cargo xtask derive`) generated from the SymPy specs in `derive/specs/`:
 //! the origin's workflow, "derive symbolically, implement numerically". Each is `no_std`,
 //! generic over the scalar, a [`Lagrangian`](lagrange_core::Lagrangian) and a
 //! [`Mechanism`](lagrange_core::Mechanism) (and [`Constraints`](lagrange_core::Constraints)
@@ -21,7 +21,8 @@
 //! [`Error::NonFiniteState`](lagrange_core::Error::NonFiniteState).
 //!
 //! Do not edit the files: `cargo xtask derive --check` (part of `cargo xtask ci`) regenerates
-//! each and fails when one differs. Each file holds a test against the automatic path of its
+//! each from the spec its header names and fails when one differs; `cargo xtask derive --update
+//! FILE.rs` regenerates one. Each file holds a test against the automatic path of its
 //! own `T` and `V`; `tests/hand_derived.rs` checks them against the hand-derived mechanisms of
 //! `lagrange-systems`.
 

@@ -1,65 +1,54 @@
-//! What the firmware binaries share: an instruction counter (SysTick under QEMU's `-icount`),
-//! a stack high-water probe (stack painting) and the exit through semihosting.
+//! What the firmware binaries share, on every core they are built for: an instruction counter,
+//! a stack high-water probe, the exit through semihosting, and a fault handler that turns any
+//! fault into a failed exit.
 //!
-//! Under `qemu-system-arm -icount shift=0` every guest instruction advances the virtual clock
-//! by 1 ns, and SysTick, clocked from the CPU clock, counts that virtual time: a count of
-//! SysTick ticks is a count of instructions, at a fixed number of instructions per tick that
-//! the lockstep binary calibrates against a loop of known length (`cortex_m::asm::delay`).
+//! The counter is each core's own: on Cortex-M, SysTick clocked from the core (under
+//! `qemu-system-arm -icount shift=0` every guest instruction advances the virtual clock by
+//! 1 ns, so a tick is a fixed number of instructions); on RISC-V, `minstret`, the count of
+//! instructions retired. [`calibrate`] measures instructions per tick against a loop of known
+//! length, so that the host need not trust either.
+//!
+//! The memory map of each board is in `memory/`, picked by `build.rs` from the target.
 
 #![no_std]
 
+#[cfg(target_arch = "arm")]
+mod arm;
+#[cfg(target_arch = "riscv32")]
+mod rv32;
+
 use core::ptr;
 
-use cortex_m::peripheral::syst::SystClkSource;
-use cortex_m::peripheral::SYST;
+#[cfg(target_arch = "arm")]
+use arm as core_specific;
+#[cfg(target_arch = "riscv32")]
+use rv32 as core_specific;
 
-/// SysTick as a 24-bit down-counter of instruction-clock ticks.
-pub struct Counter {
-    syst: SYST,
-}
+pub use core_specific::{entry, Counter};
 
-/// SysTick's reload value: the full 24 bits.
-const RELOAD: u32 = 0x00ff_ffff;
+/// The calibration loop's length: [`calibrate`] times this many more iterations of a loop of
+/// two instructions than a run of none.
+const CALIBRATION_ITERATIONS: u32 = 4_000_000;
 
-impl Counter {
-    /// Starts SysTick free-running from the processor clock, without its interrupt.
-    #[must_use]
-    pub fn start(mut syst: SYST) -> Self {
-        syst.set_clock_source(SystClkSource::Core);
-        syst.set_reload(RELOAD);
-        syst.clear_current();
-        syst.disable_interrupt();
-        syst.enable_counter();
-        Self { syst }
-    }
-
-    /// Runs `f` and returns its result with the ticks it took, or `None` for the ticks when
-    /// the counter wrapped (2^24 ticks or more, which no measured run comes near).
-    ///
-    /// The counter restarts from the top first: COUNTFLAG is set whenever it passes zero, so
-    /// a free-running counter would flag a run of any length that happened to cross zero.
-    pub fn measure<R>(&mut self, f: impl FnOnce() -> R) -> (R, Option<u32>) {
-        // Writing the current value clears it and COUNTFLAG; it reloads at the next tick.
-        self.syst.clear_current();
-        while SYST::get_current() == 0 {}
-        // Reading the control register clears COUNTFLAG (in case the reload set it).
-        let _ = self.syst.has_wrapped();
-        let before = SYST::get_current();
-        let result = f();
-        let after = SYST::get_current();
-        let wrapped = self.syst.has_wrapped();
-        let ticks = before.wrapping_sub(after) & RELOAD;
-        (result, if wrapped { None } else { Some(ticks) })
-    }
+/// Times the calibration loop: `(instructions, ticks)` of [`CALIBRATION_ITERATIONS`] more
+/// iterations of a two-instruction loop than none.
+pub fn calibrate(counter: &mut Counter) -> (u64, u64) {
+    let (_, empty) = counter.measure(|| core_specific::spin(0));
+    let (_, full) = counter.measure(|| core_specific::spin(CALIBRATION_ITERATIONS));
+    (
+        2 * u64::from(CALIBRATION_ITERATIONS),
+        full.saturating_sub(empty),
+    )
 }
 
 /// The word painted below the stack pointer before a run.
 const PAINT: u32 = 0xdead_beef;
 
 /// How far below the stack pointer the probe paints, bytes: far more than any case uses (the
-/// ragdoll landing, the deepest, uses over 32 KiB), far less than the 4 MiB of RAM. A mark of
-/// the whole depth means the probe was too shallow.
-pub const PAINT_DEPTH: u32 = 256 * 1024;
+/// ragdoll landing, the deepest, uses 47 to 48 kB on every core), and at most half the RAM of
+/// every board in `memory/` (the smallest has 256 KiB). A mark of the whole depth means the
+/// probe was too shallow.
+pub const PAINT_DEPTH: u32 = 128 * 1024;
 
 /// Runs `f` and returns its result with its stack high-water mark: the bytes below this
 /// function's stack pointer that `f` (and all it calls) wrote.
@@ -70,11 +59,12 @@ pub const PAINT_DEPTH: u32 = 256 * 1024;
 /// `0xdeadbeef`.
 #[inline(never)]
 pub fn stack_high_water<R>(f: impl FnOnce() -> R) -> (R, u32) {
-    let top = cortex_m::register::msp::read();
+    let top = core_specific::stack_pointer();
     let bottom = top - PAINT_DEPTH;
     // SAFETY: the words from `bottom` up to `top` are below the stack pointer of this frame:
-    // no live data is there (interrupts are not enabled, and this loop calls nothing), and the
-    // 4 MiB of RAM under the stack top leave room for `PAINT_DEPTH`.
+    // no live data is there (this loop calls nothing; an exception taken meanwhile stacks its
+    // frame below the stack pointer and unstacks it before the loop goes on), and every
+    // board's RAM under the stack top leaves room for `PAINT_DEPTH` (see its docs).
     unsafe {
         let mut at = bottom;
         while at < top {

@@ -22,6 +22,14 @@ pub struct ImpulseReport {
     pub settled: bool,
     /// Whether the drift correction moved the coordinates.
     pub corrected: bool,
+    /// Corrections of the drift on the gaps the first one left (the gaps are not linear in
+    /// the coordinates: a link turned in the step), each one exact solve of the rows: at most
+    /// three.
+    pub drift_rounds: u32,
+    /// Whether the drift correction could not bring every contact within the slop in its
+    /// rounds (a link turned by a large part of a radian in one step), so that the
+    /// coordinates stayed where the step began (the velocities are the impulses').
+    pub held_back: bool,
     /// Whether the energy guard scaled the velocities down.
     pub energy_guard: bool,
 }
@@ -37,6 +45,8 @@ impl ImpulseReport {
             rounds: self.rounds.max(other.rounds),
             settled: self.settled && other.settled,
             corrected: self.corrected || other.corrected,
+            drift_rounds: self.drift_rounds.max(other.drift_rounds),
+            held_back: self.held_back || other.held_back,
             energy_guard: self.energy_guard || other.energy_guard,
         }
     }
@@ -52,6 +62,8 @@ impl Default for ImpulseReport {
             rounds: 0,
             settled: true,
             corrected: false,
+            drift_rounds: 0,
+            held_back: false,
             energy_guard: false,
         }
     }

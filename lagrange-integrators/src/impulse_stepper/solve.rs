@@ -25,6 +25,18 @@ impl<T: Real, const C: usize> Impulses<T, C> {
     }
 }
 
+/// Sweeps of projected Gauss-Seidel where the exact solve of the normal rows cycles: 4 C, the
+/// exact method's own cap on its passes (each sweep costs about what one of its passes does
+/// on a few rows).
+const fn relaxed_sweeps<const C: usize>() -> u32 {
+    let sweeps = 4 * C;
+    if sweeps > u32::MAX as usize {
+        u32::MAX
+    } else {
+        sweeps as u32
+    }
+}
+
 /// How a solve went.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(super) struct Solved<T: Real, const N: usize, const C: usize> {
@@ -63,8 +75,12 @@ impl<T: Real, const N: usize, const C: usize> Problem<'_, T, N, C> {
     /// (plus the rounding of its speed). The cone holds exactly at
     /// the end. The velocities returned are `v0` plus the response of the final impulses.
     ///
+    /// Where the exact solve does not end in its passes (a degenerate set that cycles), that
+    /// round's normal impulses are projected Gauss-Seidel's ([`Delassus::relaxed`]) and the
+    /// solve is not settled.
+    ///
     /// # Errors
-    /// As [`Delassus::complementary`].
+    /// As [`Delassus::complementary`], but for [`Error::NoConvergence`].
     pub(super) fn solve(
         self,
         v0: &SVector<T, N>,
@@ -81,13 +97,23 @@ impl<T: Real, const N: usize, const C: usize> Problem<'_, T, N, C> {
         }
         let frictional = self.friction > T::zero() && self.tangent.iter().any(Option::is_some);
         let rounding = T::from_f64(16.0) * T::EPSILON;
-        let (mut taken, mut settled) = (0, false);
+        let (mut taken, mut settled, mut exact) = (0, false, true);
         let mut guess = *self.pushed;
         while taken < rounds.max(1) && !settled {
             taken += 1;
             let sliding = self.tangent_response(v0, &p.tangent);
             let b = self.normal.jacobian() * sliding - target;
-            let solved = self.normal.complementary_from(&b, self.kinds, &guess)?;
+            let solved = match self.normal.complementary_from(&b, self.kinds, &guess) {
+                Ok(solved) => solved,
+                // A degenerate set the exact method cycles on (many contacts struck at once,
+                // more than the motion has freedoms): projected Gauss-Seidel, whose impulses
+                // never add energy, for this round; the solve has not settled.
+                Err(Error::NoConvergence { .. }) => {
+                    exact = false;
+                    self.normal.relaxed(&b, self.kinds, relaxed_sweeps::<C>())
+                }
+                Err(e) => return Err(e),
+            };
             (p.normal, guess) = (solved.lambda, solved.active);
             if !frictional {
                 settled = true;
@@ -128,7 +154,7 @@ impl<T: Real, const N: usize, const C: usize> Problem<'_, T, N, C> {
             impulses: p,
             velocity,
             rounds: taken,
-            settled,
+            settled: settled && exact,
         })
     }
 

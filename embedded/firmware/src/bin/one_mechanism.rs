@@ -6,9 +6,8 @@
 #![no_std]
 #![no_main]
 
-use cortex_m_rt::{entry, exception, ExceptionFrame};
 use lagrange_cases::{Case, PendulumSetup, STEPS};
-use lagrange_firmware::exit;
+use lagrange_firmware::{entry, exit};
 use lagrange_integrators::Rk4;
 
 /// The one case this image runs.
@@ -17,11 +16,6 @@ const CASE: Case = Case::new::<f32, 1, PendulumSetup, Rk4>();
 #[entry]
 fn main() -> ! {
     exit(CASE.run(STEPS).is_ok())
-}
-
-#[exception]
-unsafe fn HardFault(_frame: &ExceptionFrame) -> ! {
-    exit(false)
 }
 
 #[panic_handler]

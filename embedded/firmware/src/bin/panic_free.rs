@@ -13,10 +13,9 @@
 
 use core::hint::black_box;
 
-use cortex_m_rt::{entry, exception, ExceptionFrame};
 use lagrange_core::nalgebra::SVector;
 use lagrange_core::{Error, EulerLagrange, Mechanism, Real, State, ViscousDamping};
-use lagrange_firmware::exit;
+use lagrange_firmware::{entry, exit};
 use lagrange_integrators::scene::{Bank, Scene, Sleeps};
 use lagrange_integrators::{
     BackwardEuler, ExplicitEuler, GaussLegendre2, ImplicitMidpoint, Integrator, RadauIIA2, Rk4,
@@ -214,9 +213,4 @@ fn main() -> ! {
     let contacts_ok =
         matches!(ragdoll::run::<f32>(), Ok(true)) && matches!(ragdoll::run::<f64>(), Ok(true));
     exit(f32_ok && f64_ok && scenes_ok && contacts_ok)
-}
-
-#[exception]
-unsafe fn HardFault(_frame: &ExceptionFrame) -> ! {
-    exit(false)
 }

@@ -8,10 +8,9 @@
 
 use core::hint::black_box;
 
-use cortex_m_rt::{entry, exception, ExceptionFrame};
 use lagrange_cases::ragdoll_thrown;
 use lagrange_core::Error;
-use lagrange_firmware::exit;
+use lagrange_firmware::{entry, exit};
 use lagrange_integrators::{Integrator, SemiImplicitEuler};
 use lagrange_systems::{Ragdoll, RagdollBody};
 
@@ -28,11 +27,6 @@ fn run() -> Result<f32, Error> {
 #[entry]
 fn main() -> ! {
     exit(black_box(run()).is_ok())
-}
-
-#[exception]
-unsafe fn HardFault(_frame: &ExceptionFrame) -> ! {
-    exit(false)
 }
 
 #[panic_handler]

@@ -8,9 +8,8 @@
 
 use core::hint::black_box;
 
-use cortex_m_rt::{entry, exception, ExceptionFrame};
 use lagrange_core::{Error, State};
-use lagrange_firmware::exit;
+use lagrange_firmware::{entry, exit};
 use lagrange_integrators::scene::{Bank, NeverSleeps, Scene};
 use lagrange_integrators::Rk4;
 use lagrange_systems::SimplePendulum;
@@ -47,11 +46,6 @@ fn run() -> Result<f32, Error> {
 #[entry]
 fn main() -> ! {
     exit(black_box(run()).is_ok())
-}
-
-#[exception]
-unsafe fn HardFault(_frame: &ExceptionFrame) -> ! {
-    exit(false)
 }
 
 #[panic_handler]

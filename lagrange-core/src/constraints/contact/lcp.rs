@@ -6,6 +6,8 @@
 use crate::nalgebra::{SMatrix, SVector};
 use crate::{Error, Real};
 
+mod relaxed;
+
 /// How a row of [`Delassus::complementary`] is held: the bounds of its multiplier
 /// `lambda`, and what its `a = W lambda + b` must be inside them (zero; at a bound, of the
 /// sign that would push the multiplier out).
@@ -846,5 +848,101 @@ mod tests {
             }
         }
         Ok(())
+    }
+
+    /// A right side that is not a number gives multipliers that are not numbers either: the
+    /// solve refuses them rather than return them, whatever the rows' kinds.
+    #[test]
+    fn a_right_side_not_a_number_is_refused() -> Result<(), Error> {
+        let mut d = corner()?;
+        for kinds in [
+            [Row::Unilateral; 3],
+            [Row::Unilateral, Row::Bounded(0.5), Row::Unilateral],
+            Row::kinds(&[true, false, false]),
+        ] {
+            let b = SVector::<f64, 3>::new(f64::NAN, -1.0, -1.0);
+            assert_eq!(
+                d.complementary(&b, &kinds),
+                Err(Error::NonFiniteState),
+                "{kinds:?}"
+            );
+        }
+        Ok(())
+    }
+
+    /// As above, solved the way a stepper asks: the candidates of the step before rebuilt
+    /// into this step's (rows leave and join), and a guess of the rows that pushed. Rows of
+    /// every kind, right sides `b = J v`, eight rows on four freedoms and six on three. The
+    /// step towards each solve is cut where a row reaches a bound (at the fraction of the way
+    /// that reaches it, from below or above) and the ray steps make dependent rows join: the
+    /// method ends, within its passes, at a point where every kind's conditions hold. A row
+    /// whose part independent of the rows solved for is below the fourth root of `EPSILON`
+    /// (1.2e-4) of its size counts as dependent and is left out (the pivot test takes
+    /// `sqrt(EPSILON)` of the squared size), so the conditions hold to that share of the
+    /// terms of `a_i = b_i + sum_k W_ik lambda_k`, not to rounding: of 180,000 such problems
+    /// (three seeds; eight rows on four freedoms, six on three, four on two) two left a
+    /// row's `a` beyond 1e-9 of those terms, at 5.1e-7 and 1.5e-5. The rows that are no
+    /// candidates take no multiplier.
+    #[test]
+    fn guessed_and_rebuilt_rows_meet_their_conditions() -> Result<(), Error> {
+        fn check<const C: usize, const N: usize>(count: usize) -> Result<(), Error> {
+            let mut seed = 0x0bad_cafe_f00d_1234_u64;
+            let mut next = || {
+                seed ^= seed << 13;
+                seed ^= seed >> 7;
+                seed ^= seed << 17;
+                (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+            };
+            for _ in 0..count {
+                let j = SMatrix::<f64, C, N>::from_fn(|_, _| next());
+                let b = j * SVector::<f64, N>::from_fn(|_, _| next());
+                let kinds: [Row<f64>; C] = core::array::from_fn(|i| {
+                    let x = next();
+                    if i == 0 && x > 0.7 {
+                        Row::Held
+                    } else if x < 0.0 {
+                        Row::Unilateral
+                    } else if x < 0.1 {
+                        Row::Bounded(0.0)
+                    } else {
+                        Row::Bounded(next().abs())
+                    }
+                });
+                let guess: [bool; C] = core::array::from_fn(|_| next() > 0.0);
+                let before: [bool; C] = core::array::from_fn(|_| next() > -0.5);
+                let now: [bool; C] = core::array::from_fn(|_| next() > -0.5);
+                let mut d = Delassus::new(&j, |_| Ok(()), &before)?;
+                d.rebuild(&j, |_| Ok(()), &now)?;
+                let s = d.complementary_from(&b, &kinds, &guess)?;
+                let a = d.w * s.lambda + b;
+                for i in 0..C {
+                    let (l, ai) = (s.lambda[i], a[i]);
+                    let terms =
+                        (0..C).fold(b[i].abs(), |t, k| t + (d.w[(i, k)] * s.lambda[k]).abs());
+                    let tol = 2e-4 * (1.0 + terms);
+                    let ok = if now[i] {
+                        match kinds[i] {
+                            Row::Unilateral => l >= 0.0 && ai >= -tol && (l * ai).abs() < tol,
+                            Row::Bounded(x) => {
+                                l.abs() <= x
+                                    && (l.abs() < x - tol && ai.abs() < tol
+                                        || l >= x - tol && ai <= tol
+                                        || l <= -x + tol && ai >= -tol)
+                            }
+                            Row::Held | Row::Bilateral => ai.abs() < tol,
+                        }
+                    } else {
+                        l == 0.0
+                    };
+                    assert!(
+                        ok,
+                        "row {i} of {kinds:?} ({now:?}): lambda {l}, a {ai}\n{j}{b}"
+                    );
+                }
+            }
+            Ok(())
+        }
+        check::<8, 4>(3200)?;
+        check::<6, 3>(2700)
     }
 }

@@ -1,6 +1,6 @@
-//! Python virtual environments under `target/`, made once and then reused: SymPy for `cargo
-//! xtask derive`, SciPy for `cargo xtask bench --peers` (the bench includes this file as a
-//! module of its own, so the two are made the same way).
+//! Python virtual environments under `target/`, made once and then reused: SciPy for `cargo
+//! xtask bench --peers`. (`lagrange-derive` makes its SymPy environment its own way, in the
+//! user's cache folder.)
 
 use std::path::{Path, PathBuf};
 use std::process::Command;

@@ -1,32 +1,48 @@
-"""The origin's workflow, derive symbolically: from a spec (T, V, Q, phi written with SymPy)
-derive the Euler-Lagrange equations and print a no_std Rust mechanism on stdout.
+"""lagrange-derive's derivation: from a spec (T, V, Q, phi written with SymPy) derive the
+Euler-Lagrange equations and print a no_std Rust mechanism on stdout.
 
-Run by `cargo xtask derive SPEC.py [--out FILE.rs] [--name TypeName] [--tests]`, which makes
-the virtual environment with the pinned SymPy, formats the output with rustfmt and writes the
-file only when everything succeeded. By hand:
+Run by `lagrange-derive SPEC.py [--out FILE.rs] [--name TypeName] [--tests]` (and by
+`cargo xtask derive` in the lagrange workspace), which carries this file, makes the virtual
+environment with the pinned SymPy, formats the output with rustfmt and writes the file only
+when everything succeeded. By hand:
 
-    python derive.py SPEC.py --source LABEL [--name TypeName] [--tests] [--command TEXT]
+    python derive.py SPEC.py [--name TypeName] [--tests] [--spec-path PATH] [--file-name NAME]
 
 ## The spec
 
 A Python file that defines, at module level:
 
+- `q`: the generalized coordinates, a list of `dynamicsymbols("name")` (or `Function("name")(t)`
+  for a time symbol `t` of your own, with any assumptions: `t = symbols("t", positive=True)`).
 - `params`: a dict from each parameter's SymPy symbol to its default, or to a tuple
   `(default, kind)` or `(default, kind, "description, unit")`; `kind` is `"positive"` (masses,
-  lengths, stiffnesses), `"non_negative"` (gravity, damping) or `"finite"` (the default).
-  The dict's order is the constructor's argument order. Names must be snake_case.
-- `q`: the coordinates, a list of `dynamicsymbols("name")` (or `Function("name")(t)`).
-- `T`: the kinetic energy, in the coordinates, their first time derivatives and the
-  parameters; quadratic in the velocities (`q'^T M(q) q' / 2 + b(q)^T q' + T0(q)`).
-- `V`: the potential energy, in the coordinates (and time, for a driven mechanism).
-- `Q` (optional): the generalized non-conservative forces, a list of `len(q)` expressions.
-- `phi` (optional): holonomic constraint rows `phi(q) = 0`, a list of expressions in `q`.
-- `name` (optional): the Rust type's name (else `--name`, else the file name in CamelCase).
+  lengths, stiffnesses), `"non_negative"` (gravity, damping) or `"finite"` (the default). The
+  dict's order is the constructor's argument order.
+- `T`: the kinetic energy, in the coordinates, their first time derivatives, the time and the
+  parameters; quadratic in the velocities (`q'^T M(t, q) q' / 2 + b(t, q)^T q' + T0(t, q)`).
+- `V`: the potential energy, in the coordinates, the time and the parameters.
+- `Q` (optional): the generalized non-conservative forces, a list of `len(q)` expressions in
+  the coordinates, velocities, time and parameters.
+- `phi` (optional): holonomic constraint rows `phi(q) = 0`, a list of expressions in `q` and
+  the parameters.
+- `name` (optional): the Rust type's name, CamelCase (else `--name`, else the file name in
+  CamelCase).
 - `doc` (optional): what the mechanism is (else the module's docstring).
-- `ranges` (optional): a dict from coordinates to `(low, high)`, where the generated test
-  draws its random states and the mass-matrix check samples (default `(-3, 3)`).
+- `ranges` (optional): a dict from coordinates to `(low, high)`, where the generated test draws
+  its random states and the mass-matrix check samples (default `(-3, 3)`).
 - `simplify` (optional, default `True`): `trigsimp` T and V before deriving (seconds for a
   few links, minutes for long chains).
+
+Time is the symbol the coordinates are functions of (`dynamicsymbols._t`, named `t`, or your
+own); any symbol of the same name, whatever its assumptions, is that time. It may enter T, V
+and Q explicitly (a driven mechanism).
+
+Names are the paper's: any SymPy name for a parameter or a coordinate (`M`, `m`, `s`, `I`,
+`theta_1`, `θ₂`, `lambda`). Each becomes a Rust identifier by the rule of `rust_name`; two
+names that become one are refused, naming both. The generated code's own names (the state
+`s`, the vectors `q` and `qd`, temporaries, constants, methods) give way to the spec's. The
+only reserved names are the spec's keys above, as Python variables, and the time's name (a
+symbol of that name is the time, not a parameter).
 
 Supported in the expressions: `+ - * /`, integer and half-integer powers, `sqrt`, `sin`,
 `cos`, `tan`, `exp`, `log`, `atan2`, `pi`. Everything else is refused with a message.
@@ -40,20 +56,23 @@ J = dphi/dq,  J'q' = d/dq (J q') q'               where phi is given
 ```
 
 Each entry is expanded and its terms grouped by their state-dependent part, so that every
-product of parameters becomes one constant formed once by the constructor; then common
+product of parameters becomes one quantity formed once by the constructor; then common
 subexpressions are eliminated (`sympy.cse`), and sines and cosines of one argument share one
 `sin_cos`. Everything is deterministic: the same spec and SymPy version give the same bytes.
 
 Bad input (a syntax error, an unknown symbol, a T not quadratic in the velocities, a singular
-mass matrix, an unsupported function, ...) prints one message on stderr and exits with 1.
+mass matrix, an unsupported function, two names that collide, ...) prints one message on
+stderr and exits with 1.
 """
 
 import argparse
-import keyword
+import itertools
+import os
 import random
 import re
 import sys
 import traceback
+import unicodedata
 
 import mpmath
 import sympy as sp
@@ -73,48 +92,153 @@ SUPPORTED = (
 )
 
 KINDS = {
-    "positive": ("positive", "> 0"),
-    "non_negative": ("non_negative", ">= 0"),
-    "finite": ("finite", "finite"),
+    "positive": "> 0",
+    "non_negative": ">= 0",
+    "finite": "finite",
 }
 
+# --------------------------------------------------------------------------------------------
+# Names: the spec's, as Rust identifiers
+
+# Rust's strict and reserved keywords (2015 to 2024), and the variants of the prelude that a
+# binding may not shadow.
 RUST_KEYWORDS = set(
     "as async await break const continue crate dyn else enum extern false fn for if impl in "
     "let loop match mod move mut pub ref return self static struct super trait true type "
     "unsafe use where while abstract become box do final macro override priv typeof unsized "
-    "virtual yield try gen Self".split()
+    "virtual yield try gen Self Ok Err Some None".split()
 )
 
-# Names the generated code uses itself: locals beside the coordinates, and the methods a
-# parameter's accessor would shadow.
-RESERVED_LOCALS = {"s", "t", "q", "qd"}
-RESERVED_LOCAL_PATTERN = re.compile(r"^(e\d+|m\d+_\d+|sin\d*|cos\d*|sin_.*|cos_.*)$")
-RESERVED_METHODS = {
-    "new", "default", "from_valid", "equations", "kinetic", "potential", "energy",
-    "kinetic_energy", "potential_energy", "non_conservative_force", "mass_matrix", "rhs",
-    "solve_mass", "law", "law_jacobian", "law_force", "acceleration", "acceleration_with",
-    "acceleration_jacobian", "velocity_jump", "with_force", "held_by", "position_residual",
-    "jacobian", "velocity_product", "residual", "check_state", "phi", "clone", "eq", "fmt",
+# The methods a mechanism has besides its parameters' accessors: an accessor of that name
+# would shadow it (inherent methods come first).
+RESERVED_METHODS = set(
+    "new from_valid default clone clone_from eq ne fmt into try_into from try_from to_owned "
+    "clone_into borrow borrow_mut type_id "
+    "mass_matrix rhs solve_mass law law_jacobian law_force reads_velocities acceleration "
+    "acceleration_with acceleration_jacobian velocity_jump velocity_jumps gather with_force "
+    "held_by kinetic potential non_conservative_force kinetic_energy potential_energy energy "
+    "mass_formula rhs_formula equations constant_mass position_residual jacobian "
+    "velocity_product residual check_state phi".split()
+)
+
+# Type names the generated file uses itself (imports, generics, the prelude).
+RESERVED_TYPES = set(
+    "T S Self ClosedForm ConstantMass Constraints HolonomicConstraints SMatrix SVector "
+    "Lagrangian Real Scalar State Option Result Default Clone Copy Debug PartialEq Send Sync "
+    "Sized String Vec Box".split()
+)
+
+# Marks of combining characters, as words (`ẋ` is `x_dot`).
+MARKS = {
+    "COMBINING DOT ABOVE": "dot",
+    "COMBINING DIAERESIS": "ddot",
+    "COMBINING MACRON": "bar",
+    "COMBINING TILDE": "tilde",
+    "COMBINING CIRCUMFLEX ACCENT": "hat",
 }
-RESERVED_FIELD_PATTERN = re.compile(r"^k\d+$")
-SNAKE = re.compile(r"^[a-z][a-z0-9_]*$")
 
 
-def check_name(name, what):
-    """A parameter's or coordinate's name as a Rust identifier that clashes with nothing."""
-    if not SNAKE.match(name) or name in RUST_KEYWORDS or keyword.iskeyword(name):
-        raise SpecError(
-            f"{what} `{name}` is not a Rust variable name: use snake_case letters, digits "
-            f"and `_` (e.g. symbols('m_cart'))"
-        )
-    if what == "coordinate":
-        clash = name in RESERVED_LOCALS or RESERVED_LOCAL_PATTERN.match(name)
+def rust_name(name, method=False):
+    """The Rust identifier of a SymPy name (the rule the documentation states):
+
+    1. A name that is already an ASCII identifier (letters, digits, `_`) keeps its letters and
+       case: `M` is `M`, `theta_1` is `theta_1`.
+    2. Otherwise, after Unicode compatibility decomposition: a Greek letter becomes its name
+       (`θ` is `theta`, `Ω` is `Omega`, `ς` is `varsigma`), joined to a neighbouring letter by
+       `_` (`mθ` is `m_theta`); a subscript or superscript digit becomes `_` and the digit
+       (`θ₂` is `theta_2`); the marks dot, diaeresis, macron, tilde and circumflex become
+       `_dot`, `_ddot`, `_bar`, `_tilde`, `_hat` (`ẋ` is `x_dot`); `'` becomes `_prime`;
+       LaTeX's `\\`, `{` and `}` are dropped (`\\theta_{1}` is `theta_1`); any other letter or
+       digit becomes `u` and its code point in hex; anything else becomes `_`. Runs of `_` are
+       one, and `_` at either end is dropped.
+    3. A name that is then empty or does not start with a letter or `_` and a letter (`1x`,
+       `_1`) gets the prefix `n_`.
+    4. A Rust keyword (`type`, `self`, `fn`, ...) or prelude variant (`Ok`, `None`, ...) gets
+       `_` at its end (`type_`); so does a parameter named like a method the mechanism already
+       has (`energy_`, `new_`), since its accessor would hide that method.
+    """
+    if re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*", name):
+        out = name
     else:
-        clash = name in RESERVED_METHODS or RESERVED_FIELD_PATTERN.match(name)
-    if clash:
-        raise SpecError(
-            f"{what} `{name}` clashes with a name the generated code uses; rename it"
-        )
+        parts = []  # (text, kind): kind "word" for a Greek name, "text" otherwise
+        for ch in unicodedata.normalize("NFKD", name.replace("\\", "").replace("{", "").replace("}", "")):
+            if ch.isascii():
+                if ch.isalnum() or ch == "_":
+                    parts.append((ch, "text"))
+                elif ch == "'":
+                    parts.append(("_prime", "text"))
+                elif ch == "^":
+                    parts.append(("_", "text"))
+                else:
+                    parts.append(("_", "text"))
+                continue
+            uname = unicodedata.name(ch, "")
+            greek = re.fullmatch(r"GREEK (SMALL|CAPITAL) LETTER (FINAL )?([A-Z]+)", uname)
+            if greek:
+                word = greek.group(3).lower()
+                if greek.group(2):
+                    word = "var" + word
+                if greek.group(1) == "CAPITAL":
+                    word = word.capitalize()
+                parts.append((word, "word"))
+            elif "SUBSCRIPT" in uname or "SUPERSCRIPT" in uname:
+                digit = unicodedata.normalize("NFKC", ch)
+                parts.append(("_" + digit if digit.isalnum() else "_", "text"))
+            elif uname in MARKS:
+                parts.append(("_" + MARKS[uname], "text"))
+            elif unicodedata.category(ch).startswith("M"):
+                continue  # an accent: dropped
+            elif ch.isalnum():
+                parts.append((f"u{ord(ch):x}", "word"))
+            else:
+                parts.append(("_", "text"))
+        out = ""
+        for i, (text, kind) in enumerate(parts):
+            before = out[-1:] if out else ""
+            if kind == "word" and before.isalpha():
+                out += "_"
+            elif kind == "text" and i and parts[i - 1][1] == "word" and text[:1].isalpha():
+                out += "_"
+            out += text
+        out = re.sub(r"_+", "_", out).strip("_")
+    if not re.match(r"[A-Za-z]|_[A-Za-z]", out):
+        out = "n_" + out if out else "n"
+    if out in RUST_KEYWORDS:
+        out += "_"
+    elif method and out in RESERVED_METHODS:
+        out += "_"
+    return out
+
+
+def is_snake(name):
+    """Whether rustc's `non_snake_case` accepts `name`: no capital, and no run of `_` inside
+    (at either end they are allowed)."""
+    core = name.strip("_")
+    return not re.search(r"[A-Z]", core) and "__" not in core
+
+
+class Names:
+    """Identifiers the generated code gives itself, each different from every name of the spec
+    and from each other: `fresh("s")` is `s`, or `s_`, `s__`, ... when `s` is taken."""
+
+    def __init__(self, taken):
+        self.taken = set(taken) | RUST_KEYWORDS
+
+    def fresh(self, base):
+        # A run of `_` inside a name (`self_` + `_d`) is one: rustc's non_snake_case refuses it.
+        name = re.sub(r"(?<=[^_])_{2,}(?=[^_])", "_", base)
+        while name in self.taken:
+            name += "_"
+        self.taken.add(name)
+        return name
+
+    def child(self):
+        """A scope of its own (a function body) that sees everything taken so far."""
+        return Names(self.taken)
+
+
+# --------------------------------------------------------------------------------------------
+# The spec
 
 
 def load_spec(path):
@@ -124,6 +248,8 @@ def load_spec(path):
             source = f.read()
     except OSError as e:
         raise SpecError(f"cannot read {path}: {e.strerror}") from None
+    except UnicodeDecodeError as e:
+        raise SpecError(f"cannot read {path}: not UTF-8 ({e.reason})") from None
     try:
         code = compile(source, path, "exec")
     except SyntaxError as e:
@@ -133,6 +259,8 @@ def load_spec(path):
             f"{path}:{e.lineno}:{e.offset}: syntax error: {e.msg}\n    {text}\n    {caret}"
         ) from None
     namespace = {"__name__": "__spec__", "__file__": path}
+    # A spec may import a module beside it, from whatever folder the command runs.
+    sys.path.insert(0, os.path.dirname(os.path.abspath(path)))
     try:
         exec(code, namespace)  # noqa: S102 - running the user's spec is the point
     except Exception as e:  # noqa: BLE001 - any failure of the spec is reported, not raised
@@ -149,7 +277,7 @@ def load_spec(path):
 
 
 def camel_case(stem):
-    return "".join(part[:1].upper() + part[1:] for part in re.split(r"[_\-\s]+", stem) if part)
+    return "".join(part[:1].upper() + part[1:] for part in re.split(r"[_\-\s.]+", stem) if part)
 
 
 class Spec:
@@ -158,21 +286,32 @@ class Spec:
     def __init__(self, path, name_override):
         ns = load_spec(path)
         self.path = path
+        self.namespace = ns
         stem = re.sub(r"\.py$", "", path.replace("\\", "/").split("/")[-1])
         self.name = name_override or ns.get("name") or camel_case(stem)
-        if not isinstance(self.name, str) or not re.match(r"^[A-Z][A-Za-z0-9]*$", self.name):
-            raise SpecError(f"type name `{self.name}` is not a Rust type name in CamelCase")
+        if not isinstance(self.name, str) or not re.fullmatch(r"[A-Z][A-Za-z0-9]*", self.name):
+            raise SpecError(
+                f"type name `{self.name}` is not a Rust type name in CamelCase (set `name = "
+                f"\"MyMechanism\"` in the spec, or --name)"
+            )
+        if self.name in RESERVED_TYPES:
+            raise SpecError(
+                f"type name `{self.name}` is a name the generated file uses for something "
+                f"else; choose another (`name = ...` in the spec, or --name)"
+            )
         doc = ns.get("doc") or ns.get("__doc__") or f"The mechanism of `{stem}.py`."
         # Paragraphs kept, each paragraph's lines joined (the output wraps them again).
         self.doc = [" ".join(p.split()) for p in re.split(r"\n\s*\n", str(doc)) if p.strip()]
+        if not self.doc:
+            self.doc = [f"The mechanism of `{stem}.py`."]
         self.simplify = bool(ns.get("simplify", True))
         for required in ("params", "q", "T", "V"):
             if required not in ns:
                 raise SpecError(f"{path}: the spec defines no `{required}`")
         self.read_coordinates(ns["q"])
         self.read_params(ns["params"])
+        self.assign_names()
         self.read_ranges(ns.get("ranges", {}))
-        self.t_name = "t"
         # The expressions as written, for the docs, and in plain symbols.
         self.T_written = self.sympify(ns["T"], "T")
         self.V_written = self.sympify(ns["V"], "V")
@@ -241,24 +380,17 @@ class Spec:
                 )
             if self.time is None:
                 self.time = c.args[0]
-            elif c.args[0] != self.time:
-                raise SpecError(f"coordinate `{c}` is a function of another time variable")
+            elif c.args[0].name != self.time.name:
+                raise SpecError(
+                    f"coordinate `{c}` is a function of `{c.args[0]}`, but "
+                    f"`{self.q_functions[0]}` of `{self.time}`: one time for all"
+                )
             if c in self.q_functions:
                 raise SpecError(f"q lists `{c}` twice")
             self.q_functions.append(c)
         self.n = len(q)
-        self.q_names = [type(c).__name__ for c in self.q_functions]
-        for name in self.q_names:
-            check_name(name, "coordinate")
-        for name in self.q_names:
-            if name.endswith("_d") and name[:-2] in self.q_names:
-                raise SpecError(
-                    f"coordinate `{name}` has the name the velocity of `{name[:-2]}` gets"
-                )
-        self.qs = [sp.Symbol(name) for name in self.q_names]
-        self.qds = [sp.Symbol(name + "_d") for name in self.q_names]
-        self.t = sp.Symbol("t")
-        self.state_symbols = set(self.qs) | set(self.qds) | {self.t}
+        self.q_written = [type(c).__name__ for c in self.q_functions]
+        self.time_name = self.time.name
 
     def read_params(self, params):
         if not isinstance(params, dict) or not params:
@@ -270,12 +402,10 @@ class Spec:
         for sym, spec in params.items():
             if not isinstance(sym, sp.Symbol):
                 raise SpecError(f"params key `{sym}` is not a symbol: make it with symbols(...)")
-            check_name(sym.name, "parameter")
-            if sym.name == "t" or sym == self.time:
-                raise SpecError(f"parameter `{sym.name}` has the name of the time")
-            if sym.name in self.q_names or sym.name in {d.name for d in self.qds}:
+            if sym.name == self.time_name:
                 raise SpecError(
-                    f"parameter `{sym.name}` has the name of a coordinate or of a velocity"
+                    f"parameter `{sym.name}` has the name of the time (the coordinates are "
+                    f"functions of `{self.time_name}`): rename one of them"
                 )
             if isinstance(spec, tuple):
                 if not 1 <= len(spec) <= 3:
@@ -300,10 +430,56 @@ class Spec:
             }[kind]
             if not ok:
                 raise SpecError(
-                    f"params[{sym}]: the default {default!r} is not {KINDS[kind][1]} ({kind})"
+                    f"params[{sym}]: the default {default!r} is not {KINDS[kind]} ({kind})"
                 )
+            if description is not None and not isinstance(description, str):
+                raise SpecError(f"params[{sym}]: the description must be a string")
             self.params.append((sym, default, kind, description))
         self.param_symbols = [p[0] for p in self.params]
+
+    def assign_names(self):
+        """Rust names for every name of the spec, refusing two that are one; then the state's
+        symbols, named by their Rust locals."""
+        seen = {}  # Rust name -> (what, written)
+        written = {}  # name as written -> what
+
+        def claim(what, name, rust):
+            if name in written:
+                raise SpecError(
+                    f"{written[name]} `{name}` and {what} `{name}` have the same name: rename "
+                    f"one of them"
+                )
+            written[name] = what
+            if rust in seen:
+                other_what, other = seen[rust]
+                raise SpecError(
+                    f"{other_what} `{other}` and {what} `{name}` both become `{rust}` in Rust "
+                    f"(see the naming rule in the docs): rename one of them"
+                )
+            seen[rust] = (what, name)
+
+        self.time_rust = rust_name(self.time_name)
+        claim("the time", self.time_name, self.time_rust)
+        self.q_rust = []
+        for name in self.q_written:
+            rust = rust_name(name)
+            claim("coordinate", name, rust)
+            self.q_rust.append(rust)
+        self.param_rust = {}
+        for sym in self.param_symbols:
+            rust = rust_name(sym.name, method=True)
+            claim("parameter", sym.name, rust)
+            self.param_rust[sym] = rust
+        # Everything the spec names, as written and in Rust: the generated code's own names
+        # give way to these.
+        self.names = Names(set(written) | set(seen))
+        self.qs = [sp.Symbol(name) for name in self.q_rust]
+        self.qds = [sp.Symbol(self.names.fresh(name + "_d")) for name in self.q_rust]
+        self.t = sp.Symbol(self.time_rust)
+        self.state_symbols = set(self.qs) | set(self.qds) | {self.t}
+        for sym in self.qs + [self.t]:
+            self.names.taken.add(sym.name)
+        self.rust_names = {sym: sym.name for sym in self.qs + self.qds + [self.t]}
 
     def read_ranges(self, ranges):
         self.ranges = [(-3.0, 3.0)] * self.n
@@ -316,30 +492,55 @@ class Spec:
                 low, high = float(r[0]), float(r[1])
             except (TypeError, ValueError, IndexError):
                 raise SpecError(f"ranges[{c}] must be (low, high)") from None
+            if not (mpmath.isfinite(low) and mpmath.isfinite(high)):
+                raise SpecError(f"ranges[{c}] = {r}: both ends must be finite")
             if not low < high:
                 raise SpecError(f"ranges[{c}] = {r}: low must be below high")
             self.ranges[self.q_functions.index(c)] = (low, high)
 
+    def time_hint(self):
+        """A note when the spec holds a symbol named like the time that is not the time the
+        coordinates are functions of: a derivative by it is zero."""
+        for value in self.namespace.values():
+            if isinstance(value, sp.Symbol) and value.name == self.time_name and value != self.time:
+                return (
+                    f" (note: the spec's `{value.name}` is not the symbol the coordinates are "
+                    f"functions of, so x.diff({value.name}) is 0: make the coordinates with "
+                    f"Function('x')({value.name}), or use dynamicsymbols._t)"
+                )
+        return ""
+
     def plain(self, expr, what, velocities=True, time=True):
         """`expr` in plain symbols: q_i(t) -> q_i, q_i'(t) -> q_i_d, the time -> t."""
-        derivatives = {sp.Derivative(c, self.time): d for c, d in zip(self.q_functions, self.qds)}
+        times = {
+            s for s in expr.free_symbols if isinstance(s, sp.Symbol) and s.name == self.time_name
+        } | {self.time}
+        derivatives = {}
+        for c, d in zip(self.q_functions, self.qds):
+            for tau in times:
+                f = c.func(tau)
+                derivatives[sp.Derivative(f, tau)] = d
         out = expr.xreplace(derivatives)
         for d in sorted(out.atoms(sp.Derivative), key=sp.default_sort_key):
             f = d.expr
-            if f in self.q_functions:
+            if f.func in {c.func for c in self.q_functions}:
                 raise SpecError(
                     f"{what} uses {sp.sstr(d)}: only the coordinates and their first time "
                     f"derivatives may appear"
                 )
-            if isinstance(f, AppliedUndef) and f.args == (self.time,):
+            if isinstance(f, AppliedUndef) and len(f.args) == 1 and f.args[0] in times:
                 raise SpecError(
                     f"{what} uses the velocity of {f}, a function of time that is not listed "
                     f"in q (an unknown coordinate)"
                 )
             raise SpecError(f"{what} uses the derivative {sp.sstr(d)}: {SUPPORTED}")
-        out = out.xreplace(dict(zip(self.q_functions, self.qs)))
+        replace = {}
+        for c, s in zip(self.q_functions, self.qs):
+            for tau in times:
+                replace[c.func(tau)] = s
+        out = out.xreplace(replace)
         for f in sorted(out.atoms(AppliedUndef), key=sp.default_sort_key):
-            if f.args == (self.time,):
+            if len(f.args) == 1 and f.args[0] in times:
                 raise SpecError(
                     f"{what} uses {f}, a function of time that is not listed in q (an unknown "
                     f"coordinate)"
@@ -347,7 +548,7 @@ class Spec:
             raise SpecError(
                 f"{what} uses the unknown function {type(f).__name__}: {SUPPORTED}"
             )
-        out = out.xreplace({self.time: self.t}) if self.time != self.t else out
+        out = out.xreplace({tau: self.t for tau in times})
         allowed = set(self.param_symbols) | set(self.qs)
         if velocities:
             allowed |= set(self.qds)
@@ -355,17 +556,20 @@ class Spec:
             allowed.add(self.t)
         for sym in sorted(out.free_symbols - allowed, key=lambda s: s.name):
             if sym in self.qds:
+                name = self.q_written[self.qds.index(sym)]
                 why = (
                     "the rows are holonomic, phi(q) = 0"
                     if what.startswith("phi")
                     else "velocity-dependent terms belong in T or Q"
                 )
                 raise SpecError(
-                    f"{what} depends on the velocity {sym.name[:-2]}': it may depend on the "
+                    f"{what} depends on the velocity {name}': it may depend on the "
                     f"coordinates only ({why})"
                 )
             if sym == self.t:
-                raise SpecError(f"{what} depends on time t: constraint rows must not")
+                raise SpecError(
+                    f"{what} depends on the time {self.time_name}: constraint rows must not"
+                )
             raise SpecError(
                 f"{what} uses the unknown symbol `{sym}`: it is neither a parameter (params), "
                 f"a coordinate (q) nor the time"
@@ -420,7 +624,7 @@ class Derivation:
         if s.simplify:
             T = sp.trigsimp(sp.expand(T))
             V = sp.trigsimp(sp.expand(V))
-        check_quadratic(T, s.qds, s.q_names)
+        check_quadratic(T, s.qds, s.q_written, s.time_hint())
         L = T - V
         self.M = sp.Matrix(n, n, lambda i, j: sp.diff(T, s.qds[i], s.qds[j]))
         f = []
@@ -470,12 +674,12 @@ class Derivation:
         return sp.Add(*[sp.factor_terms(c) * v for v, c in terms.items()])
 
 
-def check_quadratic(T, qds, names):
+def check_quadratic(T, qds, names, hint):
     """T must be a polynomial of degree at most 2 in the velocities."""
     if not T.free_symbols & set(qds):
         raise SpecError(
             "T does not depend on any velocity: the mass matrix d2T/dq'2 would be zero "
-            "(singular)"
+            "(singular)" + hint
         )
     for qd, name in zip(qds, names):
         if not T.is_polynomial(qd):
@@ -531,7 +735,7 @@ def check_mass_matrix(M, spec):
         )
     scale = max(abs(x) for x in null)
     combo = ""
-    for x, name in zip(null, spec.q_names):
+    for x, name in zip(null, spec.q_written):
         c = float(x / scale)
         if abs(c) <= 1e-6:
             continue
@@ -542,7 +746,7 @@ def check_mass_matrix(M, spec):
         raise SpecError(
             f"the mass matrix d2T/dq'2 is singular at every sampled configuration: T gives no "
             f"inertia to the velocity combination {combo} (does every coordinate's velocity "
-            f"appear in T?)"
+            f"appear in T?)" + spec.time_hint()
         )
     raise SpecError(
         f"the mass matrix d2T/dq'2 is not positive definite at any sampled configuration: "
@@ -555,10 +759,12 @@ def check_mass_matrix(M, spec):
 
 
 class Constants:
-    """The parameter-only subexpressions, each a constant `k<i>` formed by the constructor."""
+    """The parameter-only subexpressions, each a constant `k<i>` formed by the constructor
+    (named so that no name of the spec is taken)."""
 
-    def __init__(self, params):
+    def __init__(self, params, names):
         self.params = set(params)
+        self.names = names
         self.table = {}  # expression -> symbol
         self.order = []  # (symbol, expression)
 
@@ -579,7 +785,7 @@ class Constants:
         if not self.worth(c):
             return c
         if c not in self.table:
-            k = sp.Symbol(f"k{len(self.order)}")
+            k = sp.Symbol(self.names.fresh(f"k{len(self.order)}"))
             self.table[c] = k
             self.order.append((k, c))
         return self.table[c]
@@ -600,9 +806,14 @@ class Constants:
 
 
 # --------------------------------------------------------------------------------------------
+
 # Emitting Rust: typed, so that scalar-generic code multiplies a scalar by a real on its right
 
 ATOM, NEG, MUL, ADD = 4, 3, 2, 1
+
+
+# Every float literal written, for the `approx_constant` check of the header.
+LITERALS = []
 
 
 def float_literal(x):
@@ -611,6 +822,7 @@ def float_literal(x):
         raise SpecError(f"the number {x} is not finite")
     if "." not in r and "e" not in r:
         r += ".0"
+    LITERALS.append(r)
     return r
 
 
@@ -767,13 +979,16 @@ class Emitter:
         return f"{root}.powi({k})", ATOM, kind
 
 
+
 class Block:
     """A function body: common subexpressions of some outputs, with sines and cosines of one
     argument computed together, as `let` statements in dependency order."""
 
-    def __init__(self, emitter, exprs, inputs):
-        """`inputs`: symbol -> (Rust binding code, kind), bound only when used."""
+    def __init__(self, emitter, exprs, inputs, scope):
+        """`inputs`: symbol -> (Rust binding code, kind), bound only when used. `scope`: the
+        function's names, from which its temporaries are drawn."""
         self.emitter = emitter
+        self.scope = scope
         self.lines = []
         # Sines and cosines, innermost first, become placeholder symbols.
         trig = {}  # argument -> [sin symbol, cos symbol, used sin, used cos]
@@ -790,10 +1005,16 @@ class Block:
                     if arg.is_Symbol:
                         stem = names.get(arg, arg.name)
                         stem = stem.replace("self.", "")
-                        pair = (sp.Symbol(f"sin_{stem}"), sp.Symbol(f"cos_{stem}"))
+                        pair = (
+                            sp.Symbol(scope.fresh(f"sin_{stem}")),
+                            sp.Symbol(scope.fresh(f"cos_{stem}")),
+                        )
                     else:
                         i = sum(1 for a in trig if not a.is_Symbol)
-                        pair = (sp.Symbol(f"sin{i}"), sp.Symbol(f"cos{i}"))
+                        pair = (
+                            sp.Symbol(scope.fresh(f"sin{i}")),
+                            sp.Symbol(scope.fresh(f"cos{i}")),
+                        )
                     trig[arg] = [pair[0], pair[1], False, False]
                 entry = trig[arg]
                 if isinstance(e, sp.sin):
@@ -806,7 +1027,9 @@ class Block:
         exprs = [placeholders(e) for e in exprs]
         trig_args = list(trig)
         replacements, reduced = sp.cse(
-            exprs + trig_args, symbols=sp.numbered_symbols("e"), order="canonical"
+            exprs + trig_args,
+            symbols=(sp.Symbol(scope.fresh(f"e{i}")) for i in itertools.count()),
+            order="canonical",
         )
         outputs, reduced_args = reduced[: len(exprs)], reduced[len(exprs):]
         definitions = {}  # symbol -> ("let", expr) | ("trig", arg index)
@@ -886,48 +1109,102 @@ class Block:
 
 
 # --------------------------------------------------------------------------------------------
-# The Rust file
+# Docs: Markdown that reads as written
 
 
-def doc_lines(text, prefix="/// "):
-    out = []
-    for line in text.splitlines():
-        out.append((prefix + line).rstrip())
-    return out
+# A word that Markdown would read as the start of a block (a quote, a list item, a heading, a
+# fence, a table, HTML, a rule) when a line starts with it.
+RISKY = re.compile(r"^(>|\||<|```|~~~|[-+*]$|#{1,6}$|\d{1,9}[.)]$|[-=*_+]+$)")
+
+
+def escape_start(word):
+    """`word` escaped so that a line may start with it."""
+    m = re.fullmatch(r"(\d{1,9})([.)])", word)
+    if m:
+        return f"{m.group(1)}\\{m.group(2)}"
+    return "\\" + word
+
+
+def wrap(text, width=92):
+    """`text` wrapped into lines of at most `width` (a longer word stands alone), never starting
+    a line with what Markdown reads as a block marker: such a word stays on the line before,
+    or, first in the paragraph, is escaped."""
+    words, lines, line = text.split(), [], ""
+    for w in words:
+        if not line:
+            line = escape_start(w) if RISKY.match(w) else w
+        elif len(line) + 1 + len(w) > width and not RISKY.match(w):
+            lines.append(line)
+            line = w
+        else:
+            line = f"{line} {w}"
+    if line:
+        lines.append(line)
+    return lines
+
+
+def doc_lines(lines, indent):
+    return [f"{indent}/// {line}".rstrip() for line in lines]
 
 
 def capital(text):
     return text[:1].upper() + text[1:]
 
 
-def wrap(text, width=96):
-    words, lines, line = text.split(), [], ""
-    for w in words:
-        if line and len(line) + 1 + len(w) > width:
-            lines.append(line)
-            line = w
-        else:
-            line = f"{line} {w}" if line else w
-    if line:
-        lines.append(line)
-    return "\n".join(lines)
+# --------------------------------------------------------------------------------------------
+# Literals that clippy's `approx_constant` would read as an approximation of a constant
+
+
+KNOWN_CONSTANTS = [
+    mpmath.e, 1 / mpmath.pi, 1 / mpmath.sqrt(2), 2 / mpmath.pi, 2 / mpmath.sqrt(mpmath.pi),
+    mpmath.pi / 2, mpmath.pi / 3, mpmath.pi / 4, mpmath.pi / 6, mpmath.pi / 8, mpmath.ln(2),
+    mpmath.ln(10), mpmath.log(10, 2), mpmath.log(mpmath.e, 2), mpmath.log(2, 10),
+    mpmath.log(mpmath.e, 10), mpmath.pi, mpmath.sqrt(2), 2 * mpmath.pi,
+]
+
+
+def looks_like_constant(literal):
+    """True when `literal` (a float literal as written) agrees with a known constant to all
+    its digits, as clippy's `approx_constant` judges."""
+    text = literal.lstrip("-")
+    if "e" in text or "." not in text:
+        return False
+    decimals = len(text.split(".")[1])
+    if decimals < 2:
+        return False
+    value = float(text)
+    return any(abs(value - float(c)) < 10.0 ** -decimals for c in KNOWN_CONSTANTS)
+
+
+# --------------------------------------------------------------------------------------------
+# The Rust file
 
 
 class Generator:
-    def __init__(self, spec, derivation, source, command, tests):
+    def __init__(self, spec, derivation, spec_path, file_name, options):
         self.s = spec
         self.d = derivation
-        self.source = source
-        self.command = command
-        self.tests = tests
-        self.consts = Constants(spec.param_symbols)
+        self.source = spec_path.replace("\\", "/").rsplit("/", 1)[-1]
+        self.spec_path = spec_path
+        self.file_name = file_name
+        self.options = options
+        self.tests = "--tests" in options
+        self.n = spec.n
+        names = spec.names
+        # The generated code's own names: they give way to the spec's.
+        self.state = names.fresh("s")
+        self.q = names.fresh("q")
+        self.qd = names.fresh("qd")
+        self.consts = Constants(spec.param_symbols, names)
         self.out = []
-        self.uses = set()
 
     # -- printing the formulas for the docs --
 
     def pretty(self, e):
-        sub = {qd: sp.Symbol(name + "'") for qd, name in zip(self.s.qds, self.s.q_names)}
+        s = self.s
+        sub = {sym: sp.Symbol(name) for sym, name in zip(s.qs, s.q_written)}
+        sub.update({qd: sp.Symbol(name + "'") for qd, name in zip(s.qds, s.q_written)})
+        sub[s.t] = sp.Symbol(s.time_name)
         return sp.sstr(e.xreplace(sub)).replace("**", "^")
 
     def written(self, e):
@@ -936,17 +1213,16 @@ class Generator:
 
     # -- names --
 
-    def names(self, generic):
+    def code_names(self, constructor=False):
         """Symbol -> Rust code for parameters, constants and state."""
-        names = {p: f"self.{p.name}" for p in self.s.param_symbols}
+        prefix = "" if constructor else "self."
+        names = {p: prefix + self.s.param_rust[p] for p in self.s.param_symbols}
         for k, _ in self.consts.order:
-            names[k] = f"self.{k.name}"
-        for sym in self.s.qs + self.s.qds:
-            names[sym] = sym.name
-        names[self.s.t] = "t"
+            names[k] = prefix + k.name
+        names.update(self.s.rust_names)
         return names
 
-    def state_inputs(self, generic, vectors=("s.q", "s.qd"), time="s.t"):
+    def state_inputs(self, generic, vectors, time):
         kind = "S" if generic else "T"
         inputs = {}
         for i, sym in enumerate(self.s.qs):
@@ -958,10 +1234,13 @@ class Generator:
             inputs[self.s.t] = (time, kind)
         return inputs
 
-    def block(self, exprs, generic, **kw):
+    def block(self, exprs, generic, vectors=None, time=None):
+        if vectors is None:
+            vectors = (f"{self.state}.q", f"{self.state}.qd")
+            time = f"{self.state}.t"
         exprs = [self.consts.hoist(e) for e in exprs]
-        emitter = Emitter(generic, self.names(generic))
-        return Block(emitter, exprs, self.state_inputs(generic, **kw))
+        emitter = Emitter(generic, self.code_names())
+        return Block(emitter, exprs, self.state_inputs(generic, vectors, time), self.s.names.child())
 
     # -- pieces of the file --
 
@@ -974,61 +1253,73 @@ class Generator:
         blocks = {}
         blocks["mass"] = self.block(m_entries, False)
         blocks["rhs"] = self.block(d.f, False)
-        if d.fixed_mass:
-            # M^-1 (or its factor) is formed once by the constructor: the law needs f + Q.
-            blocks["law"] = self.block(forces, False)
-        else:
-            blocks["law"] = self.block(m_entries + forces, False)
+        blocks["equations"] = self.block(m_entries + forces, False)
         self.m_entries = m_entries
-        blocks["kinetic"] = self.block([d.T], True, vectors=("q", "qd"), time="t")
-        blocks["potential"] = self.block([d.V], True, vectors=("q", None), time="t")
+        qv = (self.q, self.qd)
+        blocks["kinetic"] = self.block([d.T], True, vectors=qv, time=s.t.name)
+        blocks["potential"] = self.block([d.V], True, vectors=(self.q, None), time=s.t.name)
         if d.Q is not None:
             blocks["force"] = self.block(d.Q, False)
         if d.phi is not None:
-            blocks["phi"] = self.block(d.phi, False, vectors=("q", None), time=None)
-            blocks["phi_generic"] = self.block(d.phi, True, vectors=("q", None), time=None)
-            blocks["jacobian"] = self.block(list(d.J), False, vectors=("q", None), time=None)
-            blocks["jqd"] = self.block(d.Jqd, False, vectors=("q", "qd"), time=None)
+            blocks["phi"] = self.block(d.phi, False, vectors=(self.q, None), time=None)
+            blocks["phi_generic"] = self.block(d.phi, True, vectors=(self.q, None), time=None)
+            blocks["jacobian"] = self.block(list(d.J), False, vectors=(self.q, None), time=None)
+            blocks["jqd"] = self.block(d.Jqd, False, vectors=qv, time=None)
         self.blocks = blocks
-        self.header()
-        self.struct()
-        self.constructors()
-        self.mechanism()
+        if d.fixed_mass:
+            self.mass_field = s.names.fresh("mass")
+        self.reads_velocities = any(
+            e.free_symbols & set(s.qds) for e in forces
+        )
+        self.parameters()
         self.lagrangian()
+        self.closed_form()
         if d.phi is not None:
             self.constraints()
-        self.solver()
         if self.tests:
             self.test_module()
-        return self.imports() + "\n".join(self.out) + "\n"
-
-    def imports(self):
-        core = sorted(self.uses, key=lambda x: (not x[0].islower(), x))
-        na = sorted(self.uses_na)
-        lines = []
-        if self.d.phi is not None:
-            lines.append("use lagrange_core::constraints::{Constraints, HolonomicConstraints};")
-        lines.append(f"use lagrange_core::nalgebra::{{{', '.join(na)}}};")
-        lines.append(f"use lagrange_core::{{{', '.join(core)}}};")
-        return self.header_text + "\n".join(lines) + "\n\n"
+        return self.header() + "\n".join(self.out) + "\n"
 
     def header(self):
         s = self.s
-        line1 = f"//! [`{s.name}`]: generated by `cargo xtask derive` from `{self.source}`."
-        needs = "; its test module needs `lagrange-tests`" if self.tests else ""
-        self.header_text = (
-            f"{line1}\n//!\n"
-            f"//! Do not edit: change the spec and regenerate this file (SymPy {sp.__version__}{needs}):\n"
-            f"//!\n//! ```text\n//! {self.command}\n//! ```\n\n"
-        )
-        self.uses = {"Error", "Lagrangian", "Mechanism", "Real", "Scalar", "State", "validate"}
-        self.uses.add("GeneralizedForce")
-        self.uses_na = {"SMatrix", "SVector"}
+        options = " ".join(self.options) if self.options else "none"
+        lines = [
+            f"//! [`{s.name}`]: generated by `lagrange-derive` (SymPy {sp.__version__}). Do not edit:",
+            "//! change the spec and regenerate this file from any folder, naming it by its path there:",
+            "//!",
+            "//! ```text",
+            f"//! lagrange-derive --update {self.file_name}",
+            "//! ```",
+            "//!",
+            f"//! Spec: `{self.spec_path}` (relative to this file). Options: `{options}`.",
+            "",
+        ]
+        allow = []
+        identifiers = list(s.param_rust.values()) + s.q_rust + [s.time_rust]
+        if not all(is_snake(x) for x in identifiers):
+            allow.append("non_snake_case")
+        if re.search(r"[A-Z]{2}", s.name):
+            allow.append("clippy::upper_case_acronyms")
+        if any(x.strip("_") in ("foo", "baz", "quux") for x in identifiers):
+            allow.append("clippy::disallowed_names")
+        if any(looks_like_constant(x) for x in LITERALS):
+            allow.append("clippy::approx_constant")
+        if allow:
+            lines.append(f"#![allow({', '.join(allow)})]")
+            lines.append("")
+        closed = ["ClosedForm"] + (["ConstantMass"] if self.d.fixed_mass else [])
+        lines.append(f"use lagrange_core::closed_form::{{{', '.join(closed)}}};")
+        if self.d.phi is not None:
+            lines.append("use lagrange_core::constraints::{Constraints, HolonomicConstraints};")
+        lines.append("use lagrange_core::nalgebra::{SMatrix, SVector};")
+        lines.append("use lagrange_core::{Lagrangian, Real, Scalar, State};")
+        lines.append("")
+        return "\n".join(lines) + "\n"
 
     def formulas(self):
         s, d = self.s, self.d
         lines = []
-        lines.append(f"q    = [{', '.join(s.q_names)}]")
+        lines.append(f"q    = [{', '.join(s.q_written)}]")
         for name, written, derived in (("T", s.T_written, d.T), ("V", s.V_written, d.V)):
             text = self.written(written)
             lines.append(f"{name}    = {text}")
@@ -1037,9 +1328,7 @@ class Generator:
         if s.Q_written is not None:
             lines.append(f"Q    = [{', '.join(self.written(e) for e in s.Q_written)}]")
         if s.phi_written is not None:
-            lines.append(
-                f"phi  = [{', '.join(self.pretty(e) for e in s.phi)}] = 0"
-            )
+            lines.append(f"phi  = [{', '.join(self.pretty(e) for e in s.phi)}] = 0")
         lines.append("")
         lines.append("M q'' = f + Q" + (" + J^T lambda,   J q'' = -J'q'" if d.phi is not None else ""))
         m = [[self.pretty(d.M[i, j]) for j in range(s.n)] for i in range(s.n)]
@@ -1053,135 +1342,87 @@ class Generator:
                 )
                 lines.append(f"J'q' = [{', '.join(self.pretty(e) for e in d.Jqd)}]")
         else:
-            lines.append("(M and f are long: see mass_matrix and rhs)")
+            lines.append("(M and f are long: see mass_formula and rhs_formula)")
         return lines
 
     def solve_text(self):
         n = self.s.n
         if self.d.fixed_mass:
-            how = "its inverse" if n <= 2 else "its Cholesky factor"
-            return f"`M` is constant: {how} formed once by the constructor"
+            return "`M` is constant: factored once by the constructor"
         return "closed form" if n <= 2 else "Cholesky"
 
-    def struct(self):
-        s = self.s
+    def parameters(self):
+        s, d = self.s, self.d
         o = self.out
+        o.append("lagrange_core::parameters! {")
+        ind = "    "
         for i, paragraph in enumerate(s.doc):
             if i:
-                o.append("///")
-            o.extend(doc_lines(wrap(paragraph)))
-        o.append("///")
-        o.append("/// ```text")
-        o.extend(doc_lines("\n".join(self.formulas())))
-        o.append("/// ```")
-        o.append("///")
-        params = ", ".join(
-            f"`{p.name}` = {default!r}" for p, default, _, _ in s.params
-        )
+                o.append(f"{ind}///")
+            o.extend(doc_lines(wrap(paragraph), ind))
+        o.append(f"{ind}///")
+        o.append(f"{ind}/// ```text")
+        o.extend(f"{ind}/// {line}".rstrip() for line in self.formulas())
+        o.append(f"{ind}/// ```")
+        o.append(f"{ind}///")
         o.extend(doc_lines(wrap(
-            f"Derived by SymPy from `{self.source}` (`cargo xtask derive`): the mass matrix "
-            f"and the rest of the Euler-Lagrange equations in closed form, the linear solve "
-            f"numeric ({self.solve_text()}). Defaults ([`Default`]): "
-            f"{params}."
-        )))
-        if self.d.phi is not None:
-            o.append("///")
+            f"Derived by SymPy from `{self.source}` (`lagrange-derive`): `M` and `f` in "
+            f"closed form, the linear solve numeric ({self.solve_text()}); a [`Mechanism`]"
+            f"(lagrange_core::Mechanism) by "
+            f"[`closed_form_mechanism!`](lagrange_core::closed_form_mechanism)."
+        ), ind))
+        renamed = [
+            f"`{p.name}` is `{s.param_rust[p]}`" for p in s.param_symbols
+            if p.name != s.param_rust[p]
+        ]
+        if renamed:
+            o.append(f"{ind}///")
             o.extend(doc_lines(wrap(
-                f"As a [`Mechanism`] this is the free mechanism; as [`Constraints`] it is "
-                f"the rows `phi` ({len(self.d.phi)}). The constrained mechanism is "
-                f"`Constrained::new({s.name}::default())` "
+                "The spec's names in Rust (see lagrange-derive's naming rule): "
+                + ", ".join(renamed) + "."
+            ), ind))
+        if d.phi is not None:
+            o.append(f"{ind}///")
+            o.extend(doc_lines(wrap(
+                f"As a [`Mechanism`](lagrange_core::Mechanism) this is the free mechanism; as "
+                f"[`Constraints`] it is the rows `phi` ({len(d.phi)}). The constrained "
+                f"mechanism is `Constrained::new({s.name}::default())` "
                 f"([`Constrained`](lagrange_core::Constrained))."
-            )))
-        o.append("#[derive(Debug, Clone, Copy, PartialEq)]")
-        o.append(f"pub struct {s.name}<T: Real> {{")
-        for p, _, _, desc in s.params:
-            o.append(f"    /// {capital(desc) if desc else 'Parameter `' + p.name + '`'}.")
-            o.append(f"    {p.name}: T,")
-        for k, expr in self.consts.order:
-            o.append(f"    /// `{self.pretty(expr)}`.")
-            o.append(f"    {k.name}: T,")
-        n = s.n
-        if self.d.fixed_mass and n <= 2:
-            o.append("    /// `M^-1`, formed once (`M` is constant), or why `M` has none.")
-            o.append(f"    inverse: Result<SMatrix<T, {n}, {n}>, Error>,")
-        elif self.d.fixed_mass:
-            self.uses.add("Cholesky")
-            o.append("    /// The Cholesky factor of `M`, formed once (`M` is constant), or why `M` has none.")
-            o.append(f"    factor: Result<Cholesky<T, {n}>, Error>,")
-        o.append("}")
-        o.append("")
-
-    def constructors(self):
-        s = self.s
-        o = self.out
-        args = ", ".join(f"{p.name}: T" for p in s.param_symbols)
-        names = ", ".join(p.name for p in s.param_symbols)
-        many = len(s.params) > 7
-        o.append(f"impl<T: Real> {s.name}<T> {{")
-        o.extend(doc_lines(wrap(
-            "A mechanism of these parameters: "
-            + ", ".join(
-                f"`{p.name}` ({(desc + ', ') if desc else ''}{KINDS[kind][1]})"
-                for p, _, kind, desc in s.params
-            )
-            + ".",
-            92,
-        ), "    /// "))
-        o.append("    ///")
-        o.append("    /// # Errors")
-        o.append("    /// [`Error::InvalidParameter`] naming the first parameter out of range or not finite.")
-        if many:
-            o.append("    #[allow(clippy::too_many_arguments)]")
-        o.append(f"    pub fn new({args}) -> Result<Self, Error> {{")
-        o.append("        Ok(Self::from_valid(")
-        for p, _, kind, _ in s.params:
-            o.append(f'            validate::{KINDS[kind][0]}("{p.name}", {p.name})?,')
-        o.append("        ))")
-        o.append("    }")
-        o.append("")
-        o.append("    /// The mechanism of parameters already checked, its constants formed once.")
-        if many:
-            o.append("    #[allow(clippy::too_many_arguments)]")
-        o.append(f"    fn from_valid({args}) -> Self {{")
-        names_map = {p: p.name for p in s.param_symbols}
-        emitter = Emitter(False, dict(names_map))
+            ), ind))
+        o.append(f"{ind}pub struct {s.name} {{")
+        for p, default, kind, desc in s.params:
+            text = capital(" ".join(desc.split())) if desc and desc.strip() else f"Parameter `{p.name}`"
+            if not text.endswith("."):
+                text += "."
+            o.extend(doc_lines(wrap(text, 88), ind * 2))
+            o.append(f"{ind * 2}{s.param_rust[p]}: {kind} = {float_literal(default)},")
+        o.append(f"{ind}}}")
+        formed = []
+        names = self.code_names(constructor=True)
+        emitter = Emitter(False, dict(names))
         for k, expr in self.consts.order:
             code, _, _ = emitter.emit(expr)
-            o.append(f"        let {k.name} = {code};")
-        fields = [names] + [k.name for k, _ in self.consts.order]
-        if self.d.fixed_mass:
-            # The constant M from the same constants the mass matrix returns.
-            local = dict(names_map)
-            local.update({k: k.name for k, _ in self.consts.order})
-            mass = Block(Emitter(False, local), [self.consts.hoist(e) for e in self.m_entries], {})
+            formed.append((f"`{self.pretty(expr)}`.", f"{k.name}: T = {code}"))
+        if d.fixed_mass:
+            mass = Block(
+                Emitter(False, dict(names)),
+                [self.consts.hoist(e) for e in self.m_entries],
+                {},
+                s.names.child(),
+            )
             matrix = self.matrix_from_upper(mass, 0)
-            for line in mass.lines:
-                o.append(f"        {line}")
-            o.append(f"        let mass = {matrix};")
-            if s.n <= 2:
-                fields.append("inverse: inverse(&mass)")
-            else:
-                fields.append("factor: Cholesky::factor(&mass)")
-        o.append(f"        Self {{ {', '.join(fields)} }}")
-        o.append("    }")
-        for p, _, kind, desc in s.params:
-            o.append("")
-            o.append(f"    /// {capital(desc) if desc else 'Parameter `' + p.name + '`'}.")
-            o.append("    #[must_use]")
-            o.append(f"    pub fn {p.name}(&self) -> T {{")
-            o.append(f"        self.{p.name}")
-            o.append("    }")
-        o.append("}")
-        o.append("")
-        emitter = Emitter(False, {})
-        o.append(f"impl<T: Real> Default for {s.name}<T> {{")
-        o.append("    /// The spec's defaults: " + ", ".join(f"`{p.name}` = {v!r}" for p, v, _, _ in s.params) + ".")
-        o.append("    fn default() -> Self {")
-        o.append("        Self::from_valid(")
-        for p, v, _, _ in s.params:
-            o.append(f"            {emitter.real_literal(sp.Float(v) if not float(v).is_integer() else sp.Integer(int(v)))},")
-        o.append("        )")
-        o.append("    }")
+            if mass.lines:
+                matrix = "{ " + " ".join(mass.lines) + f" {matrix} }}"
+            formed.append((
+                "`M`, the same at every state: factored once.",
+                f"{self.mass_field}: ConstantMass<T, {s.n}> = ConstantMass::new(&{matrix})",
+            ))
+        if formed:
+            o.append(f"{ind}formed {{")
+            for doc, line in formed:
+                o.append(f"{ind * 2}/// {doc}")
+                o.append(f"{ind * 2}{line},")
+            o.append(f"{ind}}}")
         o.append("}")
         o.append("")
 
@@ -1189,10 +1430,16 @@ class Generator:
         """A function: `{s}` in `signature` is the state's name, `_s` when unused."""
         o = self.out
         if doc:
-            o.extend(doc_lines(doc, indent + "/// "))
-        signature = signature.replace("{s}", "s" if block.used_inputs else "_s")
+            o.extend(doc_lines([doc], indent))
+        signature = signature.replace("{s}", self.state if block.used_inputs else "_" + self.state)
         o.append(f"{indent}{signature} {{")
-        for line in block.body():
+        lines = block.body()
+        # `let x = ...; x` is clippy's `let_and_return`: return the value itself.
+        last = lines[-1] if lines else ""
+        m = re.fullmatch(r"let ([A-Za-z_][A-Za-z0-9_]*) = (.*);", last)
+        if m and m.group(1) == result:
+            lines, result = lines[:-1], m.group(2)
+        for line in lines:
             o.append(f"{indent}    {line}")
         o.append(f"{indent}    {result}")
         o.append(f"{indent}}}")
@@ -1215,71 +1462,13 @@ class Generator:
             for j in range(i, n):
                 code = block.output(index[(i, j)], "T")
                 if i != j and block.outputs[index[(i, j)]][1] < ATOM:
-                    block.lines.append(f"let m{i}_{j} = {code};")
-                    code = f"m{i}_{j}"
+                    local = block.scope.fresh(f"m{i}_{j}")
+                    block.lines.append(f"let {local} = {code};")
+                    code = local
                 entry[(i, j)] = entry[(j, i)] = code
         # Column arrays: From<[[T; R]; C]>.
         columns = ["[" + ", ".join(entry[(i, j)] for i in range(n)) + "]" for j in range(n)]
         return f"SMatrix::from([{', '.join(columns)}])"
-
-    def mechanism(self):
-        s, d = self.s, self.d
-        n = s.n
-        b = self.blocks
-        o = self.out
-        o.append(f"impl<T: Real> {s.name}<T> {{")
-        if d.fixed_mass:
-            self.fn(
-                f"fn forces(&self, {{s}}: &State<T, {n}>) -> SVector<T, {n}>",
-                b["law"],
-                self.vector(b["law"], 0, n),
-                doc="`f + Q`: what the law needs besides the constant `M^-1`.",
-            )
-        else:
-            self.fn(
-                f"fn equations(&self, {{s}}: &State<T, {n}>) -> (SMatrix<T, {n}, {n}>, SVector<T, {n}>)",
-                b["law"],
-                f"({self.matrix_from_upper(b['law'], 0)}, {self.vector(b['law'], n * (n + 1) // 2, n)})",
-                doc="`M` and `f + Q`, their common subexpressions shared: what the law needs.",
-            )
-        o.append("}")
-        o.append("")
-        o.append(f"impl<T: Real> Mechanism<T, {n}> for {s.name}<T> {{")
-        self.fn(
-            f"fn mass_matrix(&self, {{s}}: &State<T, {n}>) -> SMatrix<T, {n}, {n}>",
-            b["mass"],
-            self.matrix_from_upper(b["mass"], 0),
-        )
-        o.append("")
-        self.fn(
-            f"fn rhs(&self, {{s}}: &State<T, {n}>) -> SVector<T, {n}>",
-            b["rhs"],
-            self.vector(b["rhs"], 0, n),
-        )
-        o.append("")
-        if d.fixed_mass:
-            apply = "finite(self.inverse? * b)" if n <= 2 else "finite(self.factor?.solve(b))"
-            o.append("    /// With the constant `M`'s inverse (or factor) formed once; finite or an error.")
-            o.append(f"    fn solve_mass(&self, _s: &State<T, {n}>, b: &SVector<T, {n}>) -> Result<SVector<T, {n}>, Error> {{")
-            o.append(f"        {apply}")
-            o.append("    }")
-            o.append("")
-            o.append("    /// `M^-1 (f + Q + extra)`, `M^-1` formed once.")
-            o.append(f"    fn law<F: GeneralizedForce<T, {n}>>(&self, s: &State<T, {n}>, extra: &F) -> Result<SVector<T, {n}>, Error> {{")
-            o.append("        self.solve_mass(s, &extra.added_to(s, self.forces(s)))")
-            o.append("    }")
-        else:
-            o.append(f"    fn solve_mass(&self, s: &State<T, {n}>, b: &SVector<T, {n}>) -> Result<SVector<T, {n}>, Error> {{")
-            o.append("        solve(&self.mass_matrix(s), b)")
-            o.append("    }")
-            o.append("")
-            o.append("    /// `M^-1 (f + Q + extra)`, with `M` and `f + Q` formed together.")
-            o.append(f"    fn law<F: GeneralizedForce<T, {n}>>(&self, s: &State<T, {n}>, extra: &F) -> Result<SVector<T, {n}>, Error> {{")
-            o.append("        let (m, f) = self.equations(s);")
-            o.append("        solve(&m, &extra.added_to(s, f))")
-            o.append("    }")
-        o.append("}")
-        o.append("")
 
     def lagrangian(self):
         s, d = self.s, self.d
@@ -1293,23 +1482,28 @@ class Generator:
             o.append("    const CONSTANT_MASS: bool = true;")
         if d.driven and not d.explicit_time:
             o.append("    const DRIVEN: bool = true;")
-        used = b["kinetic"].used_inputs
-        t = "t" if s.t in used else "_t"
-        qv = "q" if used & set(s.qs) else "_q"
-        o.append("")
+        if d.explicit_time or d.constant_mass or (d.driven and not d.explicit_time):
+            o.append("")
+
+        def arg(name, block, symbols):
+            return name if block.used_inputs & set(symbols) else "_" + name
+
+        t = s.t.name
+        kin = b["kinetic"]
         self.fn(
-            f"fn kinetic<S: Scalar<Real = T>>(&self, {t}: S, {qv}: &SVector<S, {n}>, qd: &SVector<S, {n}>) -> S",
-            b["kinetic"],
-            b["kinetic"].output(0, "S"),
+            f"fn kinetic<S: Scalar<Real = T>>(&self, {arg(t, kin, [s.t])}: S, "
+            f"{arg(self.q, kin, s.qs)}: &SVector<S, {n}>, {arg(self.qd, kin, s.qds)}: "
+            f"&SVector<S, {n}>) -> S",
+            kin,
+            kin.output(0, "S"),
         )
         o.append("")
-        used = b["potential"].used_inputs
-        t = "t" if s.t in used else "_t"
-        qv = "q" if used & set(s.qs) else "_q"
+        pot = b["potential"]
         self.fn(
-            f"fn potential<S: Scalar<Real = T>>(&self, {t}: S, {qv}: &SVector<S, {n}>) -> S",
-            b["potential"],
-            b["potential"].output(0, "S"),
+            f"fn potential<S: Scalar<Real = T>>(&self, {arg(t, pot, [s.t])}: S, "
+            f"{arg(self.q, pot, s.qs)}: &SVector<S, {n}>) -> S",
+            pot,
+            pot.output(0, "S"),
         )
         if d.Q is not None:
             o.append("")
@@ -1321,218 +1515,142 @@ class Generator:
         o.append("}")
         o.append("")
 
+    def closed_form(self):
+        s, d = self.s, self.d
+        n = s.n
+        b = self.blocks
+        o = self.out
+        o.append(f"impl<T: Real> ClosedForm<T, {n}> for {s.name}<T> {{")
+        if not self.reads_velocities:
+            o.append("    const READS_VELOCITIES: bool = false;")
+            o.append("")
+        self.fn(
+            f"fn mass_formula(&self, {{s}}: &State<T, {n}>) -> SMatrix<T, {n}, {n}>",
+            b["mass"],
+            self.matrix_from_upper(b["mass"], 0),
+        )
+        o.append("")
+        self.fn(
+            f"fn rhs_formula(&self, {{s}}: &State<T, {n}>) -> SVector<T, {n}>",
+            b["rhs"],
+            self.vector(b["rhs"], 0, n),
+        )
+        o.append("")
+        eq = b["equations"]
+        self.fn(
+            f"fn equations(&self, {{s}}: &State<T, {n}>) -> (SMatrix<T, {n}, {n}>, SVector<T, {n}>)",
+            eq,
+            f"({self.matrix_from_upper(eq, 0)}, {self.vector(eq, n * (n + 1) // 2, n)})",
+        )
+        if d.fixed_mass:
+            o.append("")
+            o.append(f"    fn constant_mass(&self) -> Option<&ConstantMass<T, {n}>> {{")
+            o.append(f"        Some(&self.{self.mass_field})")
+            o.append("    }")
+        o.append("}")
+        o.append("")
+        o.append(f"lagrange_core::closed_form_mechanism!({s.name}, {n});")
+        o.append("")
+
     def constraints(self):
         s, d = self.s, self.d
         n, c = s.n, len(d.phi)
         b = self.blocks
         o = self.out
+
+        def arg(name, block, symbols):
+            return name if block.used_inputs & set(symbols) else "_" + name
+
         o.append(f"impl<T: Real> Constraints<T, {n}, {c}> for {s.name}<T> {{")
-        qv = "q" if b["phi"].used_inputs else "_q"
         self.fn(
-            f"fn position_residual(&self, {qv}: &SVector<T, {n}>) -> SVector<T, {c}>",
+            f"fn position_residual(&self, {arg(self.q, b['phi'], s.qs)}: &SVector<T, {n}>) -> SVector<T, {c}>",
             b["phi"],
             self.vector(b["phi"], 0, c),
         )
         o.append("")
-        qv = "q" if b["jacobian"].used_inputs else "_q"
         columns = [
             "[" + ", ".join(b["jacobian"].output(i * n + j, "T") for i in range(c)) + "]"
             for j in range(n)
         ]
         self.fn(
-            f"fn jacobian(&self, {qv}: &SVector<T, {n}>) -> SMatrix<T, {c}, {n}>",
+            f"fn jacobian(&self, {arg(self.q, b['jacobian'], s.qs)}: &SVector<T, {n}>) -> SMatrix<T, {c}, {n}>",
             b["jacobian"],
             f"SMatrix::from([{', '.join(columns)}])",
         )
         o.append("")
-        used = b["jqd"].used_inputs
-        qv = "q" if used & set(s.qs) else "_q"
-        qdv = "qd" if used & set(s.qds) else "_qd"
+        jqd = b["jqd"]
         self.fn(
-            f"fn velocity_product(&self, {qv}: &SVector<T, {n}>, {qdv}: &SVector<T, {n}>) -> SVector<T, {c}>",
-            b["jqd"],
-            self.vector(b["jqd"], 0, c),
+            f"fn velocity_product(&self, {arg(self.q, jqd, s.qs)}: &SVector<T, {n}>, "
+            f"{arg(self.qd, jqd, s.qds)}: &SVector<T, {n}>) -> SVector<T, {c}>",
+            jqd,
+            self.vector(jqd, 0, c),
         )
         o.append("}")
         o.append("")
         o.append("/// The rows written generic over the scalar, for the automatic path (`Holonomic`).")
         o.append(f"impl<T: Real> HolonomicConstraints<T, {n}, {c}> for {s.name}<T> {{")
-        qv = "q" if b["phi_generic"].used_inputs else "_q"
+        pg = b["phi_generic"]
         self.fn(
-            f"fn phi<S: Scalar<Real = T> + 'static>(&self, {qv}: &SVector<S, {n}>) -> SVector<S, {c}>",
-            b["phi_generic"],
-            self.vector(b["phi_generic"], 0, c, want="S"),
+            f"fn phi<S: Scalar<Real = T> + 'static>(&self, {arg(self.q, pg, s.qs)}: &SVector<S, {n}>) -> SVector<S, {c}>",
+            pg,
+            self.vector(pg, 0, c, want="S"),
         )
         o.append("}")
         o.append("")
-
-    def solver(self):
-        n = self.s.n
-        o = self.out
-        # The finiteness rule of every function that returns a `Result` (issue 15): the solves,
-        # and so the law, return `Ok` only with finite values. Parameters that are each valid
-        # may still form products that overflow or underflow (a mass of 1e-308: an infinite
-        # inverse), and a finite state may be extreme.
-        o.extend([
-            "/// `x` when every component is finite, else [`Error::NonFiniteState`]: the solves, and so",
-            "/// the law, return `Ok` only with finite values, whatever the parameters' products and the",
-            "/// state.",
-            "fn finite<T: Real, const N: usize>(x: SVector<T, N>) -> Result<SVector<T, N>, Error> {",
-            "    if x.iter().all(|v| v.is_finite()) {",
-            "        Ok(x)",
-            "    } else {",
-            "        Err(Error::NonFiniteState)",
-            "    }",
-            "}",
-            "",
-        ])
-        if self.d.fixed_mass and n >= 3:
-            return  # the Cholesky factor of lagrange_core does it
-        if self.d.fixed_mass:
-            o.append("/// `m^-1`, column by column, or why there is none (as [`solve`] would refuse `m`).")
-            o.append(f"fn inverse<T: Real>(m: &SMatrix<T, {n}, {n}>) -> Result<SMatrix<T, {n}, {n}>, Error> {{")
-            if n == 1:
-                o.append("    let c0 = solve(m, &SVector::from([T::one()]))?;")
-                o.append("    Ok(SMatrix::from([[c0[0]]]))")
-            else:
-                o.append("    let c0 = solve(m, &SVector::from([T::one(), T::zero()]))?;")
-                o.append("    let c1 = solve(m, &SVector::from([T::zero(), T::one()]))?;")
-                o.append("    Ok(SMatrix::from([[c0[0], c0[1]], [c1[0], c1[1]]]))")
-            o.append("}")
-            o.append("")
-        if n == 1:
-            o.extend([
-                "/// Solves `m x = b` (1x1), refusing a mass that is not positive as the Cholesky solve",
-                "/// would.",
-                "fn solve<T: Real>(m: &SMatrix<T, 1, 1>, b: &SVector<T, 1>) -> Result<SVector<T, 1>, Error> {",
-                "    let d = m[(0, 0)];",
-                "    if !d.is_finite() {",
-                "        return Err(Error::NonFiniteState);",
-                "    }",
-                "    if d <= T::zero() {",
-                "        return Err(Error::SingularMassMatrix { pivot: 0 });",
-                "    }",
-                "    finite(b / d)",
-                "}",
-            ])
-        elif n == 2:
-            o.extend([
-                "/// Solves the symmetric 2x2 system `m x = b` by its closed-form inverse, refusing a mass",
-                "/// matrix that is singular or not positive definite as the Cholesky solve would.",
-                "fn solve<T: Real>(m: &SMatrix<T, 2, 2>, b: &SVector<T, 2>) -> Result<SVector<T, 2>, Error> {",
-                "    let (a, c, d) = (m[(0, 0)], m[(1, 0)], m[(1, 1)]);",
-                "    let det = a * d - c * c;",
-                "    if !det.is_finite() {",
-                "        return Err(Error::NonFiniteState);",
-                "    }",
-                "    if a <= T::zero() {",
-                "        return Err(Error::SingularMassMatrix { pivot: 0 });",
-                "    }",
-                "    if det <= a * d.abs() * T::EPSILON {",
-                "        return Err(Error::SingularMassMatrix { pivot: 1 });",
-                "    }",
-                "    let inv = T::one() / det;",
-                "    finite(SVector::from([(d * b[0] - c * b[1]) * inv, (a * b[1] - c * b[0]) * inv]))",
-                "}",
-            ])
-        else:
-            self.uses.add("solve_spd")
-            o.extend([
-                f"/// Solves `m x = b` by the fixed-size Cholesky solve.",
-                f"fn solve<T: Real>(m: &SMatrix<T, {n}, {n}>, b: &SVector<T, {n}>) -> Result<SVector<T, {n}>, Error> {{",
-                "    finite(solve_spd(m, b)?)",
-                "}",
-            ])
 
     def test_module(self):
         s, d = self.s, self.d
         n = s.n
         o = self.out
+        check = "check_held" if d.phi is not None else "check"
+        ranges = ", ".join(f"({float_literal(lo)}, {float_literal(hi)})" for lo, hi in s.ranges)
+        o.extend([
+            "/// The closed form against the automatic path of its own `T` and `V`, in `f64` and `f32`",
+            "/// (`lagrange_core::agreement`).",
+            "#[cfg(test)]",
+            "mod tests {",
+            f"    use lagrange_core::agreement::{{{check}, Disagreement}};",
+            "",
+            "    /// Where the states are drawn: the spec's ranges of the coordinates.",
+            f"    const RANGES: [(f64, f64); {n}] = [{ranges}];",
+            "",
+            "    #[test]",
+            f"    fn agrees_with_automatic_f64() -> Result<(), Disagreement<f64, {n}>> {{",
+            f"        {check}(&super::{s.name}::<f64>::default(), &RANGES)",
+            "    }",
+            "",
+            "    #[test]",
+            f"    fn agrees_with_automatic_f32() -> Result<(), Disagreement<f32, {n}>> {{",
+            f"        {check}(&super::{s.name}::<f32>::default(), &RANGES)",
+            "    }",
+            "}",
+        ])
         o.append("")
-        o.append("/// The generated equations against the automatic path of the same `T` and `V`.")
-        o.append("#[cfg(test)]")
-        o.append("mod tests {")
-        o.append("    use super::*;")
-        if d.phi is not None:
-            o.append("    use lagrange_core::constraints::Holonomic;")
-            o.append("    use lagrange_core::{Constrained, EulerLagrange};")
-            o.append("    use lagrange_tests::{agrees_with_automatic, relative, Rng, Scales};")
-        else:
-            o.append("    use lagrange_tests::{agrees_with_automatic, Rng, Scales};")
-        o.append("")
-        o.append("    /// Relative agreement in `f64`.")
-        o.append("    const F64_TOLERANCE: f64 = 1e-12;")
-        o.append("    /// Relative agreement in `f32`.")
-        o.append("    const F32_TOLERANCE: f64 = 1e-4;")
-        o.append("    /// Random states compared.")
-        o.append("    const STATES: usize = 1000;")
-        o.append("    /// Natural sizes added to the compared values' (see `Scales`).")
-        o.append("    const SCALES: Scales = Scales { acceleration: 1.0, energy: 1.0 };")
-        o.append("")
-        ranges = ", ".join(f"rng.uniform({float_literal(lo)}, {float_literal(hi)})" for lo, hi in s.ranges)
-        vel = ", ".join("rng.uniform(-3.0, 3.0)" for _ in range(n))
-        o.append("    /// A state drawn from the spec's ranges, velocities in `(-3, 3)`, time in `(0, 10)`.")
-        o.append(f"    fn sample<T: Real>(rng: &mut Rng) -> State<T, {n}> {{")
-        o.append("        let t = rng.uniform(0.0, 10.0);")
-        o.append(f"        let q = [{ranges}];")
-        o.append(f"        let qd = [{vel}];")
-        o.append("        State::new(t, q, qd)")
-        o.append("    }")
-        o.append("")
-        o.append("    fn agrees<T: Real>(tolerance: f64) -> Result<(), Error> {")
-        o.append(f"        let mechanism = {s.name}::<T>::default();")
-        o.append("        let mut rng = Rng::new(16);")
-        o.append("        agrees_with_automatic(&mechanism, SCALES, tolerance, STATES, &mut rng, sample::<T>)?;")
-        if d.phi is not None:
-            o.append("        // The rows against their dual-number derivatives, and the constrained motion.")
-            o.append("        let rows = Holonomic::new(mechanism);")
-            o.append("        let constrained = Constrained::new(mechanism);")
-            o.append("        let automatic = EulerLagrange::new(mechanism).held_by(rows);")
-            o.append("        for _ in 0..STATES {")
-            o.append("            let s = sample::<T>(&mut rng);")
-            o.append("            let checks = [")
-            o.append("                (\"phi\", relative(mechanism.position_residual(&s.q).iter().copied(), rows.position_residual(&s.q).iter().copied(), 1.0)),")
-            o.append("                (\"J\", relative(mechanism.jacobian(&s.q).iter().copied(), rows.jacobian(&s.q).iter().copied(), 1.0)),")
-            o.append("                (\"J'q'\", relative(mechanism.velocity_product(&s.q, &s.qd).iter().copied(), rows.velocity_product(&s.q, &s.qd).iter().copied(), 1.0)),")
-            o.append("                (\"q''\", relative(constrained.acceleration(&s)?.iter().copied(), automatic.acceleration(&s)?.iter().copied(), 1.0)),")
-            o.append("            ];")
-            o.append("            for (what, e) in checks {")
-            o.append("                assert!(e < tolerance, \"{what} at {s:?}: {e:e}\");")
-            o.append("            }")
-            o.append("        }")
-        o.append("        Ok(())")
-        o.append("    }")
-        o.append("")
-        o.append("    #[test]")
-        o.append("    fn agrees_with_automatic_f64() -> Result<(), Error> {")
-        o.append("        agrees::<f64>(F64_TOLERANCE)")
-        o.append("    }")
-        o.append("")
-        o.append("    #[test]")
-        o.append("    fn agrees_with_automatic_f32() -> Result<(), Error> {")
-        o.append("        agrees::<f32>(F32_TOLERANCE)")
-        o.append("    }")
-        o.append("}")
+        if o[-1] == "":
+            o.pop()
 
 
 def main(argv):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("spec")
     parser.add_argument("--name")
-    parser.add_argument("--source", help="the spec's path as the header names it")
-    parser.add_argument("--command", help="the command that regenerates the file")
-    parser.add_argument("--tests", action="store_true", help="add a test module (lagrange-tests)")
+    parser.add_argument(
+        "--spec-path", help="the spec's path as the header records it (relative to the output)"
+    )
+    parser.add_argument("--file-name", help="the output's file name, for the header's command")
+    parser.add_argument("--tests", action="store_true", help="add a test module")
     args = parser.parse_args(argv)
-    source = args.source or args.spec
-    command = args.command or f"cargo xtask derive {source}"
+    options = (["--name", args.name] if args.name else []) + (["--tests"] if args.tests else [])
+    spec_path = args.spec_path or args.spec
+    file_name = args.file_name or "FILE.rs"
     try:
         spec = Spec(args.spec, args.name)
         derivation = Derivation(spec)
-        code = Generator(spec, derivation, source, command, args.tests).generate()
+        code = Generator(spec, derivation, spec_path, file_name, options).generate()
     except SpecError as e:
         message = str(e)
         if not message.startswith(args.spec):
-            message = f"{source}: {message}"
+            message = f"{args.spec}: {message}"
         print(f"error: {message}", file=sys.stderr)
         return 1
     sys.stdout.write(code)
