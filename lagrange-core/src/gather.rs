@@ -11,8 +11,8 @@ use core::fmt::Debug;
 ///
 /// Opt-in, apart from [`Mechanism`]: a mechanism of your own needs nothing of it to be stepped,
 /// in a bank or alone. The standard mechanisms of `lagrange-systems` that are plain structs of
-/// scalars implement it (the pendulum, double pendulum, cart-pole, acrobot, spring and falling
-/// particle), and a scene's bank in lanes (`InLanes` in `lagrange-integrators`) keeps its
+/// scalars implement it (the pendulum, double pendulum, cart-pole, acrobot, spring, falling
+/// particle, rigid body), and a scene's bank in lanes (`InLanes` in `lagrange-integrators`) keeps its
 /// instances gathered, all `K` of them as one `Gathered<K>`, from which it takes each group's
 /// [`Gather::window`] at every step and into which it [`Gather::put`]s an instance that changed.
 ///

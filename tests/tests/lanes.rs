@@ -11,7 +11,7 @@ use lagrange_integrators::{
     ExplicitEuler, FixedTimestep, Integrator, Rk4, SemiImplicitEuler, VelocityVerlet,
 };
 use lagrange_systems::{
-    Acrobot, CartPole, DoublePendulum, FallingParticle, SimplePendulum, SpringMassDamper,
+    Acrobot, CartPole, DoublePendulum, FallingParticle, RigidBody, SimplePendulum, SpringMassDamper,
 };
 use lagrange_tests::{for_f32_and_f64, Rng};
 
@@ -145,6 +145,12 @@ fn every_gathering_mechanism<T: Real>() -> Result<(), Error> {
             p,
             State::new(T::zero(), [u(r, 0.0, 10.0)], [u(r, -1.0, 1.0)]),
         ))
+    })?;
+    every_method(1e-2, |r| {
+        let p = RigidBody::new(u(r, 0.5, 2.0), u(r, 0.1, 1.0), T::from_f64(9.81))?;
+        let q = [u(r, -1.0, 1.0), u(r, 0.0, 10.0), u(r, -3.0, 3.0)];
+        let qd = [u(r, -1.0, 1.0), u(r, -1.0, 1.0), u(r, -5.0, 5.0)];
+        Ok((p, State::new(T::zero(), q, qd)))
     })?;
     Ok(())
 }
