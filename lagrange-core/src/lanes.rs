@@ -21,7 +21,7 @@
 //!
 //! [`sin_cos_lanes`]: crate::fast_trig::sin_cos_lanes
 
-use crate::scalar::{powi_by_squaring, sin_cos_each, Real, Scalar};
+use crate::scalar::{cos_each, powi_by_squaring, sin_cos_each, sin_each, Real, Scalar};
 use core::cmp::Ordering;
 use core::fmt;
 use core::ops::{Add, AddAssign, Div, DivAssign, Mul, MulAssign, Neg, Sub, SubAssign};
@@ -326,13 +326,13 @@ impl<T: Real, const L: usize> Scalar for Lanes<T, L> {
     fn value(self) -> Self {
         self
     }
-    /// The scalar sine of each lane: over a vector unit, through [`Real::sin_cos_lanes`]
+    /// The scalar sine of each lane: over a vector unit, through [`Real::sin_lanes`]
     /// (branch-free, the lanes together); elsewhere lane by lane with the scalar's branches,
     /// which cost less than computing both of its paths for every lane.
     #[inline(always)]
     fn sin(self) -> Self {
         if VECTOR_UNIT {
-            Self(T::sin_cos_lanes(self.0).0)
+            Self(T::sin_lanes(self.0))
         } else {
             self.map(Scalar::sin)
         }
@@ -341,7 +341,7 @@ impl<T: Real, const L: usize> Scalar for Lanes<T, L> {
     #[inline(always)]
     fn cos(self) -> Self {
         if VECTOR_UNIT {
-            Self(T::sin_cos_lanes(self.0).1)
+            Self(T::cos_lanes(self.0))
         } else {
             self.map(Scalar::cos)
         }
@@ -404,6 +404,12 @@ impl<T: Real, const L: usize> Real for Lanes<T, L> {
     }
     fn sin_cos_lanes<const K: usize>(x: [Self; K]) -> ([Self; K], [Self; K]) {
         sin_cos_each(x)
+    }
+    fn sin_lanes<const K: usize>(x: [Self; K]) -> [Self; K] {
+        sin_each(x)
+    }
+    fn cos_lanes<const K: usize>(x: [Self; K]) -> [Self; K] {
+        cos_each(x)
     }
     /// Every lane of every value finite, with no branch per lane and no divergence counted:
     /// over a vector unit one AND a lane (`x * 0 == 0`), elsewhere one sum of `x * 0` over
