@@ -57,6 +57,7 @@ use core::fmt::Debug;
 ///     fn gather<const L: usize>(instances: [&Self; L]) -> Spring<Lanes<T, L>> {
 ///         Spring { k: Lanes::gather(&instances, |m| m.k) }
 ///     }
+///     #[inline(always)]
 ///     fn window<const W: usize, const L: usize>(
 ///         wide: &Spring<Lanes<T, W>>,
 ///         at: usize,
@@ -85,6 +86,11 @@ pub trait Gather<T: Real, const N: usize>: Mechanism<T, N> + Sized {
 
     /// `L` lanes of a wider gathered mechanism from lane `at` on ([`Lanes::window`]: lanes
     /// past its end repeat its last).
+    ///
+    /// A bank in lanes calls it for every group at every step: mark it `#[inline(always)]`,
+    /// as the standard mechanisms do. Inlined, the step reads the parameters its law uses
+    /// straight from the bank and leaves the others; called, it copies them all (left to the
+    /// compiler, it was not inlined in a bank that sleeps).
     fn window<const W: usize, const L: usize>(
         wide: &Self::Gathered<W>,
         at: usize,

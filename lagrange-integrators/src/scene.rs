@@ -46,6 +46,7 @@ mod columns;
 mod layout;
 mod sleep;
 mod slot;
+mod states;
 
 pub use bank::{Bank, Energies, Id, Status};
 pub use banks::Banks;

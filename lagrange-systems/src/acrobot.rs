@@ -274,6 +274,7 @@ impl<T: Real> Gather<T, 2> for Acrobot<T> {
             torque: lanes(|m| m.torque),
         }
     }
+    #[inline(always)] // see `Gather::window`
     fn window<const W: usize, const L: usize>(
         wide: &Self::Gathered<W>,
         at: usize,

@@ -177,6 +177,7 @@ impl<T: Real> Gather<T, 2> for CartPole<T> {
             force: lanes(|m| m.force),
         }
     }
+    #[inline(always)] // see `Gather::window`
     fn window<const W: usize, const L: usize>(
         wide: &Self::Gathered<W>,
         at: usize,

@@ -136,7 +136,10 @@ impl<T: Real> DoublePendulum<T> {
 
     /// The mass matrix, the right-hand side and `det M` together, sharing one
     /// `sin_cos(th1 - th2)`.
-    #[inline]
+    // Inlined into the law: called, over lanes it took the group's parameters through memory,
+    // and a bank of 1,024 double pendulums in lanes of 16 cost 17.8 rather than 16.1 ns per
+    // instance-step.
+    #[inline(always)]
     fn terms(&self, s: &State<T, 2>) -> (Matrix2<T>, Vector2<T>, T) {
         let k = &self.k;
         let (sin, cos) = (s.q[0] - s.q[1]).sin_cos();
@@ -169,6 +172,7 @@ impl<T: Real> Gather<T, 2> for DoublePendulum<T> {
             },
         }
     }
+    #[inline(always)] // see `Gather::window`
     fn window<const W: usize, const L: usize>(
         wide: &Self::Gathered<W>,
         at: usize,

@@ -70,6 +70,7 @@ impl<T: Real> Gather<T, 1> for FallingParticle<T> {
             gravity: lanes(|m| m.gravity),
         }
     }
+    #[inline(always)] // see `Gather::window`
     fn window<const W: usize, const L: usize>(
         wide: &Self::Gathered<W>,
         at: usize,

@@ -145,6 +145,7 @@ impl<T: Real> Gather<T, 3> for RigidBody<T> {
             gravity: lanes(|b| b.gravity),
         }
     }
+    #[inline(always)] // see `Gather::window`
     fn window<const W: usize, const L: usize>(
         wide: &Self::Gathered<W>,
         at: usize,

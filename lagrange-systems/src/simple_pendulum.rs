@@ -120,6 +120,7 @@ impl<T: Real> Gather<T, 1> for SimplePendulum<T> {
             inv_inertia: lanes(|m| m.inv_inertia),
         }
     }
+    #[inline(always)] // see `Gather::window`
     fn window<const W: usize, const L: usize>(
         wide: &Self::Gathered<W>,
         at: usize,

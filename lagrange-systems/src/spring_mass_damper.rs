@@ -82,6 +82,7 @@ impl<T: Real> Gather<T, 1> for SpringMassDamper<T> {
             damping: lanes(|m| m.damping),
         }
     }
+    #[inline(always)] // see `Gather::window`
     fn window<const W: usize, const L: usize>(
         wide: &Self::Gathered<W>,
         at: usize,

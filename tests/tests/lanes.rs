@@ -6,7 +6,7 @@
 
 use lagrange_core::nalgebra::SVector;
 use lagrange_core::{check_finite, divergences, Error, Gather, Lanes, Real, Scalar, State};
-use lagrange_integrators::scene::{Bank, InLanes, NeverSleeps, Scene};
+use lagrange_integrators::scene::{Bank, InLanes, NeverSleeps, Scene, LANES};
 use lagrange_integrators::{
     ExplicitEuler, FixedTimestep, Integrator, Rk4, SemiImplicitEuler, VelocityVerlet,
 };
@@ -15,7 +15,7 @@ use lagrange_systems::{
 };
 use lagrange_tests::{for_f32_and_f64, Rng};
 
-/// Lanes per group in these tests (the scene's width on x86_64).
+/// Lanes per group in the tests of lanes alone (a scene's bank steps [`LANES`] at a time).
 const L: usize = 8;
 
 /// Steps per comparison: long enough for a chaotic double pendulum to amplify any bit.
@@ -158,7 +158,7 @@ fn every_gathering_mechanism<T: Real>() -> Result<(), Error> {
 /// A bank of pendulums that is not a multiple of the lane width, stepped by a scene, equals
 /// a `FixedTimestep` per pendulum, bit for bit (interpolated states too).
 fn a_bank_in_lanes_equals_its_instances_alone<T: Real>() -> Result<(), Error> {
-    const K: usize = 3 * L + 5;
+    const K: usize = 3 * LANES + 5;
     let mut rng = Rng::new(11);
     let dt = T::from_f64(1.0 / 120.0);
     let mut bank: Bank<T, 2, K, DoublePendulum<T>, Rk4, NeverSleeps, InLanes> =
@@ -333,6 +333,12 @@ fn every_operation_lane_by_lane<T: Real>() -> Result<(), Error> {
     let ([s2], [c2]) = <Lanes<T, L> as Real>::sin_cos_lanes([y]);
     lane_by_lane(s2, |i| ys[i].sin(), "sin_cos_lanes.0");
     lane_by_lane(c2, |i| ys[i].cos(), "sin_cos_lanes.1");
+    let ([s3], [c3]) = (
+        <Lanes<T, L> as Real>::sin_lanes([y]),
+        <Lanes<T, L> as Real>::cos_lanes([y]),
+    );
+    lane_by_lane(s3, |i| ys[i].sin(), "sin_lanes");
+    lane_by_lane(c3, |i| ys[i].cos(), "cos_lanes");
     lane_by_lane(z.tan(), |i| zs[i].tan(), "tan");
     lane_by_lane(x.sqrt(), |i| xs[i].sqrt(), "sqrt");
     lane_by_lane(y.exp(), |i| ys[i].exp(), "exp");

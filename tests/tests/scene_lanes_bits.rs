@@ -17,8 +17,9 @@ use lagrange_tests::{for_f32_and_f64, Rng};
 const DT: f64 = 1.0 / 120.0;
 /// Steps per frame at most.
 const CAP: u32 = 4;
-/// Capacity: three groups of eight and a short one.
-const K: usize = 29;
+/// Capacity: three whole groups and a short one of more than half a group, so that as
+/// instances come and go the last group is stepped in lanes and one by one in turn.
+const K: usize = 3 * LANES + LANES / 2 + 5;
 /// Frames per run.
 const FRAMES: usize = 900;
 

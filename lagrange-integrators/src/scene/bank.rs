@@ -2,8 +2,8 @@
 //! with the awake instances packed in front.
 
 use super::awake::Awake;
-use super::columns::Columns;
 use super::slot::Slot;
+use super::states::States;
 use super::{Layout, NeverSleeps, OneByOne, Sleep, Sleeps};
 use crate::Integrator;
 use heapless::Vec;
@@ -108,9 +108,9 @@ struct Entry {
 ///
 /// The awake instances are packed at the front, so that a step is one tight loop over them
 /// and an asleep instance costs nothing but its memory. The states are kept apart from the
-/// rest, as structure of arrays (an array of times, one per coordinate, one per velocity), so
-/// that a group of instances in lanes is one window of each; they are therefore read and
-/// written by value ([`Bank::state`], [`Bank::set_state`]). Falling asleep and
+/// rest (in a bank in lanes as structure of arrays: an array of times, one per coordinate, one
+/// per velocity, so that a group of instances is one window of each); they are therefore read
+/// and written by value ([`Bank::state`], [`Bank::set_state`]). Falling asleep and
 /// waking swap an instance across the boundary (its [`Id`] follows it); the order of the
 /// instances within the array therefore depends on their history, but no instance's bits
 /// depend on it: instances do not interact, and each has its own integrator.
@@ -166,9 +166,9 @@ pub struct Bank<
     /// By place.
     slots: Vec<Slot<M, I>, K>,
     /// Each place's state after the last step.
-    current: Columns<T, N, K>,
+    current: Y::States,
     /// Each place's state before the last step (what [`Bank::interpolated`] draws from).
-    previous: Columns<T, N, K>,
+    previous: Y::States,
     /// What the layout keeps of the mechanisms.
     kept: Y::Kept,
     awake: usize,
@@ -209,8 +209,8 @@ where
             integrator,
             sleep,
             slots: Vec::new(),
-            current: Columns::new(),
-            previous: Columns::new(),
+            current: States::new(),
+            previous: States::new(),
             kept: Y::kept(),
             awake: 0,
             entries: [Entry::default(); K],
@@ -564,6 +564,7 @@ where
             slots: self.slots.get_mut(..self.awake).unwrap_or_default(),
             current: &mut self.current,
             previous: &mut self.previous,
+            states: core::marker::PhantomData,
         };
         let failed = Y::step(&self.kept, awake, dt, t);
         if failed > 0 {

@@ -1,6 +1,7 @@
 //! [`Columns`]: the states of a bank's instances as structure of arrays, one array per
 //! component, so that a group of instances side by side is a window of each array.
 
+use super::states::States;
 use lagrange_core::nalgebra::SVector;
 use lagrange_core::{Lanes, Real, State};
 
@@ -9,8 +10,6 @@ use lagrange_core::{Lanes, Real, State};
 /// a step in [`Lanes`] loads and stores whole, where a state per instance would have to be
 /// gathered and scattered component by component (on x86_64 that cost a bank of pendulums half
 /// again their step in lanes).
-///
-/// Places at or past `K` read as zero and take no write: the bank never asks for them.
 #[derive(Debug, Clone)]
 pub struct Columns<T, const N: usize, const K: usize> {
     t: Lanes<T, K>,
@@ -18,9 +17,8 @@ pub struct Columns<T, const N: usize, const K: usize> {
     qd: [Lanes<T, K>; N],
 }
 
-impl<T: Real, const N: usize, const K: usize> Columns<T, N, K> {
-    /// Every state zero.
-    pub fn new() -> Self {
+impl<T: Real, const N: usize, const K: usize> States<T, N, K> for Columns<T, N, K> {
+    fn new() -> Self {
         Self {
             t: Lanes::splat(T::zero()),
             q: [Lanes::splat(T::zero()); N],
@@ -28,9 +26,8 @@ impl<T: Real, const N: usize, const K: usize> Columns<T, N, K> {
         }
     }
 
-    /// The state at `place`.
     #[inline(always)]
-    pub fn get(&self, place: usize) -> State<T, N> {
+    fn get(&self, place: usize) -> State<T, N> {
         let at = |column: &Lanes<T, K>| column.0.get(place).copied().unwrap_or_else(T::zero);
         State {
             t: at(&self.t),
@@ -39,9 +36,8 @@ impl<T: Real, const N: usize, const K: usize> Columns<T, N, K> {
         }
     }
 
-    /// Writes the state at `place`.
     #[inline(always)]
-    pub fn set(&mut self, place: usize, s: &State<T, N>) {
+    fn set(&mut self, place: usize, s: &State<T, N>) {
         self.t.set(place, s.t);
         for (column, &x) in self.q.iter_mut().zip(s.q.iter()) {
             column.set(place, x);
@@ -51,23 +47,35 @@ impl<T: Real, const N: usize, const K: usize> Columns<T, N, K> {
         }
     }
 
-    /// Sets the time at `place`.
-    pub fn set_time(&mut self, place: usize, t: T) {
+    #[inline(always)]
+    fn step_each<X>(
+        current: &mut Self,
+        previous: &mut Self,
+        at: usize,
+        slots: &mut [X],
+        mut step: impl FnMut(&mut X, &State<T, N>) -> Option<State<T, N>>,
+    ) {
+        for (place, slot) in (at..).zip(slots) {
+            let now = current.get(place);
+            if let Some(next) = step(slot, &now) {
+                previous.set(place, &now);
+                current.set(place, &next);
+            }
+        }
+    }
+
+    fn set_time(&mut self, place: usize, t: T) {
         self.t.set(place, t);
     }
 
-    /// Swaps the states at two places.
-    pub fn swap(&mut self, a: usize, b: usize) {
+    fn swap(&mut self, a: usize, b: usize) {
         let (x, y) = (self.get(a), self.get(b));
         self.set(a, &y);
         self.set(b, &x);
     }
 
-    /// The states of places `at..at + count` side by side (`count` at most `L`), the lanes
-    /// past `count` copies of the first, so that they take the branches it takes and fail
-    /// where it fails.
     #[inline(always)]
-    pub fn window<const L: usize>(&self, at: usize, count: usize) -> State<Lanes<T, L>, N> {
+    fn window<const L: usize>(&self, at: usize, count: usize) -> State<Lanes<T, L>, N> {
         let lanes = |column: &Lanes<T, K>| {
             let mut lanes = column.window::<L>(at);
             if count < L {
@@ -85,14 +93,8 @@ impl<T: Real, const N: usize, const K: usize> Columns<T, N, K> {
         }
     }
 
-    /// Writes the first `count` lanes of `s` into places `at..at + count`.
     #[inline(always)]
-    pub fn set_window<const L: usize>(
-        &mut self,
-        at: usize,
-        count: usize,
-        s: &State<Lanes<T, L>, N>,
-    ) {
+    fn set_window<const L: usize>(&mut self, at: usize, count: usize, s: &State<Lanes<T, L>, N>) {
         let write = |column: &mut Lanes<T, K>, lanes: &Lanes<T, L>| {
             // A whole group is one store of `L` lanes; a short one goes value by value.
             let whole = column.0.get_mut(at..).and_then(|rest| rest.get_mut(..L));

@@ -4,7 +4,7 @@ use lagrange_core::Error;
 
 /// One instance: its mechanism (parameters and input), its integrator (and what that keeps
 /// between steps), and the bank's bookkeeping. Its state is kept apart, with every other
-/// instance's ([`Columns`](super::columns::Columns)).
+/// instance's ([`States`](super::states::States)).
 #[derive(Debug, Clone)]
 pub struct Slot<M, I> {
     /// Its parameters and input.
