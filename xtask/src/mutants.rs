@@ -627,6 +627,7 @@ const AREAS: [Area; 28] = [
             "lagrange-integrators/src/scene/layout.rs",
             "lagrange-integrators/src/scene/sleep.rs",
             "lagrange-integrators/src/scene/slot.rs",
+            "lagrange-integrators/src/scene/states.rs",
         ],
         only: None,
         tests: &[

@@ -57,6 +57,10 @@ pub struct OneByOne;
 /// Where there is no vector unit ([`LANES`] is 1) the bank is a bank [`OneByOne`]: it steps
 /// one by one, keeps its states as one `State` per instance and nothing gathered.
 ///
+/// Lanes pay where many instances are awake: a group's step is one chain of dependent
+/// operations, and a group of 4 takes about as long as a group of 16. With 1 to 6 pendulums
+/// awake, a bank in lanes took 1.3 to 3.3 times as long as one by one (x86_64, RK4).
+///
 /// ```
 /// use lagrange_integrators::prelude::*;
 /// use lagrange_integrators::scene::{Bank, InLanes, NeverSleeps, Scene};
