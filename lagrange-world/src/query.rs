@@ -46,12 +46,15 @@ impl<T: Real> Shape<T> {
     }
 
     /// Where the ray from `origin` along `direction` (not zero) first meets the shape, for
-    /// `t` in `[0, t_max]`: `None` where it does not. A ray that starts inside meets it at
-    /// `t = 0`. The shape is the union of its core, the bands of the radius along its edges
+    /// `t` in `[0, t_max]`: `None` where it does not (and for a `t_max` below zero or not a
+    /// number: no range). A ray that starts inside meets it at `t = 0`. The shape is the union of its core, the bands of the radius along its edges
     /// and the disks of the radius at its vertices: the ray enters it where it first enters
     /// one of them, through an edge moved out by the radius or a vertex's disk.
     #[must_use]
     pub fn ray(&self, origin: Vec2<T>, direction: Vec2<T>, t_max: T) -> Option<RayHit<T>> {
+        if t_max.partial_cmp(&T::zero()).is_none_or(|o| o.is_lt()) {
+            return None;
+        }
         if self.distance(origin) <= T::zero() {
             return Some(RayHit {
                 t: T::zero(),
@@ -68,7 +71,8 @@ impl<T: Real> Shape<T> {
         let n = v.len();
         let mut best: Option<(T, Vec2<T>)> = None;
         let mut consider = |t: T, normal: Vec2<T>| {
-            if t >= T::zero() && t <= t_max && best.is_none_or(|(b, _)| t < b) {
+            // A hit at an infinite t (a direction so short the ray crawls) is none.
+            if t >= T::zero() && t <= t_max && t.is_finite() && best.is_none_or(|(b, _)| t < b) {
                 best = Some((t, normal));
             }
         };

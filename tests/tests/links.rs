@@ -8,8 +8,8 @@ use lagrange_core::links::{Links, Pose};
 use lagrange_core::nalgebra::SVector;
 use lagrange_core::{Error, Lagrangian, Real, Scalar, State};
 use lagrange_systems::{
-    Acrobot, CartPole, DoublePendulum, NLinkPendulum, Ragdoll, RagdollBody, SimplePendulum,
-    RAGDOLL_LINKS,
+    Acrobot, CartPole, DoublePendulum, NLinkPendulum, Ragdoll, RagdollBody, RigidBody,
+    SimplePendulum, RAGDOLL_LINKS,
 };
 use lagrange_tests::{for_f32_and_f64, pick, random_state, Rng};
 
@@ -268,6 +268,29 @@ fn hand_against_duals<T: Real, L: Links<T, N>, const N: usize>(l: &L, rng: &mut 
     worst
 }
 
+/// A link number out of range is the caller's error, for which `Links::pose` promises any
+/// pose and no panic: the pose and the point (hand-derived or dual) of links `LINKS`,
+/// `LINKS + 1` and `usize::MAX` are finite at a random state.
+fn out_of_range_is_no_panic<T: Real, L: Links<T, N>, const N: usize>(l: &L, rng: &mut Rng) {
+    let q = random_state::<T, N>(rng, (-3.2, 3.2), (0.0, 0.0)).q;
+    for link in [L::LINKS, L::LINKS + 1, usize::MAX] {
+        let pose: Pose<T> = l.pose(&q, link);
+        let point = l.point(&q, link, [T::HALF, -T::one()]);
+        let finite = pose
+            .origin
+            .iter()
+            .chain(&[pose.angle])
+            .all(|x| x.is_finite())
+            && point.position.iter().all(|x| x.is_finite())
+            && point.jacobian.iter().all(|x| x.is_finite());
+        assert!(
+            finite,
+            "{}, link {link}: {pose:?} {point:?}",
+            core::any::type_name::<L>()
+        );
+    }
+}
+
 /// The chains' hand-derived points and Jacobians equal the dual-number default's, to 8 ulps of
 /// the sizes (the same sums in another order).
 fn hand_points_agree_with_duals<T: Real>() -> Result<(), Error> {
@@ -309,9 +332,36 @@ fn hand_points_agree_with_duals<T: Real>() -> Result<(), Error> {
     Ok(())
 }
 
+/// Every standard mechanism with links, asked for a link it does not have.
+fn out_of_range_links<T: Real>() -> Result<(), Error> {
+    let mut rng = Rng::new(346);
+    let g = T::from_f64(G);
+    let (h, l) = (T::from_f64(0.7), T::from_f64(1.1));
+    out_of_range_is_no_panic(&SimplePendulum::new(T::one(), h, g, T::zero())?, &mut rng);
+    out_of_range_is_no_panic(&DoublePendulum::new(T::one(), T::one(), h, l, g)?, &mut rng);
+    out_of_range_is_no_panic(&NLinkPendulum::new([T::one(); 3], [h; 3], g)?, &mut rng);
+    out_of_range_is_no_panic(&CartPole::new(T::one(), T::one(), h, g)?, &mut rng);
+    let acrobot = Acrobot::new(
+        T::one(),
+        T::one(),
+        h,
+        l,
+        T::from_f64(0.35),
+        T::from_f64(0.55),
+        T::from_f64(0.1),
+        T::from_f64(0.1),
+        g,
+    )?;
+    out_of_range_is_no_panic(&acrobot, &mut rng);
+    out_of_range_is_no_panic(&Ragdoll::new(RagdollBody::<T>::adult())?, &mut rng);
+    out_of_range_is_no_panic(&RigidBody::disk(T::one(), h, g)?, &mut rng);
+    Ok(())
+}
+
 for_f32_and_f64!(
     energies_agree,
     positions_follow_the_conventions,
     the_ragdoll_agrees,
-    hand_points_agree_with_duals
+    hand_points_agree_with_duals,
+    out_of_range_links
 );

@@ -63,6 +63,18 @@ fn exact_figures<T: Real>() -> Result<(), Error> {
         rounded.distance(v(1.0 + far, 0.5 + far)),
         far * 2.0_f64.sqrt() - 0.25
     ));
+    // A ray that starts inside meets the shape at its start, if its range holds zero: a
+    // range below zero or not a number holds nothing.
+    let inside = v(0.5, 0.5);
+    let at_start = rounded.ray(inside, v(1.0, 0.0), T::zero());
+    assert_eq!(at_start.map(|h| h.t), Some(T::zero()));
+    for t_max in [-1.0, f64::NAN] {
+        assert_eq!(
+            rounded.ray(inside, v(1.0, 0.0), T::from_f64(t_max)),
+            None,
+            "{t_max}"
+        );
+    }
     Ok(())
 }
 

@@ -32,6 +32,7 @@ mod ragdoll;
 mod scenes;
 mod setups;
 mod spring_chain;
+mod world;
 
 pub use case::{Case, Outcome, Precision, Stopwatch, Untimed, MAX_WORDS};
 pub use kernels::{Kernel, KERNELS, KERNEL_CALLS};
@@ -47,6 +48,7 @@ pub use setups::{
     PendulumSetup, Setup,
 };
 pub use spring_chain::SpringChain;
+pub use world::world_in_a_box;
 
 use lagrange_integrators::{Rk4, SemiImplicitEuler, StormerVerlet, VelocityVerlet};
 
@@ -67,7 +69,9 @@ pub const STEPS: u32 = 1000;
 /// dual numbers). The ragdoll is thrown onto the floor and lands and settles under the
 /// impulse stepper (steps of 1/240 s: 4.2 s), beside the same throw with no floor stepped by
 /// RK4; both take their steps one by one, so that the firmware times the worst step of each.
-pub const CASES: [Case; 27] = [
+/// The world is three balls and a crate dropped into a box, at 60 Hz for 1000 steps (they
+/// bounce, touch, come to rest and sleep).
+pub const CASES: [Case; 28] = [
     Case::new::<f32, 1, PendulumSetup, Rk4>(),
     Case::new::<f64, 1, PendulumSetup, Rk4>(),
     Case::new::<f32, 1, PendulumSetup, VelocityVerlet>(),
@@ -125,6 +129,13 @@ pub const CASES: [Case; 27] = [
         ragdoll_landing,
     ),
     Case::stepwise(RAGDOLL_FREE, "RK4", "f32", 5, ragdoll_free),
+    Case::scripted(
+        "world: 3 balls and a crate in a box",
+        "sequential impulses",
+        "f32",
+        2,
+        world_in_a_box,
+    ),
 ];
 
 #[cfg(test)]

@@ -75,8 +75,9 @@ impl<T: Real, const N: usize, const C: usize> Problem<'_, T, N, C> {
     /// (plus the rounding of its speed). The cone holds exactly at
     /// the end. The velocities returned are `v0` plus the response of the final impulses.
     ///
-    /// Where the exact solve does not end in its passes (a degenerate set that cycles), that
-    /// round's normal impulses are projected Gauss-Seidel's ([`Delassus::relaxed`]) and the
+    /// Where the exact solve has no answer (targets no impulses reach: a joint's two limits
+    /// asked for rebounds that would cross its range in the step) or does not end in its
+    /// passes (a degenerate set that cycles), that round's normal impulses are projected Gauss-Seidel's ([`Delassus::relaxed`]) and the
     /// solve is not settled.
     ///
     /// # Errors
@@ -105,9 +106,10 @@ impl<T: Real, const N: usize, const C: usize> Problem<'_, T, N, C> {
             let b = self.normal.jacobian() * sliding - target;
             let solved = match self.normal.complementary_from(&b, self.kinds, &guess) {
                 Ok(solved) => solved,
-                // A degenerate set the exact method cycles on (many contacts struck at once,
-                // more than the motion has freedoms): projected Gauss-Seidel, whose impulses
-                // never add energy, for this round; the solve has not settled.
+                // Targets no impulses reach, or a degenerate set the exact method cycles on
+                // (many contacts struck at once, more than the motion has freedoms):
+                // projected Gauss-Seidel, whose impulses never add energy, for this round;
+                // the solve has not settled.
                 Err(Error::NoConvergence { .. }) => {
                     exact = false;
                     self.normal.relaxed(&b, self.kinds, relaxed_sweeps::<C>())

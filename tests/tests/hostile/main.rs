@@ -1,7 +1,7 @@
 //! The hostile-input campaign: every public entry point of lagrange-core,
-//! lagrange-integrators (scenes and lanes included), lagrange-systems and the generated
-//! mechanisms of lagrange-generated, `f32` and `f64`, called with drawn nasty values
-//! (NaN, infinities, the largest and smallest values, subnormals, signed zeros, tiny and huge
+//! lagrange-integrators (scenes and lanes included), lagrange-systems, the generated
+//! mechanisms of lagrange-generated and lagrange-world's `World`, `f32` and `f64`, called
+//! with drawn nasty values (NaN, infinities, the largest and smallest values, subnormals, signed zeros, tiny and huge
 //! steps, tolerances at their edges) and classified: ok, a specific error, panic, hang, silent
 //! non-finite (`Ok` holding NaN or an infinity), wrong parameter named, state changed on error,
 //! inconsistent (a step and a one-step run disagree).
@@ -34,6 +34,7 @@ mod ragdoll;
 mod scenes;
 mod systems;
 mod values;
+mod world;
 
 use harness::Config;
 use std::process::ExitCode;
@@ -89,6 +90,7 @@ fn main() -> ExitCode {
         drivers::family(),
         scenes::family(),
         ragdoll::family(),
+        world::family(),
     ];
     let reports = harness::run(families, &cfg);
     println!();

@@ -41,7 +41,11 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
             let (lo, hi) = kinds[i].bounds();
             self.candidate[i] && lambda[i] != T::zero() && lambda[i] > lo && lambda[i] < hi
         });
-        Complementary { lambda, active }
+        Complementary {
+            lambda,
+            active,
+            passes: sweeps,
+        }
     }
 }
 
@@ -63,7 +67,9 @@ mod tests {
     /// The corner of the exact method's tests (a floor, a wall and a row that depends on
     /// both, one unit mass): within the bounds, never above zero whatever the sweeps, and
     /// after 60 sweeps the exact method's value to 1e-12 (the error shrinks geometrically);
-    /// a bounded row stays within its bound; a candidate of no mobility stays at zero.
+    /// a bounded row stays within its bound; a candidate of no mobility stays at zero. (Where
+    /// that candidate approaches, `b < 0`, no impulse can stop it and the exact method
+    /// refuses the set: the next test.)
     #[test]
     fn lowers_the_program_within_the_bounds() -> Result<(), Error> {
         let j = SMatrix::<f64, 4, 2>::new(0.0, 1.0, 1.0, 0.0, 1.0, 1.0, 0.0, 0.0);
@@ -75,7 +81,7 @@ mod tests {
             Row::Unilateral,
         ];
         for b in [
-            SVector::<f64, 4>::new(-1.0, -2.0, -3.0, -1.0),
+            SVector::<f64, 4>::new(-1.0, -2.0, -3.0, 1.0),
             SVector::<f64, 4>::new(-1.0, 2.0, 1.0, 0.0),
             SVector::<f64, 4>::new(1.0, 2.0, 3.0, 1.0),
             SVector::<f64, 4>::new(-3.0, -0.5, -1.0, 2.0),
@@ -91,6 +97,47 @@ mod tests {
             let (v, best) = (value(&d, &relaxed.lambda, &b), value(&d, &exact.lambda, &b));
             assert!((v - best).abs() <= 1e-12, "{b:?}: {v} against {best}");
         }
+        Ok(())
+    }
+
+    /// A contact of no mobility that approaches (`b < 0`): no multipliers meet the
+    /// conditions, and the exact method says so at once (`NoConvergence` at its third pass:
+    /// the floor solved, the row joins, its ray has no end;
+    /// not after its cap of `4 C + 4`), where the relaxed one still returns, that row at zero
+    /// and the others' program lowered.
+    #[test]
+    fn a_set_with_no_solution_is_refused_at_once() -> Result<(), Error> {
+        let j = SMatrix::<f64, 2, 2>::new(0.0, 1.0, 0.0, 0.0);
+        let mut d = Delassus::new(&j, |_| Ok(()), &[true; 2])?;
+        let b = SVector::<f64, 2>::new(-1.0, -1.0);
+        let kinds = [Row::Unilateral; 2];
+        assert_eq!(
+            d.complementary_from(&b, &kinds, &[false; 2]),
+            Err(Error::NoConvergence { iterations: 3 })
+        );
+        let r = d.relaxed(&b, &kinds, 4);
+        assert_eq!((r.lambda[0], r.lambda[1]), (1.0, 0.0), "{r:?}");
+        Ok(())
+    }
+
+    /// A row is active where its multiplier is strictly inside its bounds and not zero: a
+    /// contact that pushes, not a friction row held at either bound, not a row that is no
+    /// candidate (four independent rows of one unit mass in four freedoms, `W = I`, so one
+    /// sweep lands each at its clamped minimum `-b`).
+    #[test]
+    fn active_rows_are_inside_their_bounds() -> Result<(), Error> {
+        let j = SMatrix::<f64, 4, 4>::identity();
+        let d = Delassus::new(&j, |_| Ok(()), &[true, true, true, false])?;
+        let kinds = [
+            Row::Unilateral,
+            Row::Bounded(0.5),
+            Row::Bounded(0.5),
+            Row::Bounded(0.5),
+        ];
+        let b = SVector::<f64, 4>::new(-1.0, -5.0, 5.0, -0.1);
+        let r = d.relaxed(&b, &kinds, 1);
+        assert_eq!(r.lambda, SVector::<f64, 4>::new(1.0, 0.5, -0.5, 0.0));
+        assert_eq!(r.active, [true, false, false, false]);
         Ok(())
     }
 

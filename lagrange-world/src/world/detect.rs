@@ -1,0 +1,318 @@
+//! Step 2 of a [`World`]'s step: where its shapes touch or may touch in the step, as contact
+//! rows in the bodies' coordinates; sleeping bodies an awake one touches are woken.
+
+use super::bodies::Attached;
+use super::limits::{Limits, MAX_OWN_ROWS};
+use super::rows::{Contact, Row};
+use super::{World, OWN_ROWS};
+use crate::broad::Proxy;
+use crate::collide::{collide, collide_half_plane};
+use crate::manifold::ContactPoint;
+use crate::vec2::{length, rotate, sub, Vec2};
+use heapless::Vec;
+use lagrange_core::links::Links;
+use lagrange_core::nalgebra::{SMatrix, SVector};
+use lagrange_core::{Error, Mechanism, Real};
+
+/// One side of a contact: a shape's key and the body and link it is on (none: static).
+#[derive(Debug, Clone, Copy)]
+struct Side {
+    key: u32,
+    on: Option<(usize, usize)>,
+}
+
+impl<T, M, L, const N: usize, const B: usize, const S: usize, const K: usize>
+    World<T, M, N, B, S, K, L>
+where
+    T: Real,
+    M: Mechanism<T, N> + Links<T, N> + Clone,
+    L: Limits<T, N>,
+{
+    /// The step's contacts, sorted by key, warm-started from the last step's impulses; the
+    /// number of bodies woken.
+    pub(super) fn detect(&mut self, dt: T) -> Result<u32, Error> {
+        let mut woke = 0;
+        loop {
+            // A body woken has had no free step; its contacts are found again with it.
+            let woken = self.find(dt)?;
+            if woken == 0 {
+                break;
+            }
+            woke += woken;
+        }
+        self.contacts.sort_unstable_by_key(|c| c.key);
+        for c in self.contacts.iter_mut() {
+            if let Ok(i) = self.kept.binary_search_by_key(&c.key, |k| k.key) {
+                if let Some(k) = self.kept.get(i) {
+                    c.normal.lambda = k.normal;
+                    c.tangent.lambda = k.tangent;
+                }
+            }
+        }
+        Ok(woke)
+    }
+
+    /// One pass of detection; the number of sleeping bodies it woke (their contacts are then
+    /// incomplete: the caller finds them again).
+    fn find(&mut self, dt: T) -> Result<u32, Error> {
+        self.contacts.clear();
+        self.broad.clear();
+        let margin = self.settings.margin;
+        for s in &self.shapes {
+            let (lo, hi) = self.placed(s).bounds();
+            let grow = margin + self.reach(s, dt);
+            let body = s.on.map(|(i, _)| i);
+            self.broad
+                .add(Proxy {
+                    bounds: ([lo[0] - grow, lo[1] - grow], [hi[0] + grow, hi[1] + grow]),
+                    body: body.map_or(u32::MAX, |i| u32::try_from(i).unwrap_or(u32::MAX)),
+                    key: s.key,
+                    group: s.group,
+                    mask: s.mask,
+                    fixed: body.is_none(),
+                    asleep: body.is_some_and(|i| self.bodies.get(i).is_some_and(|b| b.asleep)),
+                })
+                // A box that is not finite: a body so far out that its shape's place overflows.
+                .map_err(|_| Error::NonFiniteState)?;
+        }
+        let mut pairs: Vec<(u32, u32), K> = Vec::new();
+        self.broad.pairs(&mut pairs)?;
+        let mut woken = 0;
+        for &(ka, kb) in &pairs {
+            let (Some(a), Some(b)) = (self.shape_copy(ka), self.shape_copy(kb)) else {
+                continue;
+            };
+            let reach = margin + self.reach(&a, dt) + self.reach(&b, dt);
+            let m = collide(&self.placed(&a), &self.placed(&b), reach);
+            if m.points().is_empty() {
+                continue;
+            }
+            let sleeper = [a, b]
+                .iter()
+                .filter_map(|s| s.on)
+                .find(|&(i, _)| self.bodies.get(i).is_some_and(|b| b.asleep));
+            if let Some((i, _)) = sleeper {
+                woken += self.wake_island(i, dt)?;
+                continue;
+            }
+            for p in m.points() {
+                self.push(side(&a), side(&b), m.normal, p, dt)?;
+            }
+        }
+        for pi in 0..self.planes.len() {
+            let Some(&(key, plane)) = self.planes.get(pi) else {
+                continue;
+            };
+            for si in 0..self.shapes.len() {
+                let Some(s) = self.shapes.get(si).copied() else {
+                    continue;
+                };
+                let awake =
+                    s.on.is_some_and(|(i, _)| self.bodies.get(i).is_some_and(|b| !b.asleep));
+                if !awake {
+                    continue;
+                }
+                let reach = margin + self.reach(&s, dt);
+                let m = collide_half_plane(&plane, &self.placed(&s), reach);
+                for p in m.points() {
+                    self.push(Side { key, on: None }, side(&s), m.normal, p, dt)?;
+                }
+            }
+        }
+        for i in 0..self.bodies.len() {
+            self.own_rows(i, dt)?;
+        }
+        Ok(woken)
+    }
+
+    /// The rows of awake body `i`'s own (its limits), as contacts with nothing on their
+    /// other side (no friction), their mobilities from one call of the mass solve.
+    fn own_rows(&mut self, i: usize, dt: T) -> Result<(), Error> {
+        let Some(body) = self.bodies.get(i).filter(|b| !b.asleep) else {
+            return Ok(());
+        };
+        let mut rows: Vec<(u32, T), MAX_OWN_ROWS> = Vec::new();
+        let mut jacobians = SMatrix::<T, N, MAX_OWN_ROWS>::zeros();
+        let mut full = false;
+        body.limits.rows(&body.state.q, |row, gap, j| {
+            let k = rows.len();
+            full |= rows.push((row, gap)).is_err();
+            if k < MAX_OWN_ROWS {
+                jacobians.set_column(k, &j);
+            }
+        });
+        if full {
+            return Err(Error::InvalidParameter {
+                name: "limits",
+                reason: "a body has more own rows than MAX_OWN_ROWS",
+            });
+        }
+        let mut mobilities = jacobians;
+        body.mechanism
+            .velocity_jumps(&body.state, &mut mobilities)?;
+        let zero = SVector::<T, N>::zeros();
+        let key = body.key;
+        let mut found: Vec<Contact<T, N>, MAX_OWN_ROWS> = Vec::new();
+        for (k, &(row, gap)) in rows.iter().enumerate() {
+            let (j, b) = (
+                jacobians.column(k).into_owned(),
+                mobilities.column(k).into_owned(),
+            );
+            let approach = j.dot(&body.state.qd);
+            let _ = found.push(Contact {
+                key: (OWN_ROWS, key, row),
+                bodies: [Some(i), None],
+                normal: Row::new([j, zero], [b, zero]),
+                tangent: Row::new([zero; 2], [zero; 2]),
+                gap,
+                lower: self.lowest(gap, approach, dt),
+                approach,
+                drift: T::zero(),
+                reach: T::zero(),
+                point: [T::zero(); 2],
+                direction: [T::zero(); 2],
+            });
+        }
+        for c in found {
+            self.contacts.push(c).map_err(|_| capacity())?;
+        }
+        Ok(())
+    }
+
+    /// The lowest speed of a row of gap `gap` closing at `-approach` (see `Contact::lower`).
+    fn lowest(&self, gap: T, approach: T, dt: T) -> T {
+        let model = self.settings.model;
+        // Open: it may close in the step, no more; touching: it may not close further.
+        let lower = if gap > T::zero() {
+            -gap / dt
+        } else {
+            T::zero()
+        };
+        // Striking (closing in the step, and fast enough to leave at the rest speed or
+        // more): Newton's rebound. Slower, it rests: a body on the floor gains g dt a step,
+        // which must not bounce it.
+        let rebound = -model.restitution() * approach;
+        if rebound >= model.rest_speed() && gap + approach * dt <= T::zero() {
+            lower.max(rebound)
+        } else {
+            lower
+        }
+    }
+
+    /// Wakes the island body `i` fell asleep with, each body with its free step: how many.
+    fn wake_island(&mut self, i: usize, dt: T) -> Result<u32, Error> {
+        let Some(island) = self.bodies.get(i).map(|b| b.island) else {
+            return Ok(0);
+        };
+        let mut n = 0;
+        for body in self
+            .bodies
+            .iter_mut()
+            .filter(|b| b.asleep && b.island == island)
+        {
+            body.wake();
+            body.free(dt)?;
+            n += 1;
+        }
+        Ok(n)
+    }
+
+    /// Shape `key`, copied.
+    fn shape_copy(&self, key: u32) -> Option<Attached<T>> {
+        self.shape(key).and_then(|i| self.shapes.get(i)).copied()
+    }
+
+    /// How far any point of shape `s` moves in the step at its body's velocity (zero for a
+    /// static or sleeping one): its link's origin's move and its turn times its reach from
+    /// that origin.
+    fn reach(&self, s: &Attached<T>, dt: T) -> T {
+        let Some((body, link)) = s.on.and_then(|(i, link)| Some((self.bodies.get(i)?, link)))
+        else {
+            return T::zero();
+        };
+        if body.asleep {
+            return T::zero();
+        }
+        let now = body.pose(&body.state.q, link);
+        let next = body.pose(&(body.state.q + body.state.qd * dt), link);
+        let extent = s
+            .shape
+            .vertices()
+            .iter()
+            .map(|&v| length(v))
+            .fold(T::zero(), T::max)
+            + s.shape.radius();
+        length(sub(next.origin, now.origin)) + (next.angle - now.angle).abs() * extent
+    }
+
+    /// The contact at `p` between `a` and `b` (normal `n` from `a` to `b`): its rows at the
+    /// bodies' coordinates, and its lowest speed.
+    fn push(
+        &mut self,
+        a: Side,
+        b: Side,
+        n: Vec2<T>,
+        p: &ContactPoint<T>,
+        dt: T,
+    ) -> Result<(), Error> {
+        let t = [-n[1], n[0]];
+        let zero = SVector::<T, N>::zeros();
+        let (mut jn, mut jt, mut bn, mut bt) = ([zero; 2], [zero; 2], [zero; 2], [zero; 2]);
+        let mut approach = T::zero();
+        for (s, (side, sign)) in [(a, -T::one()), (b, T::one())].into_iter().enumerate() {
+            let Some((body, link)) = side.on.and_then(|(i, l)| Some((self.bodies.get(i)?, l)))
+            else {
+                continue;
+            };
+            let pose = body.pose(&body.state.q, link);
+            let (sin, cos) = pose.angle.sin_cos();
+            let local = rotate(sub(p.point, pose.origin), (-sin, cos));
+            let j = body.mechanism.point(&body.state.q, link, local).jacobian;
+            let along = |d: Vec2<T>| {
+                SVector::<T, N>::from_fn(|k, _| sign * (d[0] * j[(0, k)] + d[1] * j[(1, k)]))
+            };
+            let (normal, tangent) = (along(n), along(t));
+            approach += normal.dot(&body.state.qd);
+            if let (Some(x), Some(y)) = (jn.get_mut(s), jt.get_mut(s)) {
+                (*x, *y) = (normal, tangent);
+            }
+            if let (Some(x), Some(y)) = (bn.get_mut(s), bt.get_mut(s)) {
+                *x = body.mechanism.velocity_jump(&body.state, &normal)?;
+                *y = body.mechanism.velocity_jump(&body.state, &tangent)?;
+            }
+        }
+        let gap = p.gap;
+        let lower = self.lowest(gap, approach, dt);
+        self.contacts
+            .push(Contact {
+                key: (a.key, b.key, p.id),
+                bodies: [a.on.map(|(i, _)| i), b.on.map(|(i, _)| i)],
+                normal: Row::new(jn, bn),
+                tangent: Row::new(jt, bt),
+                gap,
+                lower,
+                approach,
+                drift: T::zero(),
+                reach: T::zero(),
+                point: p.point,
+                direction: n,
+            })
+            .map_err(|_| capacity())
+    }
+}
+
+/// More contact points than the world holds.
+fn capacity() -> Error {
+    Error::InvalidParameter {
+        name: "capacity",
+        reason: "more contact points than K",
+    }
+}
+
+/// The side of a contact that shape `s` is.
+fn side<T>(s: &Attached<T>) -> Side {
+    Side {
+        key: s.key,
+        on: s.on,
+    }
+}

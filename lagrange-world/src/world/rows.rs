@@ -1,0 +1,86 @@
+//! The rows of a [`World`](super::World)'s contacts: a contact point between two bodies (or a
+//! body and static geometry) as a normal row and a tangent row in the two bodies' generalized
+//! coordinates, each with its mobilities (`M^-1 j^T`, from each body's own mass solve) and
+//! the impulse it has taken.
+
+use crate::vec2::Vec2;
+use lagrange_core::nalgebra::SVector;
+use lagrange_core::Real;
+
+/// What identifies a contact point from step to step: the two shapes' keys (the first the
+/// shape the normal points away from) and the features that meet (the manifold's id). Its
+/// last impulses are matched by it (warm starting), and contacts are solved in its order.
+pub(crate) type ContactKey = (u32, u32, u32);
+
+/// One row of a contact: `a = sum_s j[s] . v[body s]`, and the velocity change a unit impulse
+/// on it makes, `b[s] = M_s^-1 j[s]^T`, on each side (zero on a static side).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Row<T: Real, const N: usize> {
+    pub(crate) j: [SVector<T, N>; 2],
+    pub(crate) b: [SVector<T, N>; 2],
+    /// `1 / W`, `W = sum_s j[s] . b[s]`; zero for a row no impulse moves.
+    pub(crate) inverse: T,
+    /// The impulse taken this step (warm-started from the last step's).
+    pub(crate) lambda: T,
+}
+
+impl<T: Real, const N: usize> Row<T, N> {
+    /// A row of Jacobians `j` and mobilities `b`, no impulse yet.
+    pub(crate) fn new(j: [SVector<T, N>; 2], b: [SVector<T, N>; 2]) -> Self {
+        let w = j[0].dot(&b[0]) + j[1].dot(&b[1]);
+        // A row no impulse moves (both sides static, or a point that no coordinate moves
+        // along it) takes none.
+        let inverse = if w > T::EPSILON && (T::one() / w).is_finite() {
+            T::one() / w
+        } else {
+            T::zero()
+        };
+        Self {
+            j,
+            b,
+            inverse,
+            lambda: T::zero(),
+        }
+    }
+
+    /// The row's velocity `a` at the bodies' velocities `v` (a side of no body: `None`).
+    pub(crate) fn speed(&self, v: [Option<&SVector<T, N>>; 2]) -> T {
+        v.iter()
+            .zip(&self.j)
+            .filter_map(|(v, j)| v.map(|v| j.dot(v)))
+            .fold(T::zero(), |a, x| a + x)
+    }
+}
+
+/// A contact point of a step.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Contact<T: Real, const N: usize> {
+    pub(crate) key: ContactKey,
+    /// The bodies (indices into the world's) on each side; `None` for static geometry.
+    pub(crate) bodies: [Option<usize>; 2],
+    pub(crate) normal: Row<T, N>,
+    pub(crate) tangent: Row<T, N>,
+    /// The gap at the step's start (negative: overlapping).
+    pub(crate) gap: T,
+    /// The normal row's lowest velocity after the solve: `-gap / dt` for a contact still
+    /// open (it may close this step, no more), zero for one touching, `-e a0` for one that
+    /// rebounds.
+    pub(crate) lower: T,
+    /// The normal row's speed at the free step's velocities (negative: closing).
+    pub(crate) approach: T,
+    /// The drift correction's impulse (on pseudo-velocities; see `solve::drift`).
+    pub(crate) drift: T,
+    /// The drift correction's lowest pseudo-speed (see `solve::drift`).
+    pub(crate) reach: T,
+    /// Where it is and the normal, world coordinates (for events and queries).
+    pub(crate) point: Vec2<T>,
+    pub(crate) direction: Vec2<T>,
+}
+
+/// What a contact's impulses were at the end of a step, kept for the next one.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Kept<T> {
+    pub(crate) key: ContactKey,
+    pub(crate) normal: T,
+    pub(crate) tangent: T,
+}
