@@ -367,29 +367,68 @@ fn pick(take: bool, a: f32, b: f32) -> f32 {
 #[must_use]
 #[inline(always)]
 pub fn sin_cos_lanes<const L: usize>(x: [f32; L]) -> ([f32; L], [f32; L]) {
-    let (mut sin, mut cos) = ([0.0; L], [0.0; L]);
-    let mut reduced = 0u32;
-    for &xi in &x {
-        reduced |= u32::from(magnitude(xi) > FRAC_PI_4_BITS as i32);
-    }
-    if reduced == 0 {
-        // Every lane small: the small path alone, stage by stage over the lanes (each stage
-        // a loop the compiler vectorizes), the operations of `sin_kernel` and `cos_kernel`.
-        let u = x.map(|r| r * r);
-        for i in 0..L {
-            let (r, u) = (x[i], u[i]);
-            let p = SIN_POLY[0] + u * (SIN_POLY[1] + u * SIN_POLY[2]);
-            let kernel = r + r * u * p;
-            sin[i] = pick(magnitude(r) < TINY_BITS as i32, r, kernel);
-        }
-        for i in 0..L {
-            let u = u[i];
-            let p = COS_POLY[0] + u * (COS_POLY[1] + u * COS_POLY[2]);
-            cos[i] = (1.0 - 0.5 * u) + u * u * p;
-        }
-        return (sin, cos);
+    if all_small(&x) {
+        return (small_sin_lanes(&x), small_cos_lanes(&x));
     }
     sin_cos_lanes_reduced(x)
+}
+
+/// The sine of each of `L` arguments: [`sin_cos_lanes`]'s first half, bit for bit, without
+/// the cosine's work where every lane is small (the compiler did not always drop it).
+#[must_use]
+#[inline(always)]
+pub fn sin_lanes<const L: usize>(x: [f32; L]) -> [f32; L] {
+    if all_small(&x) {
+        return small_sin_lanes(&x);
+    }
+    sin_cos_lanes_reduced(x).0
+}
+
+/// The cosine of each of `L` arguments: [`sin_cos_lanes`]'s second half, bit for bit, as
+/// [`sin_lanes`].
+#[must_use]
+#[inline(always)]
+pub fn cos_lanes<const L: usize>(x: [f32; L]) -> [f32; L] {
+    if all_small(&x) {
+        return small_cos_lanes(&x);
+    }
+    sin_cos_lanes_reduced(x).1
+}
+
+/// True when every lane is within pi/4 (the small path), with one branch for all.
+#[inline(always)]
+fn all_small<const L: usize>(x: &[f32; L]) -> bool {
+    let mut reduced = 0u32;
+    for &xi in x {
+        reduced |= u32::from(magnitude(xi) > FRAC_PI_4_BITS as i32);
+    }
+    reduced == 0
+}
+
+/// The small path's sine over the lanes, stage by stage (each stage a loop the compiler
+/// vectorizes), the operations of `sin_kernel`; a tiny argument is itself, with no branch.
+#[inline(always)]
+#[allow(clippy::needless_range_loop)] // the formulas over two arrays at once
+fn small_sin_lanes<const L: usize>(x: &[f32; L]) -> [f32; L] {
+    let u = x.map(|r| r * r);
+    let mut sin = [0.0; L];
+    for i in 0..L {
+        let (r, u) = (x[i], u[i]);
+        let p = SIN_POLY[0] + u * (SIN_POLY[1] + u * SIN_POLY[2]);
+        let kernel = r + r * u * p;
+        sin[i] = pick(magnitude(r) < TINY_BITS as i32, r, kernel);
+    }
+    sin
+}
+
+/// The small path's cosine over the lanes, stage by stage, the operations of `cos_kernel`.
+#[inline(always)]
+fn small_cos_lanes<const L: usize>(x: &[f32; L]) -> [f32; L] {
+    let u = x.map(|r| r * r);
+    u.map(|u| {
+        let p = COS_POLY[0] + u * (COS_POLY[1] + u * COS_POLY[2]);
+        (1.0 - 0.5 * u) + u * u * p
+    })
 }
 
 /// `v` truncated, as an integer and as an `f32`: `v as i32` and that as `f32` for

@@ -21,7 +21,7 @@
 //!
 //! [`sin_cos_lanes`]: crate::fast_trig::sin_cos_lanes
 
-use crate::scalar::{powi_by_squaring, sin_cos_each, Real, Scalar};
+use crate::scalar::{cos_each, powi_by_squaring, sin_cos_each, sin_each, Real, Scalar};
 use core::cmp::Ordering;
 use core::fmt;
 use core::ops::{Add, AddAssign, Div, DivAssign, Mul, MulAssign, Neg, Sub, SubAssign};
@@ -63,11 +63,57 @@ impl<T: Real, const L: usize> Lanes<T, L> {
     }
 
     /// One field of `L` instances, lane `i` from `instances[i]`: how a mechanism gathers its
-    /// parameters ([`Mechanism::gather`](crate::Mechanism::gather)).
+    /// parameters ([`Gather::gather`](crate::Gather::gather)).
     #[must_use]
     #[inline(always)]
     pub fn gather<M>(instances: &[&M; L], field: impl Fn(&M) -> T) -> Self {
         Self(core::array::from_fn(|i| field(instances[i])))
+    }
+
+    /// `W` lanes from lane `at` on; lanes past the end repeat the last lane (how a bank takes
+    /// a group of its instances from all of them gathered: [`Gather::window`]).
+    ///
+    /// ```
+    /// use lagrange_core::Lanes;
+    /// let all = Lanes([1.0f32, 2.0, 3.0, 4.0, 5.0, 6.0]);
+    /// assert_eq!(all.window::<4>(2).0, [3.0, 4.0, 5.0, 6.0]);
+    /// assert_eq!(all.window::<4>(4).0, [5.0, 6.0, 6.0, 6.0]);
+    /// ```
+    ///
+    /// [`Gather::window`]: crate::Gather::window
+    #[must_use]
+    #[inline(always)]
+    pub fn window<const W: usize>(&self, at: usize) -> Lanes<T, W> {
+        let inside = self.0.get(at..).and_then(|rest| rest.get(..W));
+        match inside.and_then(|lanes| <[T; W]>::try_from(lanes).ok()) {
+            // One load of `W` lanes where they are all there.
+            Some(lanes) => Lanes(lanes),
+            None => self.window_past_end(at),
+        }
+    }
+
+    /// [`Lanes::window`] where it runs past the end (out of line: a bank's last group).
+    #[cold]
+    #[inline(never)]
+    fn window_past_end<const W: usize>(&self, at: usize) -> Lanes<T, W> {
+        let last = self.0.last().copied().unwrap_or_else(T::zero);
+        Lanes(core::array::from_fn(|i| {
+            at.checked_add(i)
+                .and_then(|j| self.0.get(j))
+                .copied()
+                .unwrap_or(last)
+        }))
+    }
+
+    /// Sets lane `lane` to `x`; nothing when `lane` is not below `L` (how a bank writes an
+    /// instance into its gathered mechanism: [`Gather::put`]).
+    ///
+    /// [`Gather::put`]: crate::Gather::put
+    #[inline(always)]
+    pub fn set(&mut self, lane: usize, x: T) {
+        if let Some(slot) = self.0.get_mut(lane) {
+            *slot = x;
+        }
     }
 
     /// `f` of each lane.
@@ -280,13 +326,13 @@ impl<T: Real, const L: usize> Scalar for Lanes<T, L> {
     fn value(self) -> Self {
         self
     }
-    /// The scalar sine of each lane: over a vector unit, through [`Real::sin_cos_lanes`]
+    /// The scalar sine of each lane: over a vector unit, through [`Real::sin_lanes`]
     /// (branch-free, the lanes together); elsewhere lane by lane with the scalar's branches,
     /// which cost less than computing both of its paths for every lane.
     #[inline(always)]
     fn sin(self) -> Self {
         if VECTOR_UNIT {
-            Self(T::sin_cos_lanes(self.0).0)
+            Self(T::sin_lanes(self.0))
         } else {
             self.map(Scalar::sin)
         }
@@ -295,7 +341,7 @@ impl<T: Real, const L: usize> Scalar for Lanes<T, L> {
     #[inline(always)]
     fn cos(self) -> Self {
         if VECTOR_UNIT {
-            Self(T::sin_cos_lanes(self.0).1)
+            Self(T::cos_lanes(self.0))
         } else {
             self.map(Scalar::cos)
         }
@@ -359,6 +405,12 @@ impl<T: Real, const L: usize> Real for Lanes<T, L> {
     fn sin_cos_lanes<const K: usize>(x: [Self; K]) -> ([Self; K], [Self; K]) {
         sin_cos_each(x)
     }
+    fn sin_lanes<const K: usize>(x: [Self; K]) -> [Self; K] {
+        sin_each(x)
+    }
+    fn cos_lanes<const K: usize>(x: [Self; K]) -> [Self; K] {
+        cos_each(x)
+    }
     /// Every lane of every value finite, with no branch per lane and no divergence counted:
     /// over a vector unit one AND a lane (`x * 0 == 0`), elsewhere one sum of `x * 0` over
     /// them all, compared with zero once.
@@ -384,11 +436,20 @@ impl<T: Real, const L: usize> Real for Lanes<T, L> {
     }
 }
 
-/// Whether lanes map onto a vector unit: x86_64 (SSE2) and aarch64 (NEON). Where they do not
-/// (the Cortex-M4F), a lane's sine goes lane by lane through the scalar's branches, and the
-/// test of finiteness is a sum: the branch-free forms a vector unit needs cost more there (the
-/// lanes of 4 pendulums took 1.14 times the instructions of one by one with them).
-const VECTOR_UNIT: bool = cfg!(any(target_arch = "x86_64", target_arch = "aarch64"));
+/// Whether [`Lanes`] map onto a vector unit on the target built for: x86_64 (SSE2), aarch64
+/// (NEON) and wasm32 built with `simd128` (`-C target-feature=+simd128`). Where they do not
+/// (the Cortex-M4F, wasm32 without `simd128`), lanes give the same bits at no gain, and a
+/// scene's bank steps its instances one by one.
+///
+/// Inside, it chooses the lanes' sine and test of finiteness: where there is no vector unit a
+/// lane's sine goes lane by lane through the scalar's branches, and the test is a sum, because
+/// the branch-free forms a vector unit needs cost more there (the lanes of 4 pendulums took
+/// 1.14 times the instructions of one by one with them on the Cortex-M4F).
+pub const VECTOR_UNIT: bool = cfg!(any(
+    target_arch = "x86_64",
+    target_arch = "aarch64",
+    all(target_arch = "wasm32", target_feature = "simd128")
+));
 
 /// Every lane of every value finite (`x * 0` is zero exactly where `x` is finite), one AND a
 /// lane, which vectorises: the lanes stay apart until the end. (A count of the finite lanes,
@@ -481,5 +542,19 @@ mod tests {
     #[test]
     fn finiteness_forms_agree_f64() {
         finiteness_forms_agree::<f64>();
+    }
+
+    /// A window inside the lanes reads them; one that runs past the end repeats the last lane;
+    /// `set` past the end changes nothing.
+    #[test]
+    fn windows_and_set() {
+        let wide = Lanes::<f32, 6>::from_fn(|i| i as f32);
+        assert_eq!(wide.window::<4>(1).0, [1.0, 2.0, 3.0, 4.0]);
+        assert_eq!(wide.window::<4>(4).0, [4.0, 5.0, 5.0, 5.0]);
+        assert_eq!(wide.window::<2>(9).0, [5.0, 5.0]);
+        let mut lanes = wide;
+        lanes.set(2, -1.0);
+        lanes.set(6, -2.0);
+        assert_eq!(lanes.0, [0.0, 1.0, -1.0, 3.0, 4.0, 5.0]);
     }
 }

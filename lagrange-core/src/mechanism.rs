@@ -5,7 +5,7 @@ use crate::constraints::{Constrained, Constraints, Held};
 use crate::forces::{Forced, NoForce};
 use crate::{
     central_difference_jacobian, check_finite, solve_spd, Error, GeneralizedForce, Jacobian,
-    Lagrangian, Lanes, Real, State,
+    Lagrangian, Real, State,
 };
 use nalgebra::{SMatrix, SVector};
 
@@ -257,19 +257,6 @@ pub trait Mechanism<T: Real, const N: usize>: Lagrangian<T, N> {
         Ok(())
     }
 
-    /// These instances of the type side by side, as one mechanism over [`Lanes`] (lane `i`
-    /// is `instances[i]`), where the type can gather its parameters (a plain struct of
-    /// scalars): what lets a scene step a bank `L` instances at a time, each lane bit for bit
-    /// its instance alone. `None` by default, and then a bank steps them one by one.
-    ///
-    /// The gathered law must pass its errors on, not replace a failed result by another: the
-    /// tests of results ([`check_finite`](crate::check_finite)) fail for all lanes when one
-    /// lane fails and count no divergence, because the error sends the step's lanes one by one.
-    fn gather<const L: usize>(instances: [&Self; L]) -> Option<impl Mechanism<Lanes<T, L>, N>> {
-        let _ = instances;
-        None::<Ungathered>
-    }
-
     /// This mechanism with `force` added to its generalized forces.
     ///
     /// ```
@@ -352,33 +339,5 @@ where
         Some(e) => Err(e),
         None if j.is_finite() => Ok((qdd, j)),
         None => Err(Error::NonFiniteState),
-    }
-}
-
-/// The mechanism of a type that gathers no lanes ([`Mechanism::gather`]'s default): a type with
-/// no value, so that none of its methods can be called.
-#[derive(Debug, Clone, Copy)]
-pub(crate) enum Ungathered {}
-
-impl<T: Real, const N: usize> Lagrangian<T, N> for Ungathered {
-    fn kinetic<S: crate::Scalar<Real = T>>(
-        &self,
-        _t: S,
-        _q: &SVector<S, N>,
-        _qd: &SVector<S, N>,
-    ) -> S {
-        match *self {}
-    }
-    fn potential<S: crate::Scalar<Real = T>>(&self, _t: S, _q: &SVector<S, N>) -> S {
-        match *self {}
-    }
-}
-
-impl<T: Real, const N: usize> Mechanism<T, N> for Ungathered {
-    fn mass_matrix(&self, _state: &State<T, N>) -> SMatrix<T, N, N> {
-        match *self {}
-    }
-    fn rhs(&self, _state: &State<T, N>) -> SVector<T, N> {
-        match *self {}
     }
 }

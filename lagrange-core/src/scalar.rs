@@ -139,6 +139,12 @@ pub trait Real:
     /// [`Lanes`](crate::Lanes) computes with (`f32`'s a vectorizable form of
     /// [`fast_trig`](crate::fast_trig)).
     fn sin_cos_lanes<const L: usize>(x: [Self; L]) -> ([Self; L], [Self; L]);
+    /// The sine of each of `L` values: [`Real::sin_cos_lanes`]'s first half, bit for bit,
+    /// without the cosine's work.
+    fn sin_lanes<const L: usize>(x: [Self; L]) -> [Self; L];
+    /// The cosine of each of `L` values: [`Real::sin_cos_lanes`]'s second half, bit for bit,
+    /// without the sine's work.
+    fn cos_lanes<const L: usize>(x: [Self; L]) -> [Self; L];
     /// True when every lane of every value is finite: [`all_finite`] for a plain scalar.
     /// Over [`Lanes`](crate::Lanes) it is data, not a branch taken for all lanes, so lanes
     /// that disagree count no divergence: for a test whose `false` fails the computation
@@ -211,6 +217,18 @@ pub(crate) fn sin_cos_each<S: Scalar, const L: usize>(x: [S; L]) -> ([S; L], [S;
     (s, c)
 }
 
+/// The sine of each value, one at a time.
+#[inline]
+pub(crate) fn sin_each<S: Scalar, const L: usize>(x: [S; L]) -> [S; L] {
+    x.map(Scalar::sin)
+}
+
+/// The cosine of each value, one at a time.
+#[inline]
+pub(crate) fn cos_each<S: Scalar, const L: usize>(x: [S; L]) -> [S; L] {
+    x.map(Scalar::cos)
+}
+
 /// `x^n` by binary powering, shared by every scalar so all give the same sequence of products.
 pub(crate) fn powi_by_squaring<S: Scalar>(x: S, n: i32) -> S {
     let mut base = if n < 0 { x.recip() } else { x };
@@ -231,7 +249,8 @@ pub(crate) fn powi_by_squaring<S: Scalar>(x: S, n: i32) -> S {
 macro_rules! impl_real {
     ($t:ident, $sin:ident, $cos:ident, $sin_cos:ident, $tan:ident, $sqrt:ident, $exp:ident,
      $ln:ident, $fabs:ident, $atan2:ident, $floor:ident, $round:ident, $asin:ident,
-     $acos:ident, $atan:ident, $pow:ident, $lanes:path, $cbrt_eps:expr) => {
+     $acos:ident, $atan:ident, $pow:ident, $lanes:path, $sin_lanes:path, $cos_lanes:path,
+     $cbrt_eps:expr) => {
         impl Scalar for $t {
             type Real = $t;
             #[inline]
@@ -357,6 +376,14 @@ macro_rules! impl_real {
                 $lanes(x)
             }
             #[inline(always)]
+            fn sin_lanes<const L: usize>(x: [$t; L]) -> [$t; L] {
+                $sin_lanes(x)
+            }
+            #[inline(always)]
+            fn cos_lanes<const L: usize>(x: [$t; L]) -> [$t; L] {
+                $cos_lanes(x)
+            }
+            #[inline(always)]
             fn every_lane_finite(values: &[$t]) -> bool {
                 all_finite(values)
             }
@@ -386,6 +413,8 @@ impl_real!(
     atan,
     pow,
     sin_cos_each,
+    sin_each,
+    cos_each,
     6.055_454_452_393_343e-6 // 2^(-52/3)
 );
 impl_real!(
@@ -406,5 +435,7 @@ impl_real!(
     atanf,
     powf,
     scalar_trig::sin_cos_lanesf,
+    scalar_trig::sin_lanesf,
+    scalar_trig::cos_lanesf,
     4.921_566_4e-3 // 2^(-23/3)
 );

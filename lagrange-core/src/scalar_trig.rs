@@ -17,7 +17,8 @@ pub(crate) fn sin_cos(x: f64) -> (f64, f64) {
 
 #[cfg(not(feature = "libm-trig"))]
 pub(crate) use crate::fast_trig::{
-    cos as cosf, sin as sinf, sin_cos as sin_cosf, sin_cos_lanes as sin_cos_lanesf,
+    cos as cosf, cos_lanes as cos_lanesf, sin as sinf, sin_cos as sin_cosf,
+    sin_cos_lanes as sin_cos_lanesf, sin_lanes as sin_lanesf,
 };
 
 #[cfg(feature = "libm-trig")]
@@ -35,6 +36,20 @@ pub(crate) fn sin_cosf(x: f32) -> (f32, f32) {
 #[inline]
 pub(crate) fn sin_cos_lanesf<const L: usize>(x: [f32; L]) -> ([f32; L], [f32; L]) {
     (x.map(libm::sinf), x.map(libm::cosf))
+}
+
+/// `sin x` of each lane by `libm`.
+#[cfg(feature = "libm-trig")]
+#[inline]
+pub(crate) fn sin_lanesf<const L: usize>(x: [f32; L]) -> [f32; L] {
+    x.map(libm::sinf)
+}
+
+/// `cos x` of each lane by `libm`.
+#[cfg(feature = "libm-trig")]
+#[inline]
+pub(crate) fn cos_lanesf<const L: usize>(x: [f32; L]) -> [f32; L] {
+    x.map(libm::cosf)
 }
 
 #[cfg(test)]

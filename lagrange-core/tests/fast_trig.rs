@@ -317,14 +317,21 @@ fn lane_trig_is_the_scalar_trig() {
     assert!(checked > 14_000);
 }
 
-/// `sin_cos_lanes` of `x` is, lane by lane, the scalar `sin_cos` to the bit, and so are the
-/// scalar `sin` and `cos` (what `Lanes` takes lane by lane on a target without a vector unit).
+/// `sin_cos_lanes` of `x` is, lane by lane, the scalar `sin_cos` to the bit, and so are
+/// `sin_lanes` and `cos_lanes` and the scalar `sin` and `cos` (what `Lanes` takes lane by lane
+/// on a target without a vector unit).
 fn assert_lanes_are_scalar(x: [f32; L]) {
     let (s, c) = fast_trig::sin_cos_lanes(x);
+    let (s1, c1) = (fast_trig::sin_lanes(x), fast_trig::cos_lanes(x));
     for (i, &xi) in x.iter().enumerate() {
         let (es, ec) = fast_trig::sin_cos(xi);
         let bits = (es.to_bits(), ec.to_bits());
         assert_eq!((s[i].to_bits(), c[i].to_bits()), bits, "x = {xi:e}");
+        assert_eq!(
+            (s1[i].to_bits(), c1[i].to_bits()),
+            bits,
+            "alone, x = {xi:e}"
+        );
         let apart = (fast_trig::sin(xi).to_bits(), fast_trig::cos(xi).to_bits());
         assert_eq!(apart, bits, "sin and cos apart, x = {xi:e}");
     }

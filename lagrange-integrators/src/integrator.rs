@@ -174,8 +174,8 @@ pub trait Integrator<T: Real, const N: usize, M: Mechanism<T, N>>: Method {
     }
 
     /// Steps `L` instances at once, side by side in lanes (their mechanisms gathered by
-    /// [`Mechanism::gather`]), each lane bit for bit what [`Integrator::run_step`] gives for its
-    /// instance alone: where the method keeps nothing between steps, `Some`; `None` by
+    /// [`Gather::gather`](lagrange_core::Gather::gather)), each lane bit for bit what
+    /// [`Integrator::run_step`] gives for its instance alone: where the method keeps nothing between steps, `Some`; `None` by
     /// default, and then the caller steps the instances one by one. The result is that of
     /// every lane only if no comparison diverged across the lanes meanwhile
     /// ([`lagrange_core::divergences`]): the caller reads the count before and after, and

@@ -39,12 +39,18 @@
 //! # Ok::<(), lagrange_core::Error>(())
 //! ```
 
+mod awake;
 mod bank;
 mod banks;
+mod columns;
+mod layout;
 mod sleep;
+mod slot;
+mod states;
 
 pub use bank::{Bank, Energies, Id, Status};
 pub use banks::Banks;
+pub use layout::{InLanes, Layout, OneByOne, LANES};
 pub use sleep::{NeverSleeps, Sleep, Sleeps};
 
 use crate::FrameClock;

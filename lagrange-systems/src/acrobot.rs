@@ -3,8 +3,8 @@
 use crate::small_solve::solve_sym2;
 use lagrange_core::nalgebra::{Matrix2, SVector, Vector2};
 use lagrange_core::{
-    free_law_force, validate, Controlled, Error, GeneralizedForce, Lagrangian, Lanes, Mechanism,
-    Real, Scalar, State,
+    free_law_force, validate, Controlled, Error, Gather, GeneralizedForce, Lagrangian, Lanes,
+    Mechanism, Real, Scalar, State,
 };
 
 /// Spong's acrobot: two rigid links in a vertical plane, the first hinged to a fixed pivot
@@ -256,11 +256,12 @@ impl<T: Real> Controlled<T> for Acrobot<T> {
     }
 }
 
-impl<T: Real> Mechanism<T, 2> for Acrobot<T> {
+impl<T: Real> Gather<T, 2> for Acrobot<T> {
+    type Gathered<const L: usize> = Acrobot<Lanes<T, L>>;
     /// Lane by lane: every parameter gathered.
-    fn gather<const L: usize>(instances: [&Self; L]) -> Option<impl Mechanism<Lanes<T, L>, 2>> {
+    fn gather<const L: usize>(instances: [&Self; L]) -> Self::Gathered<L> {
         let lanes = |field: fn(&Self) -> T| Lanes::gather(&instances, field);
-        Some(Acrobot {
+        Acrobot {
             m1: lanes(|m| m.m1),
             m2: lanes(|m| m.m2),
             l1: lanes(|m| m.l1),
@@ -271,8 +272,41 @@ impl<T: Real> Mechanism<T, 2> for Acrobot<T> {
             i2: lanes(|m| m.i2),
             gravity: lanes(|m| m.gravity),
             torque: lanes(|m| m.torque),
-        })
+        }
     }
+    #[inline(always)] // see `Gather::window`
+    fn window<const W: usize, const L: usize>(
+        wide: &Self::Gathered<W>,
+        at: usize,
+    ) -> Self::Gathered<L> {
+        Acrobot {
+            m1: wide.m1.window(at),
+            m2: wide.m2.window(at),
+            l1: wide.l1.window(at),
+            l2: wide.l2.window(at),
+            lc1: wide.lc1.window(at),
+            lc2: wide.lc2.window(at),
+            i1: wide.i1.window(at),
+            i2: wide.i2.window(at),
+            gravity: wide.gravity.window(at),
+            torque: wide.torque.window(at),
+        }
+    }
+    fn put<const L: usize>(&self, lanes: &mut Self::Gathered<L>, lane: usize) {
+        lanes.m1.set(lane, self.m1);
+        lanes.m2.set(lane, self.m2);
+        lanes.l1.set(lane, self.l1);
+        lanes.l2.set(lane, self.l2);
+        lanes.lc1.set(lane, self.lc1);
+        lanes.lc2.set(lane, self.lc2);
+        lanes.i1.set(lane, self.i1);
+        lanes.i2.set(lane, self.i2);
+        lanes.gravity.set(lane, self.gravity);
+        lanes.torque.set(lane, self.torque);
+    }
+}
+
+impl<T: Real> Mechanism<T, 2> for Acrobot<T> {
     fn mass_matrix(&self, s: &State<T, 2>) -> Matrix2<T> {
         self.terms(s).0
     }

@@ -3,8 +3,8 @@
 use crate::small_solve::solve_sym2;
 use lagrange_core::nalgebra::{Matrix2, SVector, Vector2};
 use lagrange_core::{
-    free_law_force, validate, Controlled, Error, GeneralizedForce, Lagrangian, Lanes, Mechanism,
-    Real, Scalar, State,
+    free_law_force, validate, Controlled, Error, Gather, GeneralizedForce, Lagrangian, Lanes,
+    Mechanism, Real, Scalar, State,
 };
 
 /// The cart-pole: a cart of mass `M` on a frictionless horizontal track, driven by a horizontal
@@ -164,18 +164,42 @@ impl<T: Real> Controlled<T> for CartPole<T> {
     }
 }
 
-impl<T: Real> Mechanism<T, 2> for CartPole<T> {
+impl<T: Real> Gather<T, 2> for CartPole<T> {
+    type Gathered<const L: usize> = CartPole<Lanes<T, L>>;
     /// Lane by lane: every parameter gathered.
-    fn gather<const L: usize>(instances: [&Self; L]) -> Option<impl Mechanism<Lanes<T, L>, 2>> {
+    fn gather<const L: usize>(instances: [&Self; L]) -> Self::Gathered<L> {
         let lanes = |field: fn(&Self) -> T| Lanes::gather(&instances, field);
-        Some(CartPole {
+        CartPole {
             cart_mass: lanes(|m| m.cart_mass),
             pole_mass: lanes(|m| m.pole_mass),
             pole_half_length: lanes(|m| m.pole_half_length),
             gravity: lanes(|m| m.gravity),
             force: lanes(|m| m.force),
-        })
+        }
     }
+    #[inline(always)] // see `Gather::window`
+    fn window<const W: usize, const L: usize>(
+        wide: &Self::Gathered<W>,
+        at: usize,
+    ) -> Self::Gathered<L> {
+        CartPole {
+            cart_mass: wide.cart_mass.window(at),
+            pole_mass: wide.pole_mass.window(at),
+            pole_half_length: wide.pole_half_length.window(at),
+            gravity: wide.gravity.window(at),
+            force: wide.force.window(at),
+        }
+    }
+    fn put<const L: usize>(&self, lanes: &mut Self::Gathered<L>, lane: usize) {
+        lanes.cart_mass.set(lane, self.cart_mass);
+        lanes.pole_mass.set(lane, self.pole_mass);
+        lanes.pole_half_length.set(lane, self.pole_half_length);
+        lanes.gravity.set(lane, self.gravity);
+        lanes.force.set(lane, self.force);
+    }
+}
+
+impl<T: Real> Mechanism<T, 2> for CartPole<T> {
     fn mass_matrix(&self, s: &State<T, 2>) -> Matrix2<T> {
         self.terms(s).0
     }

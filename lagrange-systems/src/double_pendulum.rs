@@ -3,8 +3,8 @@
 use crate::small_solve::solve_sym2_det;
 use lagrange_core::nalgebra::{Matrix2, SVector, Vector2};
 use lagrange_core::{
-    free_law_force, validate, Error, GeneralizedForce, Lagrangian, Lanes, Mechanism, Real, Scalar,
-    State,
+    free_law_force, validate, Error, Gather, GeneralizedForce, Lagrangian, Lanes, Mechanism, Real,
+    Scalar, State,
 };
 
 /// Point masses `m1`, `m2` on massless rods `l1`, `l2`: the first hangs from a fixed pivot,
@@ -136,7 +136,10 @@ impl<T: Real> DoublePendulum<T> {
 
     /// The mass matrix, the right-hand side and `det M` together, sharing one
     /// `sin_cos(th1 - th2)`.
-    #[inline]
+    // Inlined into the law: called, over lanes it took the group's parameters through memory,
+    // and a bank of 1,024 double pendulums in lanes of 16 cost 17.8 rather than 16.1 ns per
+    // instance-step.
+    #[inline(always)]
     fn terms(&self, s: &State<T, 2>) -> (Matrix2<T>, Vector2<T>, T) {
         let k = &self.k;
         let (sin, cos) = (s.q[0] - s.q[1]).sin_cos();
@@ -148,11 +151,12 @@ impl<T: Real> DoublePendulum<T> {
     }
 }
 
-impl<T: Real> Mechanism<T, 2> for DoublePendulum<T> {
+impl<T: Real> Gather<T, 2> for DoublePendulum<T> {
+    type Gathered<const L: usize> = DoublePendulum<Lanes<T, L>>;
     /// Lane by lane: every parameter gathered.
-    fn gather<const L: usize>(instances: [&Self; L]) -> Option<impl Mechanism<Lanes<T, L>, 2>> {
+    fn gather<const L: usize>(instances: [&Self; L]) -> Self::Gathered<L> {
         let lanes = |field: fn(&Self) -> T| Lanes::gather(&instances, field);
-        Some(DoublePendulum {
+        DoublePendulum {
             m1: lanes(|m| m.m1),
             m2: lanes(|m| m.m2),
             l1: lanes(|m| m.l1),
@@ -166,8 +170,45 @@ impl<T: Real> Mechanism<T, 2> for DoublePendulum<T> {
                 weight2: lanes(|m| m.k.weight2),
                 det_scale: lanes(|m| m.k.det_scale),
             },
-        })
+        }
     }
+    #[inline(always)] // see `Gather::window`
+    fn window<const W: usize, const L: usize>(
+        wide: &Self::Gathered<W>,
+        at: usize,
+    ) -> Self::Gathered<L> {
+        DoublePendulum {
+            m1: wide.m1.window(at),
+            m2: wide.m2.window(at),
+            l1: wide.l1.window(at),
+            l2: wide.l2.window(at),
+            gravity: wide.gravity.window(at),
+            k: Coefficients {
+                m11: wide.k.m11.window(at),
+                m22: wide.k.m22.window(at),
+                coupling: wide.k.coupling.window(at),
+                weight1: wide.k.weight1.window(at),
+                weight2: wide.k.weight2.window(at),
+                det_scale: wide.k.det_scale.window(at),
+            },
+        }
+    }
+    fn put<const L: usize>(&self, lanes: &mut Self::Gathered<L>, lane: usize) {
+        lanes.m1.set(lane, self.m1);
+        lanes.m2.set(lane, self.m2);
+        lanes.l1.set(lane, self.l1);
+        lanes.l2.set(lane, self.l2);
+        lanes.gravity.set(lane, self.gravity);
+        lanes.k.m11.set(lane, self.k.m11);
+        lanes.k.m22.set(lane, self.k.m22);
+        lanes.k.coupling.set(lane, self.k.coupling);
+        lanes.k.weight1.set(lane, self.k.weight1);
+        lanes.k.weight2.set(lane, self.k.weight2);
+        lanes.k.det_scale.set(lane, self.k.det_scale);
+    }
+}
+
+impl<T: Real> Mechanism<T, 2> for DoublePendulum<T> {
     fn mass_matrix(&self, s: &State<T, 2>) -> Matrix2<T> {
         self.mass((s.q[0] - s.q[1]).cos())
     }

@@ -3,8 +3,8 @@
 use crate::small_solve::finite;
 use lagrange_core::nalgebra::{Matrix1, SMatrix, SVector, Vector1};
 use lagrange_core::{
-    free_law_force, validate, Error, GeneralizedForce, Lagrangian, Lanes, Mechanism, Real, Scalar,
-    State,
+    free_law_force, validate, Error, Gather, GeneralizedForce, Lagrangian, Lanes, Mechanism, Real,
+    Scalar, State,
 };
 
 /// A point mass `m` falling in uniform gravity `g` along -y.
@@ -60,15 +60,33 @@ impl<T: Real> FallingParticle<T> {
     }
 }
 
-impl<T: Real> Mechanism<T, 1> for FallingParticle<T> {
+impl<T: Real> Gather<T, 1> for FallingParticle<T> {
+    type Gathered<const L: usize> = FallingParticle<Lanes<T, L>>;
     /// Lane by lane: every parameter gathered.
-    fn gather<const L: usize>(instances: [&Self; L]) -> Option<impl Mechanism<Lanes<T, L>, 1>> {
+    fn gather<const L: usize>(instances: [&Self; L]) -> Self::Gathered<L> {
         let lanes = |field: fn(&Self) -> T| Lanes::gather(&instances, field);
-        Some(FallingParticle {
+        FallingParticle {
             mass: lanes(|m| m.mass),
             gravity: lanes(|m| m.gravity),
-        })
+        }
     }
+    #[inline(always)] // see `Gather::window`
+    fn window<const W: usize, const L: usize>(
+        wide: &Self::Gathered<W>,
+        at: usize,
+    ) -> Self::Gathered<L> {
+        FallingParticle {
+            mass: wide.mass.window(at),
+            gravity: wide.gravity.window(at),
+        }
+    }
+    fn put<const L: usize>(&self, lanes: &mut Self::Gathered<L>, lane: usize) {
+        lanes.mass.set(lane, self.mass);
+        lanes.gravity.set(lane, self.gravity);
+    }
+}
+
+impl<T: Real> Mechanism<T, 1> for FallingParticle<T> {
     fn mass_matrix(&self, _s: &State<T, 1>) -> SMatrix<T, 1, 1> {
         Matrix1::new(self.mass)
     }

@@ -4,8 +4,8 @@ use crate::small_solve::finite;
 use lagrange_core::links::{LinkPoint, Links, Pose};
 use lagrange_core::nalgebra::{SMatrix, SVector, Vector3};
 use lagrange_core::{
-    free_law_force, validate, Error, GeneralizedForce, Lagrangian, Lanes, Mechanism, Real, Scalar,
-    State,
+    free_law_force, validate, Error, Gather, GeneralizedForce, Lagrangian, Lanes, Mechanism, Real,
+    Scalar, State,
 };
 
 /// A rigid body of mass `m` and moment of inertia `I` about its centre of mass, free in the
@@ -134,16 +134,36 @@ fn blame_inertia(e: Error, name: &'static str) -> Error {
     }
 }
 
-impl<T: Real> Mechanism<T, 3> for RigidBody<T> {
+impl<T: Real> Gather<T, 3> for RigidBody<T> {
+    type Gathered<const L: usize> = RigidBody<Lanes<T, L>>;
     /// Lane by lane: every parameter gathered.
-    fn gather<const L: usize>(instances: [&Self; L]) -> Option<impl Mechanism<Lanes<T, L>, 3>> {
+    fn gather<const L: usize>(instances: [&Self; L]) -> Self::Gathered<L> {
         let lanes = |field: fn(&Self) -> T| Lanes::gather(&instances, field);
-        Some(RigidBody {
+        RigidBody {
             mass: lanes(|b| b.mass),
             inertia: lanes(|b| b.inertia),
             gravity: lanes(|b| b.gravity),
-        })
+        }
     }
+    #[inline(always)] // see `Gather::window`
+    fn window<const W: usize, const L: usize>(
+        wide: &Self::Gathered<W>,
+        at: usize,
+    ) -> Self::Gathered<L> {
+        RigidBody {
+            mass: wide.mass.window(at),
+            inertia: wide.inertia.window(at),
+            gravity: wide.gravity.window(at),
+        }
+    }
+    fn put<const L: usize>(&self, lanes: &mut Self::Gathered<L>, lane: usize) {
+        lanes.mass.set(lane, self.mass);
+        lanes.inertia.set(lane, self.inertia);
+        lanes.gravity.set(lane, self.gravity);
+    }
+}
+
+impl<T: Real> Mechanism<T, 3> for RigidBody<T> {
     fn mass_matrix(&self, _s: &State<T, 3>) -> SMatrix<T, 3, 3> {
         SMatrix::from_diagonal(&Vector3::new(self.mass, self.mass, self.inertia))
     }

@@ -3,8 +3,8 @@
 use crate::small_solve::finite;
 use lagrange_core::nalgebra::{Matrix1, SMatrix, SVector, Vector1};
 use lagrange_core::{
-    free_law_force, validate, Error, GeneralizedForce, Lagrangian, Lanes, Mechanism, Real, Scalar,
-    State,
+    free_law_force, validate, Error, Gather, GeneralizedForce, Lagrangian, Lanes, Mechanism, Real,
+    Scalar, State,
 };
 
 /// A point mass `m` on a massless rod of length `l` about a fixed pivot, in gravity `g`, with
@@ -105,11 +105,12 @@ impl<T: Real> SimplePendulum<T> {
     }
 }
 
-impl<T: Real> Mechanism<T, 1> for SimplePendulum<T> {
+impl<T: Real> Gather<T, 1> for SimplePendulum<T> {
+    type Gathered<const L: usize> = SimplePendulum<Lanes<T, L>>;
     /// Lane by lane: every parameter gathered.
-    fn gather<const L: usize>(instances: [&Self; L]) -> Option<impl Mechanism<Lanes<T, L>, 1>> {
+    fn gather<const L: usize>(instances: [&Self; L]) -> Self::Gathered<L> {
         let lanes = |field: fn(&Self) -> T| Lanes::gather(&instances, field);
-        Some(SimplePendulum {
+        SimplePendulum {
             mass: lanes(|m| m.mass),
             length: lanes(|m| m.length),
             gravity: lanes(|m| m.gravity),
@@ -117,8 +118,35 @@ impl<T: Real> Mechanism<T, 1> for SimplePendulum<T> {
             w2: lanes(|m| m.w2),
             rate: lanes(|m| m.rate),
             inv_inertia: lanes(|m| m.inv_inertia),
-        })
+        }
     }
+    #[inline(always)] // see `Gather::window`
+    fn window<const W: usize, const L: usize>(
+        wide: &Self::Gathered<W>,
+        at: usize,
+    ) -> Self::Gathered<L> {
+        SimplePendulum {
+            mass: wide.mass.window(at),
+            length: wide.length.window(at),
+            gravity: wide.gravity.window(at),
+            damping: wide.damping.window(at),
+            w2: wide.w2.window(at),
+            rate: wide.rate.window(at),
+            inv_inertia: wide.inv_inertia.window(at),
+        }
+    }
+    fn put<const L: usize>(&self, lanes: &mut Self::Gathered<L>, lane: usize) {
+        lanes.mass.set(lane, self.mass);
+        lanes.length.set(lane, self.length);
+        lanes.gravity.set(lane, self.gravity);
+        lanes.damping.set(lane, self.damping);
+        lanes.w2.set(lane, self.w2);
+        lanes.rate.set(lane, self.rate);
+        lanes.inv_inertia.set(lane, self.inv_inertia);
+    }
+}
+
+impl<T: Real> Mechanism<T, 1> for SimplePendulum<T> {
     fn mass_matrix(&self, _s: &State<T, 1>) -> SMatrix<T, 1, 1> {
         Matrix1::new(self.inertia())
     }

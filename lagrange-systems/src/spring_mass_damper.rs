@@ -3,8 +3,8 @@
 use crate::small_solve::finite;
 use lagrange_core::nalgebra::{Matrix1, SMatrix, SVector, Vector1};
 use lagrange_core::{
-    free_law_force, validate, Error, GeneralizedForce, Lagrangian, Lanes, Mechanism, Real, Scalar,
-    State,
+    free_law_force, validate, Error, Gather, GeneralizedForce, Lagrangian, Lanes, Mechanism, Real,
+    Scalar, State,
 };
 
 /// A mass `m` on a linear spring of stiffness `k` and a viscous damper `c`, no gravity.
@@ -71,16 +71,36 @@ impl<T: Real> SpringMassDamper<T> {
     }
 }
 
-impl<T: Real> Mechanism<T, 1> for SpringMassDamper<T> {
+impl<T: Real> Gather<T, 1> for SpringMassDamper<T> {
+    type Gathered<const L: usize> = SpringMassDamper<Lanes<T, L>>;
     /// Lane by lane: every parameter gathered.
-    fn gather<const L: usize>(instances: [&Self; L]) -> Option<impl Mechanism<Lanes<T, L>, 1>> {
+    fn gather<const L: usize>(instances: [&Self; L]) -> Self::Gathered<L> {
         let lanes = |field: fn(&Self) -> T| Lanes::gather(&instances, field);
-        Some(SpringMassDamper {
+        SpringMassDamper {
             mass: lanes(|m| m.mass),
             stiffness: lanes(|m| m.stiffness),
             damping: lanes(|m| m.damping),
-        })
+        }
     }
+    #[inline(always)] // see `Gather::window`
+    fn window<const W: usize, const L: usize>(
+        wide: &Self::Gathered<W>,
+        at: usize,
+    ) -> Self::Gathered<L> {
+        SpringMassDamper {
+            mass: wide.mass.window(at),
+            stiffness: wide.stiffness.window(at),
+            damping: wide.damping.window(at),
+        }
+    }
+    fn put<const L: usize>(&self, lanes: &mut Self::Gathered<L>, lane: usize) {
+        lanes.mass.set(lane, self.mass);
+        lanes.stiffness.set(lane, self.stiffness);
+        lanes.damping.set(lane, self.damping);
+    }
+}
+
+impl<T: Real> Mechanism<T, 1> for SpringMassDamper<T> {
     fn mass_matrix(&self, _s: &State<T, 1>) -> SMatrix<T, 1, 1> {
         Matrix1::new(self.mass)
     }

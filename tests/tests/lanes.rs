@@ -5,17 +5,17 @@
 //! `lagrange-core/tests/fast_trig.rs`.)
 
 use lagrange_core::nalgebra::SVector;
-use lagrange_core::{check_finite, divergences, Error, Lanes, Mechanism, Real, Scalar, State};
-use lagrange_integrators::scene::{Bank, NeverSleeps, Scene};
+use lagrange_core::{check_finite, divergences, Error, Gather, Lanes, Real, Scalar, State};
+use lagrange_integrators::scene::{Bank, InLanes, NeverSleeps, Scene, LANES};
 use lagrange_integrators::{
     ExplicitEuler, FixedTimestep, Integrator, Rk4, SemiImplicitEuler, VelocityVerlet,
 };
 use lagrange_systems::{
-    Acrobot, CartPole, DoublePendulum, FallingParticle, SimplePendulum, SpringMassDamper,
+    Acrobot, CartPole, DoublePendulum, FallingParticle, RigidBody, SimplePendulum, SpringMassDamper,
 };
 use lagrange_tests::{for_f32_and_f64, Rng};
 
-/// Lanes per group in these tests (the scene's width on x86_64).
+/// Lanes per group in the tests of lanes alone (a scene's bank steps [`LANES`] at a time).
 const L: usize = 8;
 
 /// Steps per comparison: long enough for a chaotic double pendulum to amplify any bit.
@@ -32,16 +32,13 @@ fn lanes_equal_alone<T, const N: usize, M, I>(
 ) -> Result<(), Error>
 where
     T: Real,
-    M: Mechanism<T, N>,
+    M: Gather<T, N>,
     I: Integrator<T, N, M> + Clone,
 {
     let mut rng = Rng::new(seed);
     let built: Vec<(M, State<T, N>)> = (0..L).map(|_| make(&mut rng)).collect::<Result<_, _>>()?;
     let instances: [&M; L] = core::array::from_fn(|i| &built[i].0);
-    let lanes = M::gather(instances).ok_or(Error::InvalidParameter {
-        name: "mechanism",
-        reason: "gathers no lanes",
-    })?;
+    let lanes = M::gather(instances);
     let dt = T::from_f64(dt);
     let mut alone: Vec<State<T, N>> = built.iter().map(|(_, s)| *s).collect();
     let states: [&State<T, N>; L] = core::array::from_fn(|i| &built[i].1);
@@ -79,7 +76,7 @@ fn every_method<T, const N: usize, M>(
 ) -> Result<(), Error>
 where
     T: Real,
-    M: Mechanism<T, N>,
+    M: Gather<T, N>,
 {
     lanes_equal_alone(Rk4, dt, make, 1)?;
     lanes_equal_alone(ExplicitEuler, dt, make, 2)?;
@@ -149,16 +146,23 @@ fn every_gathering_mechanism<T: Real>() -> Result<(), Error> {
             State::new(T::zero(), [u(r, 0.0, 10.0)], [u(r, -1.0, 1.0)]),
         ))
     })?;
+    every_method(1e-2, |r| {
+        let p = RigidBody::new(u(r, 0.5, 2.0), u(r, 0.1, 1.0), T::from_f64(9.81))?;
+        let q = [u(r, -1.0, 1.0), u(r, 0.0, 10.0), u(r, -3.0, 3.0)];
+        let qd = [u(r, -1.0, 1.0), u(r, -1.0, 1.0), u(r, -5.0, 5.0)];
+        Ok((p, State::new(T::zero(), q, qd)))
+    })?;
     Ok(())
 }
 
 /// A bank of pendulums that is not a multiple of the lane width, stepped by a scene, equals
 /// a `FixedTimestep` per pendulum, bit for bit (interpolated states too).
 fn a_bank_in_lanes_equals_its_instances_alone<T: Real>() -> Result<(), Error> {
-    const K: usize = 3 * L + 5;
+    const K: usize = 3 * LANES + 5;
     let mut rng = Rng::new(11);
     let dt = T::from_f64(1.0 / 120.0);
-    let mut bank: Bank<T, 2, K, DoublePendulum<T>, Rk4> = Bank::new(Rk4, NeverSleeps)?;
+    let mut bank: Bank<T, 2, K, DoublePendulum<T>, Rk4, NeverSleeps, InLanes> =
+        Bank::new(Rk4, NeverSleeps)?;
     let mut alone = Vec::new();
     for _ in 0..K {
         let p = DoublePendulum::new(
@@ -258,12 +262,7 @@ fn a_lane_that_blows_up_fails_the_group<T: Real>() -> Result<(), Error> {
             ))
         })
         .collect::<Result<_, Error>>()?;
-    let lanes = SimplePendulum::gather(core::array::from_fn(|i| &built[i].0)).ok_or(
-        Error::InvalidParameter {
-            name: "mechanism",
-            reason: "gathers no lanes",
-        },
-    )?;
+    let lanes = SimplePendulum::gather(core::array::from_fn(|i| &built[i].0));
     let states: [&State<T, 1>; L] = core::array::from_fn(|i| &built[i].1);
     let side = State {
         t: Lanes::gather(&states, |s| s.t),
@@ -334,6 +333,12 @@ fn every_operation_lane_by_lane<T: Real>() -> Result<(), Error> {
     let ([s2], [c2]) = <Lanes<T, L> as Real>::sin_cos_lanes([y]);
     lane_by_lane(s2, |i| ys[i].sin(), "sin_cos_lanes.0");
     lane_by_lane(c2, |i| ys[i].cos(), "sin_cos_lanes.1");
+    let ([s3], [c3]) = (
+        <Lanes<T, L> as Real>::sin_lanes([y]),
+        <Lanes<T, L> as Real>::cos_lanes([y]),
+    );
+    lane_by_lane(s3, |i| ys[i].sin(), "sin_lanes");
+    lane_by_lane(c3, |i| ys[i].cos(), "cos_lanes");
     lane_by_lane(z.tan(), |i| zs[i].tan(), "tan");
     lane_by_lane(x.sqrt(), |i| xs[i].sqrt(), "sqrt");
     lane_by_lane(y.exp(), |i| ys[i].exp(), "exp");

@@ -244,7 +244,7 @@ fn comes_to_rest_and_sleeps<T: Real>() -> Result<(), Error> {
         }
     }
     let asleep = asleep.ok_or(Error::NoConvergence { iterations: 360 })?;
-    let rest = *scene.banks().state(id)?;
+    let rest = scene.banks().state(id)?;
     let contacts = RagdollContacts::adult(&doll, T::zero())?;
     let lowest = contacts
         .floor_points(&rest.q)
@@ -261,7 +261,7 @@ fn comes_to_rest_and_sleeps<T: Real>() -> Result<(), Error> {
     for _ in 0..30 {
         scene.advance(frame)?;
     }
-    assert_eq!(*scene.banks().state(id)?, rest);
+    assert_eq!(scene.banks().state(id)?, rest);
     let mut kick = SVector::<T, N>::zeros();
     kick[1] = T::from_f64(100.0);
     scene.banks_mut().apply_impulse(id, &kick)?;

@@ -108,7 +108,7 @@ where
         );
         let state = bank.state(twin.id)?;
         assert_eq!(
-            bits(state),
+            bits(&state),
             bits(twin.sim.current()),
             "{state:?} against {:?}",
             twin.sim.current()
@@ -356,7 +356,7 @@ fn a_sleeper_does_not_change<T: Real>() -> Result<(), Error> {
     assert_eq!(bank.status(placed)?, Status::Asleep);
     assert_eq!(bank.status(settled)?, Status::Asleep);
     assert_eq!(bank.status(swinging)?, Status::Awake);
-    let frozen = [bits(bank.state(placed)?), bits(bank.state(settled)?)];
+    let frozen = [bits(&bank.state(placed)?), bits(&bank.state(settled)?)];
     assert_ne!(bank.state(placed)?.q[0], zero);
     let slept_at = scene.time();
     let mut rng = Rng::new(7);
@@ -364,7 +364,7 @@ fn a_sleeper_does_not_change<T: Real>() -> Result<(), Error> {
         assert_eq!(scene.advance(rng.uniform(0.0, 3.0 * DT))?.failed, 0);
         let bank = scene.banks();
         for (id, frozen) in [placed, settled].into_iter().zip(&frozen) {
-            assert_eq!(&bits(bank.state(id)?), frozen);
+            assert_eq!(&bits(&bank.state(id)?), frozen);
             assert_eq!(&bits(&bank.interpolated(id, scene.alpha())?), frozen);
             assert_eq!(bank.status(id)?, Status::Asleep);
         }
@@ -487,7 +487,7 @@ fn a_woken_instance_is_a_fresh_start<T: Real>() -> Result<(), Error> {
     assert_eq!(carts.status(cart)?, Status::Awake);
     let now = scene.time();
     let twin = |id: Id| -> Result<_, Error> {
-        let state = *scene.banks().0.state(id)?;
+        let state = scene.banks().0.state(id)?;
         assert_eq!(state.t, now, "a woken instance takes the bank's time");
         let mechanism = *scene.banks().0.mechanism(id)?;
         Ok((
@@ -499,7 +499,7 @@ fn a_woken_instance_is_a_fresh_start<T: Real>() -> Result<(), Error> {
         .iter()
         .map(|&id| twin(id))
         .collect::<Result<Vec<_>, _>>()?;
-    let cart_start = *scene.banks().1.state(cart)?;
+    let cart_start = scene.banks().1.state(cart)?;
     let cart_mechanism = *scene.banks().1.mechanism(cart)?;
     let mut cart_twin = FixedTimestep::new(Rk4, dt, CAP, cart_start)?;
     // Compared while awake; a creeper woken where it slept creeps on and sleeps again, at
@@ -521,13 +521,13 @@ fn a_woken_instance_is_a_fresh_start<T: Real>() -> Result<(), Error> {
             assert_eq!(f.steps, frame.steps);
             let (id, way) = (ids[i], ways[i]);
             if creepers.status(id)? == Status::Awake {
-                same_motion(creepers.state(id)?, sim.current(), &format!("{way:?}"));
+                same_motion(&creepers.state(id)?, sim.current(), &format!("{way:?}"));
                 compared[i] += frame.steps;
                 continue;
             }
             slept_again[i] = true;
             let s = creepers.state(id)?;
-            let at = bits(s).1;
+            let at = bits(&s).1;
             let last = at == bits(sim.current()).1;
             let one_before = frame.steps == 2 && at == bits(sim.previous()).1;
             assert!(
@@ -540,7 +540,7 @@ fn a_woken_instance_is_a_fresh_start<T: Real>() -> Result<(), Error> {
         }
         cart_twin.advance(&cart_mechanism, frame_time)?;
         assert_eq!(carts.status(cart)?, Status::Awake);
-        same_motion(carts.state(cart)?, cart_twin.current(), "input");
+        same_motion(&carts.state(cart)?, cart_twin.current(), "input");
         cart_compared += frame.steps;
     }
     println!("steps compared after waking: {compared:?} (creepers), {cart_compared} (cart)");
@@ -619,7 +619,7 @@ fn a_change_restarts_an_awake_instance<T: Real>() -> Result<(), Error> {
             kept = runs.clone();
             for ((run, keeping), &id) in runs.iter_mut().zip(&mut kept).zip(&ids) {
                 let mechanism = *scene.banks().mechanism(id)?;
-                assert_eq!(bits(scene.banks().state(id)?), bits(&run.state));
+                assert_eq!(bits(&scene.banks().state(id)?), bits(&run.state));
                 keeping.mechanism = mechanism;
                 *run = ByHand {
                     mechanism,
@@ -638,10 +638,10 @@ fn a_change_restarts_an_awake_instance<T: Real>() -> Result<(), Error> {
         }
         let bank = scene.banks();
         for (run, &id) in runs.iter().zip(&ids) {
-            assert_eq!(bits(bank.state(id)?), bits(&run.state), "frame {frame}");
+            assert_eq!(bits(&bank.state(id)?), bits(&run.state), "frame {frame}");
         }
         for (run, &id) in kept.iter().zip(&ids) {
-            if bits(bank.state(id)?) != bits(&run.state) {
+            if bits(&bank.state(id)?) != bits(&run.state) {
                 parted += 1;
             }
         }

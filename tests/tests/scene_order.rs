@@ -130,11 +130,11 @@ fn act<T: Real>(world: &mut World<T>, which: Which, act: Act<T>) -> Result<(), E
         (Which::Prop(id), Act::Remove) => drop(props.remove(id)?),
         (Which::Chain(id), Act::Remove) => drop(chains.remove(id)?),
         (Which::Prop(id), Act::Nudge(d)) => {
-            let s = *props.state(id)?;
+            let s = props.state(id)?;
             props.set_state(id, State::at_rest([s.q[0] + d]))?;
         }
         (Which::Chain(id), Act::Nudge(d)) => {
-            let s = *chains.state(id)?;
+            let s = chains.state(id)?;
             chains.set_state(id, State::at_rest([s.q[0] + d, s.q[1] - d]))?;
         }
         (Which::Prop(id), Act::Impulse(p)) => props.apply_impulse(id, &[p].into())?,

@@ -43,7 +43,7 @@ where
 {
     bank.iter()
         .next()
-        .map(|(_, s)| *s)
+        .map(|(_, s)| s)
         .ok_or(Error::NoSuchInstance)
 }
 
@@ -178,7 +178,7 @@ fn a_driven_cart_never_sleeps<T: Real>() -> Result<(), Error> {
         kinetic = kinetic.max(held.energies(a)?.kinetic.to_f64());
         let still = State {
             qd: SVector::zeros(),
-            ..*s
+            ..s
         };
         let q2 = held.mechanism(a)?.acceleration(&still)?;
         accel = q2.iter().fold(accel, |m, x| m.max(x.abs().to_f64()));
@@ -373,7 +373,7 @@ fn a_ball_sleeps_on_the_floor_and_wakes_to_an_impulse<T: Real>() -> Result<(), E
             }
         };
     let (first, _) = advance_until_asleep(&mut scene, 5.0)?;
-    let rest = *scene.banks().state(ball)?;
+    let rest = scene.banks().state(ball)?;
     assert!(
         rest.q[0].abs().to_f64() <= tol.to_f64() && rest.qd[0] == T::zero(),
         "{rest:?}"
@@ -394,7 +394,7 @@ fn a_ball_sleeps_on_the_floor_and_wakes_to_an_impulse<T: Real>() -> Result<(), E
         "{highest}"
     );
     assert!(deepest >= -tol.to_f64());
-    let rest = *scene.banks().state(ball)?;
+    let rest = scene.banks().state(ball)?;
     assert!(
         rest.q[0].abs().to_f64() <= tol.to_f64() && rest.qd[0] == T::zero(),
         "{rest:?}"

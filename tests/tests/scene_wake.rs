@@ -83,17 +83,22 @@ fn what_wakes_a_sleeper<T: Real>() -> Result<(), Error> {
     let (props, carts) = scene.banks_mut();
 
     // The cart: its input.
-    let before = *carts.state(cart)?;
+    let before = carts.state(cart)?;
     assert!(before.t < now);
     carts.set_input(cart, T::zero())?;
     still_asleep(
         carts.status(cart)?,
-        carts.state(cart)?,
+        &carts.state(cart)?,
         &before,
         "the same input",
     );
     carts.set_input(cart, -T::zero())?;
-    still_asleep(carts.status(cart)?, carts.state(cart)?, &before, "-0 for 0");
+    still_asleep(
+        carts.status(cart)?,
+        &carts.state(cart)?,
+        &before,
+        "-0 for 0",
+    );
     carts.set_input(cart, T::from_f64(0.1))?;
     assert_eq!(carts.status(cart)?, Status::Awake);
     assert_eq!(carts.mechanism(cart)?.force(), T::from_f64(0.1));
@@ -102,11 +107,11 @@ fn what_wakes_a_sleeper<T: Real>() -> Result<(), Error> {
 
     // The pendulums.
     let [a, b, c, d, e, f, h] = <[Id; 7]>::try_from(ids).map_err(|_| Error::NoSuchInstance)?;
-    let before = *props.state(a)?;
+    let before = props.state(a)?;
     props.modify(a, |_| Ok(()))?;
     still_asleep(
         props.status(a)?,
-        props.state(a)?,
+        &props.state(a)?,
         &before,
         "modify: nothing",
     );
@@ -116,7 +121,7 @@ fn what_wakes_a_sleeper<T: Real>() -> Result<(), Error> {
     })?;
     still_asleep(
         props.status(a)?,
-        props.state(a)?,
+        &props.state(a)?,
         &before,
         "modify: an equal pendulum",
     );
@@ -131,7 +136,7 @@ fn what_wakes_a_sleeper<T: Real>() -> Result<(), Error> {
     assert_eq!(props.mechanism(a)?.damping(), T::HALF);
     still_asleep(
         props.status(a)?,
-        props.state(a)?,
+        &props.state(a)?,
         &before,
         "modify: refused",
     );
@@ -142,24 +147,24 @@ fn what_wakes_a_sleeper<T: Real>() -> Result<(), Error> {
     assert_eq!(props.status(a)?, Status::Awake, "modify: damping 0.5 to 1");
     assert_eq!(props.mechanism(a)?.damping(), T::one());
 
-    let before = *props.state(b)?;
+    let before = props.state(b)?;
     props.set_state(b, before)?;
     assert_eq!(props.status(b)?, Status::Awake, "set_state: the same state");
-    let s = *props.state(b)?;
+    let s = props.state(b)?;
     assert_eq!((s.q, s.qd, s.t), (before.q, before.qd, now));
     for alpha in [0.0, 0.5, 1.0] {
         assert_eq!(bits(&props.interpolated(b, T::from_f64(alpha))?), bits(&s));
     }
 
-    let before = *props.state(c)?;
+    let before = props.state(c)?;
     props.apply_impulse(c, &SVector::from([T::from_f64(0.25)]))?;
     assert_eq!(props.status(c)?, Status::Awake, "impulse");
-    let s = *props.state(c)?;
+    let s = props.state(c)?;
     // m l^2 = 1: the velocity is the impulse, exactly.
     assert_eq!((s.q, s.qd[0], s.t), (before.q, T::from_f64(0.25), now));
 
     for (id, way) in [(d, "wake"), (e, "contact")] {
-        let before = *props.state(id)?;
+        let before = props.state(id)?;
         if way == "wake" {
             props.wake(id)?;
         } else {
@@ -210,12 +215,12 @@ fn waking_an_awake_instance_changes_nothing<T: Real>() -> Result<(), Error> {
         let bank = scene.banks_mut();
         bank.wake(touched)?;
         bank.contact(touched)?;
-        let s = *bank.state(written)?;
+        let s = bank.state(written)?;
         bank.set_state(written, s)?;
         scene.advance(rng.uniform(0.0, 2.5 * DT))?;
         let bank = scene.banks();
-        assert_eq!(bits(bank.state(touched)?), bits(bank.state(plain)?));
-        if bits(bank.state(written)?) != bits(bank.state(plain)?) {
+        assert_eq!(bits(&bank.state(touched)?), bits(&bank.state(plain)?));
+        if bits(&bank.state(written)?) != bits(&bank.state(plain)?) {
             parted += 1;
         }
     }
@@ -246,11 +251,11 @@ fn an_impulse_keeps_the_constraints<T: Real>() -> Result<(), Error> {
     }
     let mut worst = (0.0f64, 0.0f64);
     for &id in &ids {
-        let before = *bank.state(id)?;
+        let before = bank.state(id)?;
         let p = SVector::from([rng.uniform::<T>(-2.0, 2.0), rng.uniform::<T>(-2.0, 2.0)]);
         bank.apply_impulse(id, &p)?;
         assert_eq!(bank.status(id)?, Status::Awake);
-        let s = *bank.state(id)?;
+        let s = bank.state(id)?;
         assert_eq!(s.q, before.q);
         let [x, y] = [s.q[0].to_f64(), s.q[1].to_f64()];
         let [vx, vy] = [s.qd[0].to_f64(), s.qd[1].to_f64()];
@@ -307,7 +312,7 @@ fn an_impulse_jumps_by_the_inverse_mass<T: Real>() -> Result<(), Error> {
         let id = bank.add(p, start)?;
         let impulse = SVector::from([rng.uniform::<T>(-3.0, 3.0), rng.uniform::<T>(-3.0, 3.0)]);
         bank.apply_impulse(id, &impulse)?;
-        let s = *bank.state(id)?;
+        let s = bank.state(id)?;
         assert_eq!(s.q, start.q);
         // In f64: the jump, M and p as the bank had them.
         let dqd = s.qd.map(|x| x.to_f64()) - start.qd.map(|x| x.to_f64());

@@ -19,8 +19,19 @@ const PLOT_SECONDS = 6;
 const DRAG_GAIN = 12; // 1/s: a dragged point moves towards the pointer at this rate
 const PUSH = 15; // N: the cart's force under an arrow key
 
+// The module: built with WebAssembly SIMD (`simd128`: the scenes' banks in lanes step their
+// instances side by side on 128-bit vectors) where the browser validates a SIMD instruction,
+// else the scalar build (the same bits, one by one). `?scalar` in the address forces the
+// latter. The probe: (module (func (result v128) i32.const 0 i8x16.splat i8x16.popcnt)).
+const SIMD_PROBE = new Uint8Array([0, 97, 115, 109, 1, 0, 0, 0, 1, 5, 1, 96, 0, 1, 123, 3,
+  2, 1, 0, 10, 10, 1, 8, 0, 65, 0, 253, 15, 253, 98, 11]);
+const SIMD = !new URLSearchParams(location.search).has('scalar') &&
+  WebAssembly.validate(SIMD_PROBE);
+const MODULE = SIMD ? 'lagrange_web_simd128.wasm' : 'lagrange_web.wasm';
+
 const state = {
   wasm: null,
+  build: SIMD ? 'simd128' : 'scalar',
   panels: [],
   frames: 0,
   paused: false,
@@ -505,14 +516,15 @@ window.lagrangeProbe = function probe() {
     work: state.panels.map((_, p) => [ex().lg_work(p, 0), ex().lg_work(p, 1)]),
     roundsCap: ex().lg_rounds_cap(),
     scenario: state.scenario,
+    build: state.build,
     nonFinite: state.nonFinite,
   });
 };
 
 async function main() {
   const status = document.getElementById('status');
-  const response = await fetch('lagrange_web.wasm');
-  if (!response.ok) throw new Error(`lagrange_web.wasm: ${response.status} ${response.statusText}`);
+  const response = await fetch(MODULE);
+  if (!response.ok) throw new Error(`${MODULE}: ${response.status} ${response.statusText}`);
   const bytes = await response.arrayBuffer();
   const { instance } = await WebAssembly.instantiate(bytes, {});
   state.wasm = instance;
@@ -529,7 +541,8 @@ async function main() {
   });
   init(true);
   runScenario();
-  status.textContent = `${(bytes.byteLength / 1024).toFixed(0)} KiB of WebAssembly; ` +
+  status.textContent = `${(bytes.byteLength / 1024).toFixed(0)} KiB of WebAssembly ` +
+    `(${SIMD ? 'with SIMD: banks in lanes' : 'scalar'}); ` +
     'each mechanism steps in a lagrange Scene with a fixed-timestep clock, drawn interpolated.';
   state.ready = true;
   requestAnimationFrame(frame);

@@ -4,10 +4,10 @@
 
 use lagrange_core::nalgebra::{SVector, Vector4};
 use lagrange_core::{
-    Constrained, Controlled, Error, Holonomic, HolonomicConstraints, Projection, Real, Scalar,
-    State,
+    Constrained, Controlled, Error, Gather, Holonomic, HolonomicConstraints, Projection, Real,
+    Scalar, State,
 };
-use lagrange_integrators::scene::{Bank, Id, Sleeps};
+use lagrange_integrators::scene::{Bank, Id, InLanes, Layout, Sleeps};
 use lagrange_integrators::{
     ContactModel, ImpulseSettings, ImpulseStepper, Integrator, Projected, Rk4, SemiImplicitEuler,
     StormerVerlet,
@@ -198,19 +198,43 @@ macro_rules! by_method {
     };
 }
 
-/// A boxed [`Sim`] of `recipe`.
-fn boxed<T, const N: usize, M, I>(recipe: Recipe<T, N, M, I>) -> Result<Box<dyn Panel>, Error>
+/// A boxed [`Sim`] of `recipe`, its bank laid out by `Y`: [`InLanes`] for the mechanisms that
+/// gather (pendulum, double pendulum, cart-pole: the same bits as one by one).
+fn boxed<T, const N: usize, M, I, Y>(recipe: Recipe<T, N, M, I, Y>) -> Result<Box<dyn Panel>, Error>
 where
     T: Real,
+    Y: Layout<T, N, 2, M> + 'static,
     M: lagrange_core::Mechanism<T, N> + Clone + 'static,
     I: Integrator<T, N, M> + Clone + 'static,
 {
     Ok(Box::new(Sim::new(recipe)?))
 }
 
+/// A boxed [`Sim`] of `recipe`, stepped one by one.
+fn one_by_one<T, const N: usize, M, I>(recipe: Recipe<T, N, M, I>) -> Result<Box<dyn Panel>, Error>
+where
+    T: Real,
+    M: lagrange_core::Mechanism<T, N> + Clone + 'static,
+    I: Integrator<T, N, M> + Clone + 'static,
+{
+    boxed(recipe)
+}
+
+/// A boxed [`Sim`] of `recipe`, in lanes.
+fn in_lanes<T, const N: usize, M, I>(
+    recipe: Recipe<T, N, M, I, InLanes>,
+) -> Result<Box<dyn Panel>, Error>
+where
+    T: Real,
+    M: Gather<T, N> + Clone + 'static,
+    I: Integrator<T, N, M> + Clone + 'static,
+{
+    boxed(recipe)
+}
+
 /// The cart-pole's input: its force, N.
-fn push<T: Real, I>(
-    bank: &mut Bank<T, 2, 2, CartPole<T>, I, Sleeps<T>>,
+fn push<T: Real, I, Y: Layout<T, 2, 2, CartPole<T>>>(
+    bank: &mut Bank<T, 2, 2, CartPole<T>, I, Sleeps<T>, Y>,
     id: Id,
     force: f64,
 ) -> Result<(), Error>
@@ -255,7 +279,7 @@ pub fn make<T: Real>(kind: usize, method: usize) -> Result<Box<dyn Panel>, Error
     match kind {
         0 => {
             let mechanism = SimplePendulum::new(T::one(), T::one(), T::from_f64(G), T::zero())?;
-            by_method!(method, T, 1, |i| boxed(Recipe {
+            by_method!(method, T, 1, |i| in_lanes(Recipe {
                 mechanism,
                 start: State::at_rest([T::from_f64(TH0)]),
                 twin: None,
@@ -274,7 +298,7 @@ pub fn make<T: Real>(kind: usize, method: usize) -> Result<Box<dyn Panel>, Error
                 DoublePendulum::new(T::one(), T::one(), T::one(), T::one(), T::from_f64(G))?;
             let start = State::at_rest([T::from_f64(2.2), T::from_f64(2.6)]);
             let twin = State::at_rest([twin_angle(T::from_f64(2.2)), T::from_f64(2.6)]);
-            by_method!(method, T, 2, |i| boxed(Recipe {
+            by_method!(method, T, 2, |i| in_lanes(Recipe {
                 mechanism,
                 start,
                 twin: Some(twin),
@@ -295,7 +319,7 @@ pub fn make<T: Real>(kind: usize, method: usize) -> Result<Box<dyn Panel>, Error
                 T::from_f64(G),
             )?;
             let start = State::at_rest([T::from_f64(1.3); LINKS]);
-            by_method!(method, T, LINKS, |i| boxed(Recipe {
+            by_method!(method, T, LINKS, |i| one_by_one(Recipe {
                 mechanism,
                 start,
                 twin: None,
@@ -322,7 +346,7 @@ pub fn make<T: Real>(kind: usize, method: usize) -> Result<Box<dyn Panel>, Error
                 Branch::Right,
             )?;
             let projection = Projection::new(pick::<T>(1e-5, 1e-10), 4)?;
-            by_method!(method, T, 3, |i| boxed(Recipe {
+            by_method!(method, T, 3, |i| one_by_one(Recipe {
                 mechanism,
                 start,
                 twin: None,
@@ -344,7 +368,7 @@ pub fn make<T: Real>(kind: usize, method: usize) -> Result<Box<dyn Panel>, Error
                 T::from_f64(9.8),
             )?;
             let start = State::at_rest([T::zero(), T::from_f64(0.05)]);
-            by_method!(method, T, 2, |i| boxed(Recipe {
+            by_method!(method, T, 2, |i| in_lanes(Recipe {
                 mechanism,
                 start,
                 twin: None,
@@ -368,7 +392,7 @@ pub fn make<T: Real>(kind: usize, method: usize) -> Result<Box<dyn Panel>, Error
             );
             let model = ContactModel::new(T::from_f64(0.5), T::from_f64(0.1), T::one())?;
             let contacts = Holonomic::new(FloorAndLimits);
-            by_method!(method, T, 2, |i| boxed(Recipe {
+            by_method!(method, T, 2, |i| one_by_one(Recipe {
                 mechanism,
                 start,
                 twin: None,
@@ -387,7 +411,7 @@ pub fn make<T: Real>(kind: usize, method: usize) -> Result<Box<dyn Panel>, Error
             let model = ContactModel::new(T::from_f64(0.3), T::from_f64(0.3), T::one())?
                 .with_friction(T::from_f64(0.8))?;
             let contacts = RagdollContacts::adult(&mechanism, T::zero())?;
-            by_method!(method, T, RAGDOLL_COORDINATES, |i| boxed(Recipe {
+            by_method!(method, T, RAGDOLL_COORDINATES, |i| one_by_one(Recipe {
                 mechanism,
                 start: thrown(),
                 twin: None,

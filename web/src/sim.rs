@@ -4,7 +4,7 @@
 
 use lagrange_core::nalgebra::{SVector, Vector2};
 use lagrange_core::{Error, Mechanism, Real, State};
-use lagrange_integrators::scene::{Bank, Id, Scene, Sleeps, Status};
+use lagrange_integrators::scene::{Bank, Id, Layout, OneByOne, Scene, Sleeps, Status};
 use lagrange_integrators::Integrator;
 
 /// The most fixed steps one frame may take: a slow frame (or a tiny dt) slows the motion
@@ -72,23 +72,24 @@ pub struct PointCounts {
 pub type PointsFn<M, T, const N: usize> = fn(&M, &SVector<T, N>) -> Vec<[f64; 2]>;
 
 /// The input of the mechanism, set on its bank.
-pub type InputFn<T, const N: usize, M, I> =
-    fn(&mut Bank<T, N, 2, M, I, Sleeps<T>>, Id, f64) -> Result<(), Error>;
+pub type InputFn<T, const N: usize, M, I, Y = OneByOne> =
+    fn(&mut Bank<T, N, 2, M, I, Sleeps<T>, Y>, Id, f64) -> Result<(), Error>;
 
-/// The bank of a [`Sim`].
-type SimBank<T, const N: usize, M, I> = Bank<T, N, 2, M, I, Sleeps<T>>;
+/// The bank of a [`Sim`], laid out by `Y`: [`InLanes`](lagrange_integrators::scene::InLanes)
+/// for the mechanisms that gather (the same bits as one by one).
+type SimBank<T, const N: usize, M, I, Y> = Bank<T, N, 2, M, I, Sleeps<T>, Y>;
 
 /// A scene over a [`SimBank`] and the ids of its instances (main, then twin). The scene is
 /// boxed where it is made: a bank of two ragdoll impulse steppers in `f64` is 100 kB, and each
 /// frame that moved it by value kept a copy (unoptimised, the page's tests overflowed a 2 MB
 /// thread stack).
-type Built<T, const N: usize, M, I> = (Box<Scene<T, SimBank<T, N, M, I>>>, Vec<Id>);
+type Built<T, const N: usize, M, I, Y> = (Box<Scene<T, SimBank<T, N, M, I, Y>>>, Vec<Id>);
 
 /// The exact solution's points at time `t`, s.
 pub type ExactFn = fn(f64) -> Vec<[f64; 2]>;
 
 /// How a [`Sim`] is made: its mechanism, its start states, its integrator and rules.
-pub struct Recipe<T: Real, const N: usize, M, I> {
+pub struct Recipe<T: Real, const N: usize, M, I, Y: Layout<T, N, 2, M> = OneByOne> {
     /// The mechanism (parameters).
     pub mechanism: M,
     /// The main instance's start.
@@ -108,16 +109,16 @@ pub struct Recipe<T: Real, const N: usize, M, I> {
     /// The exact solution's points at time `t`, while the motion is the exact one's.
     pub exact: Option<ExactFn>,
     /// The input, for a mechanism that has one.
-    pub input: Option<InputFn<T, N, M, I>>,
+    pub input: Option<InputFn<T, N, M, I, Y>>,
     /// The worst work of the integrator's steps so far, `[rows, rounds]`, for one that
     /// reports it (a time-stepping contact solver).
     pub work: Option<fn(&I) -> [u32; 2]>,
 }
 
 /// One mechanism in its scene.
-pub struct Sim<T: Real, const N: usize, M, I> {
-    recipe: Recipe<T, N, M, I>,
-    scene: Box<Scene<T, SimBank<T, N, M, I>>>,
+pub struct Sim<T: Real, const N: usize, M, I, Y: Layout<T, N, 2, M> = OneByOne> {
+    recipe: Recipe<T, N, M, I, Y>,
+    scene: Box<Scene<T, SimBank<T, N, M, I, Y>>>,
     ids: Vec<Id>,
     dt: f64,
     e0: f64,
@@ -128,17 +129,18 @@ pub struct Sim<T: Real, const N: usize, M, I> {
 }
 
 /// A scene over a new bank of the recipe's instances at `states`, stepped by `dt`.
-fn build<T, const N: usize, M, I>(
-    recipe: &Recipe<T, N, M, I>,
+fn build<T, const N: usize, M, I, Y>(
+    recipe: &Recipe<T, N, M, I, Y>,
     states: &[State<T, N>],
     dt: f64,
-) -> Result<Built<T, N, M, I>, Error>
+) -> Result<Built<T, N, M, I, Y>, Error>
 where
+    Y: Layout<T, N, 2, M>,
     T: Real,
     M: Mechanism<T, N> + Clone,
     I: Integrator<T, N, M> + Clone,
 {
-    let mut bank: SimBank<T, N, M, I> = Bank::new(recipe.integrator.clone(), recipe.sleep)?;
+    let mut bank: SimBank<T, N, M, I, Y> = Bank::new(recipe.integrator.clone(), recipe.sleep)?;
     let mut ids = Vec::with_capacity(states.len());
     for s in states {
         ids.push(bank.add(recipe.mechanism.clone(), *s)?);
@@ -147,8 +149,9 @@ where
     Ok((scene, ids))
 }
 
-impl<T, const N: usize, M, I> Sim<T, N, M, I>
+impl<T, const N: usize, M, I, Y> Sim<T, N, M, I, Y>
 where
+    Y: Layout<T, N, 2, M>,
     T: Real,
     M: Mechanism<T, N> + Clone,
     I: Integrator<T, N, M> + Clone,
@@ -157,7 +160,7 @@ where
     ///
     /// # Errors
     /// The library's errors building the bank and the scene.
-    pub fn new(recipe: Recipe<T, N, M, I>) -> Result<Self, Error> {
+    pub fn new(recipe: Recipe<T, N, M, I, Y>) -> Result<Self, Error> {
         let (scene, ids) = build(&recipe, &Self::starts(&recipe), recipe.dt)?;
         let e0 = recipe.mechanism.energy(&recipe.start).to_f64();
         let dt = recipe.dt;
@@ -175,14 +178,14 @@ where
     }
 
     /// The start states: main, then twin.
-    fn starts(recipe: &Recipe<T, N, M, I>) -> Vec<State<T, N>> {
+    fn starts(recipe: &Recipe<T, N, M, I, Y>) -> Vec<State<T, N>> {
         core::iter::once(recipe.start).chain(recipe.twin).collect()
     }
 
     /// The main instance's current state.
     fn main_state(&self) -> Result<State<T, N>, Error> {
         let id = *self.ids.first().ok_or(Error::NoSuchInstance)?;
-        self.scene.banks().state(id).copied()
+        self.scene.banks().state(id)
     }
 
     /// Keeps `error` and resets.
@@ -213,8 +216,9 @@ fn push_finite(out: &mut Vec<f64>, points: &[[f64; 2]]) -> usize {
     }
 }
 
-impl<T, const N: usize, M, I> Panel for Sim<T, N, M, I>
+impl<T, const N: usize, M, I, Y> Panel for Sim<T, N, M, I, Y>
 where
+    Y: Layout<T, N, 2, M>,
     T: Real,
     M: Mechanism<T, N> + Clone,
     I: Integrator<T, N, M> + Clone,
@@ -308,7 +312,7 @@ where
     fn set_dt(&mut self, dt: f64) -> Result<(), Error> {
         let bank = self.scene.banks();
         let states: Result<Vec<State<T, N>>, Error> =
-            self.ids.iter().map(|&id| bank.state(id).copied()).collect();
+            self.ids.iter().map(|&id| bank.state(id)).collect();
         let rebuilt = states.and_then(|states| self.rebuild(&states, dt));
         rebuilt.map_err(|e| self.fail(e))?;
         // The exact solution no longer shares the clock's start.
@@ -351,8 +355,9 @@ where
     }
 }
 
-impl<T, const N: usize, M, I> Sim<T, N, M, I>
+impl<T, const N: usize, M, I, Y> Sim<T, N, M, I, Y>
 where
+    Y: Layout<T, N, 2, M>,
     T: Real,
     M: Mechanism<T, N> + Clone,
     I: Integrator<T, N, M> + Clone,

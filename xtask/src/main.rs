@@ -32,9 +32,11 @@
 //!   under `target/mutants/` (hours; not part of `ci`).
 //! - `fuzz [CALLS] [--seed S]`: the hostile-input campaign (`tests/tests/hostile`) in release,
 //!   10^7 calls by default (its 10^5-call run is part of `test` and `ci`).
-//! - `web`: the interactive page, the library compiled to WebAssembly, written to
+//! - `web`: the interactive page, the library compiled to WebAssembly (with SIMD and
+//!   without, the page loading the first where the browser has it), written to
 //!   `target/lagrange-web/` and served on 127.0.0.1 (`--no-serve`: build only; `--test`: drive
-//!   it in headless Chromium and compare its scenario's bits with the host's and QEMU's).
+//!   it in headless Chromium and compare its scenario's bits, from both modules, with the
+//!   host's and QEMU's).
 //! - `publish`: the library crates' docs (rustdoc warnings denied) and packages, each verified
 //!   against the others' packaged files.
 //! - `guide [--figures]`: the user's guide (mdBook, `guide/`) built into `target/guide/`, its

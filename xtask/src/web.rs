@@ -1,17 +1,21 @@
 //! `cargo xtask web`: the interactive page, the library compiled to WebAssembly.
 //!
 //! 1. Installs the `wasm32-unknown-unknown` target with rustup when it is missing.
-//! 2. Builds `web/` (crate `lagrange-web`, plain C ABI exports) for it in the `web` profile.
-//! 3. Writes the static site to `target/lagrange-web/`: `web/site/*` and the `.wasm`; no CDN,
-//!    no network at run time.
+//! 2. Builds `web/` (crate `lagrange-web`, plain C ABI exports) for it in the `web` profile,
+//!    twice: without and with WebAssembly SIMD (`simd128`, under which a scene's banks in
+//!    lanes step side by side); the page loads the second where the browser has SIMD.
+//! 3. Writes the static site to `target/lagrange-web/`: `web/site/*` and the two `.wasm`; no
+//!    CDN, no network at run time.
 //! 4. Serves it on 127.0.0.1 and prints the URL (`--no-serve`: stops after the build).
 //!
 //! `--test` drives the page in headless Chromium (Debian's `chromium`, installed by apt-get
 //! when missing) over the DevTools protocol ([`crate::cdp`]) and checks that it loads without
-//! console errors, that frames advance, that the scripted scenario's words and digest equal
-//! the host's (x86_64, computed here) and the firmware's (under QEMU, `crate::qemu`), and that
-//! bad input (a dt of 0 or NaN, an absurd throw) shows the library's error, resets the
-//! instance and leaves every drawn value finite. It saves `target/lagrange-web/screenshot.png`.
+//! console errors, that frames advance, that it loaded the SIMD module, that the scripted
+//! scenario's words and digest, from the SIMD module and again from the scalar one (the page
+//! loaded with `?scalar`), equal the host's (x86_64, computed here) and the firmware's (under
+//! QEMU, `crate::qemu`), and that bad input (a dt of 0 or NaN, an absurd throw) shows the
+//! library's error, resets the instance and leaves every drawn value finite. It saves
+//! `target/lagrange-web/screenshot.png`.
 //!
 //! The test holds the module back for ten seconds ([`WASM_HOLD`]), as a loaded machine does
 //! when it compiles it on a first start: the page must answer "not ready" until it is
@@ -67,26 +71,29 @@ pub fn run(args: &[String]) -> Result<(), String> {
     }
 }
 
-/// Builds the wasm and writes the site; its directory.
+/// The page's two modules: the scalar one every browser runs, and one built with WebAssembly
+/// SIMD (`simd128`), where lanes map onto 128-bit vectors and a scene's banks in lanes step
+/// their instances side by side ([`VECTOR_UNIT`]), which the page loads where the browser
+/// validates a SIMD instruction. Each in a target directory of its own (their flags differ,
+/// and sharing one would rebuild each in turn): file, rustflags, directory under `target/`
+/// (none: `target/` itself).
+///
+/// [`VECTOR_UNIT`]: lagrange_core::VECTOR_UNIT
+const MODULES: [(&str, &str, &str); 2] = [
+    ("lagrange_web.wasm", "", ""),
+    (
+        "lagrange_web_simd128.wasm",
+        r#"target.wasm32-unknown-unknown.rustflags=["-C","target-feature=+simd128"]"#,
+        "web-simd128",
+    ),
+];
+
+/// Builds the two modules and writes the site; its directory.
 fn build() -> Result<PathBuf, String> {
     let clock = Instant::now();
     cross::ensure_rustup_target(WASM)?;
     let root = cmd::project_root();
     let target = root.join("target");
-    cmd::run(
-        cmd::cargo()
-            .args([
-                "build",
-                "--quiet",
-                "-p",
-                "lagrange-web",
-                "--lib",
-                "--target",
-                WASM,
-            ])
-            .args(["--profile", "web", "--target-dir"])
-            .arg(&target),
-    )?;
     let site = target.join("lagrange-web");
     std::fs::create_dir_all(&site).map_err(|e| format!("{}: {e}", site.display()))?;
     let copy = |from: &Path, to: &Path| {
@@ -94,19 +101,43 @@ fn build() -> Result<PathBuf, String> {
             .map(|_| ())
             .map_err(|e| format!("copying {} to {}: {e}", from.display(), to.display()))
     };
-    let wasm = target.join(WASM).join("web").join("lagrange_web.wasm");
-    copy(&wasm, &site.join("lagrange_web.wasm"))?;
+    let mut sizes = Vec::new();
+    for (file, flags, dir) in MODULES {
+        let dir = if dir.is_empty() {
+            target.clone()
+        } else {
+            target.join(dir)
+        };
+        let mut build = cmd::cargo();
+        build.args([
+            "build",
+            "--quiet",
+            "-p",
+            "lagrange-web",
+            "--lib",
+            "--target",
+            WASM,
+        ]);
+        if !flags.is_empty() {
+            build.args(["--config", flags]);
+        }
+        build.args(["--profile", "web", "--target-dir"]).arg(&dir);
+        cmd::run(&mut build)?;
+        let wasm = dir.join(WASM).join("web").join("lagrange_web.wasm");
+        copy(&wasm, &site.join(file))?;
+        let size = std::fs::metadata(site.join(file)).map_or(0, |m| m.len());
+        sizes.push(format!("{file} {} KiB", size / 1024));
+    }
     let sources = root.join("web").join("site");
     let entries = std::fs::read_dir(&sources).map_err(|e| format!("{}: {e}", sources.display()))?;
     for entry in entries.flatten() {
         copy(&entry.path(), &site.join(entry.file_name()))?;
     }
-    let size = std::fs::metadata(site.join("lagrange_web.wasm")).map_or(0, |m| m.len());
     println!(
-        "xtask web: built in {:.0} s: {} ({} KiB of wasm)",
+        "xtask web: built in {:.0} s: {} ({})",
         clock.elapsed().as_secs_f64(),
         site.display(),
-        size / 1024
+        sizes.join(", ")
     );
     Ok(site)
 }
@@ -238,18 +269,24 @@ fn test(site: &Path) -> Result<(), String> {
     let profile = site.join("chromium-profile");
     let _ = std::fs::remove_dir_all(&profile);
     let mut browser = Browser::start(CHROMIUM, &profile, &site.join("chromium.log"))?;
-    let checked = drive(&mut browser, &url, site);
+    let checked = drive(&mut browser, &url, site).and_then(|(failures, simd)| {
+        let scalar = scalar_scenario(&mut browser, &url)?;
+        Ok((failures, simd, scalar))
+    });
     let console = std::mem::take(&mut browser.console_errors);
     browser.close();
     let _ = std::fs::remove_dir_all(&profile);
-    let (mut failures, page) = checked?;
+    let (mut failures, simd, scalar) = checked?;
     if !console.is_empty() {
         failures.push(format!(
             "console errors on the page:\n  {}",
             console.join("\n  ")
         ));
     }
-    failures.extend(compare(&page, &firmware));
+    failures.extend(compare(
+        &[("wasm simd128", &simd), ("wasm scalar", &scalar)],
+        &firmware,
+    ));
     println!("xtask web --test: {:.0} s", clock.elapsed().as_secs_f64());
     if failures.is_empty() {
         println!("xtask web --test: all checks passed");
@@ -433,8 +470,19 @@ fn drive(
             before
         }
     };
-    let scenario = after.get("scenario");
-    let lines = ["f32", "f64"]
+    if after.get("build").str() != Some("simd128") {
+        failures.push(format!(
+            "Chromium validates WebAssembly SIMD, but the page loaded the {:?} module",
+            after.get("build")
+        ));
+    }
+    Ok((failures, scenario_lines(&after)))
+}
+
+/// The scripted scenario's lines of a page's state, by precision.
+fn scenario_lines(state: &Json) -> BTreeMap<String, String> {
+    let scenario = state.get("scenario");
+    ["f32", "f64"]
         .into_iter()
         .filter_map(|p| {
             scenario
@@ -442,8 +490,27 @@ fn drive(
                 .str()
                 .map(|s| (p.to_string(), s.to_string()))
         })
-        .collect();
-    Ok((failures, lines))
+        .collect()
+}
+
+/// The page loaded again with `?scalar`, which makes it take the module without SIMD (what a
+/// browser without it runs): its scripted scenario's lines, once it has them.
+fn scalar_scenario(browser: &mut Browser, url: &str) -> Result<BTreeMap<String, String>, String> {
+    browser.call(
+        "Page.navigate",
+        &format!(
+            r#"{{"url":{}}}"#,
+            crate::cdp::quote(&format!("{url}?scalar"))
+        ),
+    )?;
+    let state = wait_until(
+        browser,
+        "the scalar page's scenario",
+        READY_DEADLINE,
+        |state| state.get("build").str() == Some("scalar") && scenario_lines(state).len() == 2,
+    )?;
+    println!("page: loaded again with ?scalar: the scalar module");
+    Ok(scenario_lines(&state))
 }
 
 /// Saves the page's screenshot to `site/screenshot.png`.
@@ -640,7 +707,7 @@ fn throws(browser: &mut Browser) -> Result<Vec<String>, String> {
 
 /// Compares the page's scenario with the host's and the firmware's; the failures.
 fn compare(
-    page: &BTreeMap<String, String>,
+    pages: &[(&str, &BTreeMap<String, String>)],
     firmware: &Result<BTreeMap<usize, Option<Vec<u64>>>, String>,
 ) -> Vec<String> {
     let mut failures = Vec::new();
@@ -668,36 +735,37 @@ fn compare(
             .as_ref()
             .ok()
             .and_then(|states| states.get(&id?).cloned().flatten());
-        let wasm = page.get(precision).map(|line| parse_scenario(line));
         let show = |words: Option<&Vec<u64>>| {
             words.map_or_else(|| "missing".to_string(), |w| format!("{:016x}", digest(w)))
         };
-        let wasm_words = match &wasm {
-            Some(Ok((words, shown))) => {
-                if *shown != digest(words) {
-                    failures.push(format!(
-                        "{precision}: the page's digest does not match its words"
-                    ));
+        let mut shown = vec![format!("host x86_64 {}", show(Some(&host)))];
+        for (name, page) in pages {
+            let wasm = page.get(precision).map(|line| parse_scenario(line));
+            let wasm_words = match &wasm {
+                Some(Ok((words, digest_shown))) => {
+                    if *digest_shown != digest(words) {
+                        failures.push(format!(
+                            "{precision}: the {name} page's digest does not match its words"
+                        ));
+                    }
+                    Some(words)
                 }
-                Some(words)
+                Some(Err(e)) => {
+                    failures.push(e.clone());
+                    None
+                }
+                None => None,
+            };
+            shown.push(format!("{name} (Chromium) {}", show(wasm_words)));
+            if wasm_words != Some(&host) {
+                failures.push(format!(
+                    "{precision}: the {name} page's scenario differs from the host's: page \
+                     {wasm:?}, host {host:x?}"
+                ));
             }
-            Some(Err(e)) => {
-                failures.push(e.clone());
-                None
-            }
-            None => None,
-        };
-        println!(
-            "  {precision}: host x86_64 {}  wasm (Chromium) {}  M4F (QEMU) {}",
-            show(Some(&host)),
-            show(wasm_words),
-            show(m4f.as_ref())
-        );
-        if wasm_words != Some(&host) {
-            failures.push(format!(
-                "{precision}: the page's scenario differs from the host's: page {wasm:?}, host {host:x?}"
-            ));
         }
+        shown.push(format!("M4F (QEMU) {}", show(m4f.as_ref())));
+        println!("  {precision}: {}", shown.join("  "));
         if m4f.as_ref() != Some(&host) {
             failures.push(format!(
                 "{precision}: the firmware's scenario differs from the host's: M4F {m4f:x?}, \
@@ -706,7 +774,10 @@ fn compare(
         }
     }
     if failures.is_empty() {
-        println!("  identical bits: host x86_64 = wasm in Chromium = Cortex-M4F under QEMU");
+        println!(
+            "  identical bits: host x86_64 (banks in lanes) = wasm in Chromium, with SIMD (in \
+             lanes) and without (one by one) = Cortex-M4F under QEMU (one by one)"
+        );
     }
     failures
 }

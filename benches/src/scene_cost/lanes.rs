@@ -1,133 +1,109 @@
-//! Lanes: 1,024 `f32` pendulums and 1,024 `f32` double pendulums stepped by RK4 one by one
-//! (the scalar loop), side by side in lanes of 8 (their parameters gathered once), and by a
-//! scene's bank (which gathers them every step): ns per instance and step, and the ratios.
+//! Lanes: 1,024 `f32` pendulums and 1,024 `f32` double pendulums, all awake, stepped by RK4 in a
+//! scene's bank in lanes ([`InLanes`]) against the same bank one by one ([`OneByOne`]), timed
+//! interleaved (rows `bank_pendulums`, `bank_double_pendulums`); and by hand, without a bank,
+//! one by one and in lanes gathered once (rows `pendulums_by_hand`, `double_pendulums_by_hand`):
+//! what the bank's lanes can reach at most. After the timing, the two banks' states are
+//! compared bit for bit (they took the same frames).
 
 use super::frames::ratio;
 use super::{Ratio, Row};
 use lagrange_benches::timing::Budget;
 use lagrange_core::nalgebra::SVector;
-use lagrange_core::{Error, Lanes, Mechanism, State};
-use lagrange_integrators::scene::{Bank, NeverSleeps, Scene};
+use lagrange_core::{divergences, Error, Gather, Lanes, State};
+use lagrange_integrators::scene::{Bank, Id, InLanes, Layout, NeverSleeps, OneByOne, Scene, LANES};
 use lagrange_integrators::{Integrator, Rk4};
 use lagrange_systems::{DoublePendulum, SimplePendulum};
 
 /// Instances of each mechanism.
 const K: usize = 1024;
-/// Lanes per group.
-const L: usize = 8;
 /// The step, s.
 const DT: f32 = 1.0 / 120.0;
-/// The goal: lanes at least this many times fewer ns per instance-step than the loop.
+/// The goal: a bank in lanes at least this many times fewer ns per instance-step than the
+/// same bank one by one.
 const LANE_GOAL: f64 = 3.0;
 
-/// `K` instances made by `make(k / K)`, with their starts.
-fn instances<M>(
-    make: impl Fn(f32) -> Result<(M, State<f32, 2>), Error>,
-) -> Result<Vec<(M, State<f32, 2>)>, Error> {
-    (0..K).map(|k| make(k as f32 / K as f32)).collect()
+/// A scene of one bank of `built`, laid out by `Y`, and the instances' ids in order.
+type Built<const N: usize, M, Y> = (Scene<f32, Bank<f32, N, K, M, Rk4, NeverSleeps, Y>>, Vec<Id>);
+
+/// The bank of `built`, laid out by `Y`, in a scene of one step per frame.
+fn scene<M, const N: usize, Y>(built: &[(M, State<f32, N>)]) -> Result<Built<N, M, Y>, Error>
+where
+    M: Gather<f32, N> + Clone,
+    Y: Layout<f32, N, K, M>,
+{
+    let mut bank = Bank::new(Rk4, NeverSleeps)?;
+    let ids = built
+        .iter()
+        .map(|(m, s)| bank.add(m.clone(), *s))
+        .collect::<Result<_, _>>()?;
+    Ok((Scene::new(bank, DT, 1)?, ids))
 }
 
-/// The three ways of stepping one mechanism's instances, timed against each other.
+/// The bank in lanes against one by one, and by hand, of one mechanism's instances.
 fn measure_one<M, const N: usize>(
     name: &str,
     budget: Budget,
-    built: Vec<(M, State<f32, N>)>,
+    built: &[(M, State<f32, N>)],
     rows: &mut Vec<Row>,
     ratios: &mut Vec<Ratio>,
 ) -> Result<(), Error>
 where
-    M: Mechanism<f32, N> + Clone,
+    M: Gather<f32, N> + Clone,
 {
-    // One by one.
-    let mut alone = built.clone();
-    // In lanes, gathered once.
-    let mut groups = Vec::new();
-    for chunk in built.chunks_exact(L) {
-        let refs: [&M; L] = core::array::from_fn(|i| &chunk[i].0);
-        let lanes = M::gather(refs).ok_or(Error::InvalidParameter {
-            name: "mechanism",
-            reason: "gathers no lanes",
-        })?;
-        let starts: [&State<f32, N>; L] = core::array::from_fn(|i| &chunk[i].1);
-        let state = State {
-            t: Lanes::gather(&starts, |s| s.t),
-            q: SVector::from_fn(|j, _| Lanes::gather(&starts, |s| s.q[j])),
-            qd: SVector::from_fn(|j, _| Lanes::gather(&starts, |s| s.qd[j])),
-        };
-        groups.push((lanes, state));
-    }
-    // A scene's bank.
-    let mut bank: Bank<f32, N, K, M, Rk4, NeverSleeps> = Bank::new(Rk4, NeverSleeps)?;
-    for (m, s) in &built {
-        bank.add(m.clone(), *s)?;
-    }
-    let mut scene = Scene::new(&mut bank, DT, 1)?;
-    let mut failure = None;
-    let mut fail = |r: Result<(), Error>| {
-        if let Err(e) = r {
-            failure = Some(e);
+    let (mut lanes, lane_ids) = scene::<M, N, InLanes>(built)?;
+    let (mut each, each_ids) = scene::<M, N, OneByOne>(built)?;
+    let (mut r1, mut r2) = (Ok(()), Ok(()));
+    let diverged = divergences();
+    let (bank_ratio, ns_each, ns_lanes) = ratio(
+        budget,
+        || {
+            if let Err(e) = each.advance(DT) {
+                r1 = Err(e);
+            }
+        },
+        || {
+            if let Err(e) = lanes.advance(DT) {
+                r2 = Err(e);
+            }
+        },
+    );
+    r1?;
+    r2?;
+    // Comparisons on which lanes disagreed while timed: each sent a group one by one.
+    let diverged = divergences()
+        .zip(diverged)
+        .map_or(0, |(after, before)| after.wrapping_sub(before));
+    // The same frames were taken by both: the same bits.
+    for (&a, &b) in lane_ids.iter().zip(&each_ids) {
+        let (x, y) = (lanes.banks().state(a)?, each.banks().state(b)?);
+        if x.q != y.q || x.qd != y.qd || x.t.to_bits() != y.t.to_bits() {
+            return Err(Error::InvalidParameter {
+                name: "lanes",
+                reason: "a bank in lanes left the bits of the same bank one by one",
+            });
         }
-    };
-    let (mut r1, mut r2, mut r3) = (Ok(()), Ok(()), Ok(()));
-    let (lanes_ratio, ns_alone, ns_lanes) = ratio(
-        budget,
-        || {
-            for (m, s) in &mut alone {
-                match Rk4.step(m, s, DT) {
-                    Ok(next) => *s = next,
-                    Err(e) => r1 = Err(e),
-                }
-            }
-        },
-        || {
-            for (m, s) in &mut groups {
-                match Integrator::<Lanes<f32, L>, N, _>::step(&mut Rk4, m, s, Lanes::splat(DT)) {
-                    Ok(next) => *s = next,
-                    Err(e) => r2 = Err(e),
-                }
-            }
-        },
-    );
-    // From the start again, so that one by one and the bank step the same states in lockstep
-    // (the cost of a double pendulum's step depends on its angles: past pi/4 its sines take
-    // the reduced path).
-    alone.clone_from(&built);
-    let (bank_ratio, _, ns_bank) = ratio(
-        budget,
-        || {
-            for (m, s) in &mut alone {
-                if let Ok(next) = Rk4.step(m, s, DT) {
-                    *s = next;
-                }
-            }
-        },
-        || {
-            if let Err(e) = scene.advance(DT) {
-                r3 = Err(e);
-            }
-        },
-    );
-    fail(r1);
-    fail(r2);
-    fail(r3);
-    if let Some(e) = failure {
-        return Err(e);
     }
+
+    let (hand_ratio, ns_alone, ns_hand) = by_hand(budget, built)?;
     let per = |ns: f64| ns / K as f64;
     println!(
-        "{name}: {:.1} ns per instance-step one by one, {:.1} in lanes of {L} ({lanes_ratio:.2}x), \
-         {:.1} in a scene's bank ({bank_ratio:.2}x)",
-        per(ns_alone),
+        "{name}: a bank {:.1} ns per instance-step one by one, {:.1} in lanes of {LANES} \
+         ({bank_ratio:.2}x; {diverged} divergences while timed); by hand {:.1} one by one, {:.1} \
+         in lanes ({hand_ratio:.2}x)",
+        per(ns_each),
         per(ns_lanes),
-        per(ns_bank)
+        per(ns_alone),
+        per(ns_hand)
     );
-    for (scene_name, ns) in [
-        (format!("{name}, one by one"), ns_alone),
-        (format!("{name}, lanes of {L}"), ns_lanes),
-        (format!("{name}, a scene's bank in lanes"), ns_bank),
+    for (scene, layout, ns) in [
+        (format!("bank_{name}"), "one_by_one", ns_each),
+        (format!("bank_{name}"), "lanes", ns_lanes),
+        (format!("{name}_by_hand"), "one_by_one", ns_alone),
+        (format!("{name}_by_hand"), "lanes", ns_hand),
     ] {
         rows.push(Row {
-            scene: scene_name,
+            scene,
+            layout,
             instances: K,
             awake_fraction: 1.0,
             integrator: "RK4",
@@ -137,12 +113,12 @@ where
     }
     for (what, r) in [
         (
-            format!("{name} RK4 f32: one by one / lanes of {L}"),
-            lanes_ratio,
+            format!("bank_{name} RK4 f32: one_by_one / lanes (of {LANES})"),
+            bank_ratio,
         ),
         (
-            format!("{name} RK4 f32: one by one / a scene's bank in lanes"),
-            bank_ratio,
+            format!("{name}_by_hand RK4 f32: one_by_one / lanes (of {LANES}, gathered once)"),
+            hand_ratio,
         ),
     ] {
         ratios.push(Ratio {
@@ -155,24 +131,70 @@ where
     Ok(())
 }
 
-/// Both mechanisms.
+/// The instances stepped by hand without a bank, one by one and in lanes of [`LANES`] (their
+/// mechanisms gathered once), timed interleaved: the ratio and each side's ns per frame.
+fn by_hand<M, const N: usize>(
+    budget: Budget,
+    built: &[(M, State<f32, N>)],
+) -> Result<(f64, f64, f64), Error>
+where
+    M: Gather<f32, N> + Clone,
+{
+    let mut alone = built.to_vec();
+    let mut groups = Vec::new();
+    for chunk in built.chunks_exact(LANES) {
+        let refs: [&M; LANES] = core::array::from_fn(|i| &chunk[i].0);
+        let starts: [&State<f32, N>; LANES] = core::array::from_fn(|i| &chunk[i].1);
+        let state = State {
+            t: Lanes::gather(&starts, |s| s.t),
+            q: SVector::from_fn(|j, _| Lanes::gather(&starts, |s| s.q[j])),
+            qd: SVector::from_fn(|j, _| Lanes::gather(&starts, |s| s.qd[j])),
+        };
+        groups.push((M::gather(refs), state));
+    }
+    let (mut r1, mut r2) = (Ok(()), Ok(()));
+    let out = ratio(
+        budget,
+        || {
+            for (m, s) in &mut alone {
+                match Rk4.step(m, s, DT) {
+                    Ok(next) => *s = next,
+                    Err(e) => r1 = Err(e),
+                }
+            }
+        },
+        || {
+            for (m, s) in &mut groups {
+                match Integrator::<Lanes<f32, LANES>, N, _>::step(&mut Rk4, m, s, Lanes::splat(DT))
+                {
+                    Ok(next) => *s = next,
+                    Err(e) => r2 = Err(e),
+                }
+            }
+        },
+    );
+    r1?;
+    r2?;
+    Ok(out)
+}
+
+/// Both mechanisms: pendulums of lengths 0.5 to 1.5 m from 0.2 to 0.7 rad; double pendulums
+/// with lower rods of 0.5 to 1.5 m from (0.2 to 0.7, -0.4) rad.
 pub fn measure(budget: Budget, rows: &mut Vec<Row>, ratios: &mut Vec<Ratio>) -> Result<(), Error> {
-    let pendulums: Vec<(SimplePendulum<f32>, State<f32, 1>)> = (0..K)
+    let x = |k: usize| k as f32 / K as f32;
+    let pendulums = (0..K)
         .map(|k| {
-            let x = k as f32 / K as f32;
-            Ok((
-                SimplePendulum::new(1.0, 0.5 + x, 9.81, 0.0)?,
-                State::at_rest([0.2 + 0.5 * x]),
-            ))
+            let p = SimplePendulum::new(1.0, 0.5 + x(k), 9.81, 0.0)?;
+            Ok((p, State::at_rest([0.2 + 0.5 * x(k)])))
         })
-        .collect::<Result<_, Error>>()?;
-    measure_one("1024 pendulums", budget, pendulums, rows, ratios)?;
-    let doubles = instances(|x| {
-        Ok((
-            DoublePendulum::new(1.0, 1.0, 1.0, 0.5 + x, 9.81)?,
-            State::at_rest([0.2 + 0.5 * x, -0.4]),
-        ))
-    })?;
-    measure_one("1024 double pendulums", budget, doubles, rows, ratios)?;
+        .collect::<Result<Vec<_>, Error>>()?;
+    measure_one("pendulums", budget, &pendulums, rows, ratios)?;
+    let doubles = (0..K)
+        .map(|k| {
+            let p = DoublePendulum::new(1.0, 1.0, 1.0, 0.5 + x(k), 9.81)?;
+            Ok((p, State::at_rest([0.2 + 0.5 * x(k), -0.4])))
+        })
+        .collect::<Result<Vec<_>, Error>>()?;
+    measure_one("double_pendulums", budget, &doubles, rows, ratios)?;
     Ok(())
 }

@@ -8,13 +8,14 @@
 //! - A mixed scene ([`mixed`]): pendulums, double pendulums, cart-poles (some pushed), four-bar
 //!   linkages and balls bouncing to rest on a floor, at its start (all awake) and once
 //!   settled.
-//! - Lanes ([`lanes`]): 1,024 `f32` pendulums and double pendulums stepped by RK4 one by one,
-//!   in lanes of 8, and by a scene's bank (which uses the lanes).
+//! - Lanes ([`lanes`]): banks of 1,024 `f32` pendulums and of 1,024 double pendulums, all awake,
+//!   stepped by RK4 in lanes against the same banks one by one (and the same by hand, without a
+//!   bank).
 //! - The constant-mass skip of the automatic path ([`constant_mass`]): ns per acceleration of
 //!   a spring chain (N = 2, 5, 10) with the skip and without, and how far apart they are.
 //!
 //! Output under `target/lagrange-bench/`: `scene.csv`
-//! (`scene,instances,awake_fraction,integrator,scalar,ns_per_frame`) and `scene.md`.
+//! (`scene,layout,instances,awake_fraction,integrator,scalar,ns_per_frame`) and `scene.md`.
 //! `--quick` for a smoke run.
 
 mod constant_mass;
@@ -33,6 +34,11 @@ use std::process::ExitCode;
 pub struct Row {
     /// Which scene (and which loop, for the plain loops).
     pub scene: String,
+    /// How its instances are stepped: `"lanes"` (side by side, a bank [`InLanes`]) or
+    /// `"one_by_one"`.
+    ///
+    /// [`InLanes`]: lagrange_integrators::scene::InLanes
+    pub layout: &'static str,
     /// Instances in it.
     pub instances: usize,
     /// Fraction of them awake while measured.

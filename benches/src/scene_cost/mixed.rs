@@ -144,6 +144,7 @@ pub fn measure(budget: Budget, rows: &mut Vec<Row>) -> Result<(), Error> {
         );
         rows.push(Row {
             scene: stage.into(),
+            layout: "one_by_one",
             instances: INSTANCES,
             awake_fraction: fraction,
             integrator: "mixed",

@@ -1,11 +1,12 @@
-//! 1,000 damped pendulums at dt = 1/120 s: a frame's cost against the fraction awake, and
-//! against the loops a scene replaces.
+//! 1,000 damped pendulums at dt = 1/120 s: a frame's cost against the fraction awake (a bank
+//! one by one, and for RK4 in `f32` also in lanes), and against the loops a scene replaces.
 
 use super::frames::{ns_per_frame, ratio};
 use super::{Ratio, Row};
 use lagrange_benches::precision;
 use lagrange_benches::timing::Budget;
 use lagrange_integrators::prelude::*;
+use lagrange_integrators::scene::{InLanes, Layout, OneByOne};
 use lagrange_integrators::FrameClock;
 use lagrange_systems::SimplePendulum;
 
@@ -33,20 +34,24 @@ fn rule<T: Real>() -> Result<Sleeps<T>, Error> {
     Sleeps::new(T::from_f64(1e-6), T::from_f64(1e-3), 60)
 }
 
-/// The pendulum bank with sleeping by `Z`.
-type Pendulums<T, I, Z> = Bank<T, 1, INSTANCES, SimplePendulum<T>, I, Z>;
+/// The pendulum bank with sleeping by `Z`, laid out by `Y`.
+type Pendulums<T, I, Z, Y = OneByOne> = Bank<T, 1, INSTANCES, SimplePendulum<T>, I, Z, Y>;
+
+/// A scene of one [`Pendulums`] bank.
+type PendulumScene<T, I, Z, Y> = Scene<T, Pendulums<T, I, Z, Y>>;
 
 /// A scene of [`INSTANCES`] pendulums, `awake` of them swinging from 1 rad and the rest
 /// asleep at the bottom, the two kinds added interleaved.
-fn scene<T, I, Z>(
+fn scene<T, I, Z, Y>(
     integrator: I,
     sleep: Z,
     awake: usize,
-) -> Result<Scene<T, Pendulums<T, I, Z>>, Error>
+) -> Result<PendulumScene<T, I, Z, Y>, Error>
 where
     T: Real,
     I: Integrator<T, 1, SimplePendulum<T>> + Clone,
     Z: lagrange_integrators::scene::Sleep<T>,
+    Y: Layout<T, 1, INSTANCES, SimplePendulum<T>>,
 {
     let mut bank = Bank::new(integrator, sleep)?;
     let p = pendulum()?;
@@ -64,11 +69,12 @@ where
 }
 
 /// Steps the scene's frames until the resting ones are asleep (a second of frames).
-fn settle<T, I, Z>(scene: &mut Scene<T, Pendulums<T, I, Z>>) -> Result<(), Error>
+fn settle<T, I, Z, Y>(scene: &mut PendulumScene<T, I, Z, Y>) -> Result<(), Error>
 where
     T: Real,
     I: Integrator<T, 1, SimplePendulum<T>> + Clone,
     Z: lagrange_integrators::scene::Sleep<T>,
+    Y: Layout<T, 1, INSTANCES, SimplePendulum<T>>,
 {
     for _ in 0..120 {
         scene.advance(T::from_f64(DT))?;
@@ -140,17 +146,48 @@ impl<T: Real, I: Integrator<T, 1, SimplePendulum<T>> + Clone> Clocks<T, I> {
 }
 
 /// Every row and ratio of the pendulum scene, for Stormer-Verlet and RK4 in `f32`, and
-/// Stormer-Verlet in `f64`.
+/// Stormer-Verlet in `f64`, one by one; and the fractions awake for RK4 in `f32` in lanes.
 pub fn measure(budget: Budget, rows: &mut Vec<Row>, ratios: &mut Vec<Ratio>) -> Result<(), Error> {
     one::<f32, _>(StormerVerlet::default(), budget, rows, ratios)?;
     one::<f32, _>(Rk4, budget, rows, ratios)?;
     one::<f64, _>(StormerVerlet::default(), budget, rows, ratios)?;
+    by_fraction::<f32, _, InLanes>(Rk4, "lanes", budget, rows, ratios)?;
     Ok(())
 }
 
-/// The rows and ratios of one integrator in one precision.
-fn one<T, I>(
+/// A row of the pendulum scene, printed.
+fn row<T: Real, I: Method>(
+    scene: &str,
+    layout: &'static str,
+    awake_fraction: f64,
+    ns_per_frame: f64,
+) -> Row {
+    println!(
+        "{:<44} {:<10} {:<16} {}  {:>5.1}% awake  {:>10.0} ns/frame",
+        scene,
+        layout,
+        I::NAME,
+        precision::<T>(),
+        awake_fraction * 100.0,
+        ns_per_frame
+    );
+    Row {
+        scene: scene.into(),
+        layout,
+        instances: INSTANCES,
+        awake_fraction,
+        integrator: I::NAME,
+        scalar: precision::<T>(),
+        ns_per_frame,
+    }
+}
+
+/// The rows of a bank laid out by `Y` (named `layout`) with each fraction awake, and the ratio
+/// of all awake to 10% awake, timed interleaved (a ratio of two medians taken apart moved by
+/// 15% between runs with the load of the machine).
+fn by_fraction<T, I, Y>(
     integrator: I,
+    layout: &'static str,
     budget: Budget,
     rows: &mut Vec<Row>,
     ratios: &mut Vec<Ratio>,
@@ -158,31 +195,13 @@ fn one<T, I>(
 where
     T: Real,
     I: Integrator<T, 1, SimplePendulum<T>> + Clone,
+    Y: Layout<T, 1, INSTANCES, SimplePendulum<T>>,
 {
     let dt = T::from_f64(DT);
-    let row = |scene: &str, awake_fraction: f64, ns_per_frame: f64| {
-        println!(
-            "{:<44} {:<16} {}  {:>5.1}% awake  {:>10.0} ns/frame",
-            scene,
-            I::NAME,
-            precision::<T>(),
-            awake_fraction * 100.0,
-            ns_per_frame
-        );
-        Row {
-            scene: scene.into(),
-            instances: INSTANCES,
-            awake_fraction,
-            integrator: I::NAME,
-            scalar: precision::<T>(),
-            ns_per_frame,
-        }
-    };
-
-    let mut by_fraction = Vec::new();
+    let (mut all, mut tenth) = (None, None);
     for fraction in FRACTIONS {
         let awake = ((INSTANCES as f64) * fraction).round() as usize;
-        let mut s = scene(integrator.clone(), rule::<T>()?, awake)?;
+        let mut s = scene::<T, I, _, Y>(integrator.clone(), rule::<T>()?, awake)?;
         settle(&mut s)?;
         let mut failure = None;
         let ns = ns_per_frame(budget, || {
@@ -197,25 +216,63 @@ where
             println!("  (expected {awake} awake, found {})", s.banks().awake());
         }
         let measured = s.banks().awake() as f64 / INSTANCES as f64;
-        rows.push(row("pendulums", measured, ns));
-        by_fraction.push((fraction, ns));
+        rows.push(row::<T, I>("pendulums", layout, measured, ns));
+        if fraction == 1.0 {
+            all = Some(s);
+        } else if fraction == 0.1 {
+            tenth = Some(s);
+        }
     }
-    if let (Some(all), Some(tenth)) = (
-        by_fraction.iter().find(|(f, _)| *f == 1.0),
-        by_fraction.iter().find(|(f, _)| *f == 0.1),
-    ) {
-        let r = all.1 / tenth.1;
-        ratios.push(Ratio {
-            what: format!("{} {}: all awake / 10% awake", I::NAME, precision::<T>()),
-            ratio: r,
-            goal: ">= 8",
-            met: r >= SLEEP_GOAL,
-        });
-    }
+    let (Some(mut all), Some(mut tenth)) = (all, tenth) else {
+        return Ok(());
+    };
+    let (mut r1, mut r2) = (Ok(()), Ok(()));
+    let (r, _, _) = ratio(
+        budget,
+        || {
+            if let Err(e) = all.advance(dt) {
+                r1 = Err(e);
+            }
+        },
+        || {
+            if let Err(e) = tenth.advance(dt) {
+                r2 = Err(e);
+            }
+        },
+    );
+    r1?;
+    r2?;
+    ratios.push(Ratio {
+        what: format!(
+            "{} {}, {layout}: all awake / 10% awake",
+            I::NAME,
+            precision::<T>()
+        ),
+        ratio: r,
+        goal: ">= 8",
+        met: r >= SLEEP_GOAL,
+    });
+    Ok(())
+}
+
+/// The rows and ratios of one integrator in one precision, one by one.
+fn one<T, I>(
+    integrator: I,
+    budget: Budget,
+    rows: &mut Vec<Row>,
+    ratios: &mut Vec<Ratio>,
+) -> Result<(), Error>
+where
+    T: Real,
+    I: Integrator<T, 1, SimplePendulum<T>> + Clone,
+{
+    by_fraction::<T, I, OneByOne>(integrator.clone(), "one_by_one", budget, rows, ratios)?;
 
     // All awake, against the loops a scene replaces.
-    let mut never = scene(integrator.clone(), NeverSleeps, INSTANCES)?;
-    let mut sleeps = scene(integrator.clone(), rule::<T>()?, INSTANCES)?;
+    let dt = T::from_f64(DT);
+    let row = |scene: &str, fraction: f64, ns: f64| row::<T, I>(scene, "one_by_one", fraction, ns);
+    let mut never = scene::<T, I, _, OneByOne>(integrator.clone(), NeverSleeps, INSTANCES)?;
+    let mut sleeps = scene::<T, I, _, OneByOne>(integrator.clone(), rule::<T>()?, INSTANCES)?;
     let mut hand = HandLoop::new(&integrator)?;
     let mut clocks = Clocks::new(&integrator)?;
     let mut failures = [None, None, None, None];

@@ -6,12 +6,19 @@ use std::fmt::Write;
 
 /// Every row, in the issue's columns.
 pub fn csv(rows: &[Row]) -> String {
-    let mut out = String::from("scene,instances,awake_fraction,integrator,scalar,ns_per_frame\n");
+    let mut out =
+        String::from("scene,layout,instances,awake_fraction,integrator,scalar,ns_per_frame\n");
     for r in rows {
         let _ = writeln!(
             out,
-            "{},{},{:.4},{},{},{:.1}",
-            r.scene, r.instances, r.awake_fraction, r.integrator, r.scalar, r.ns_per_frame
+            "{},{},{},{:.4},{},{},{:.1}",
+            r.scene,
+            r.layout,
+            r.instances,
+            r.awake_fraction,
+            r.integrator,
+            r.scalar,
+            r.ns_per_frame
         );
     }
     out
@@ -27,15 +34,16 @@ pub fn markdown(quick: bool, rows: &[Row], ratios: &[Ratio], skip: &[Skip]) -> S
     out.push_str(
         "Median wall time per frame (one fixed step of 1/120 s per frame), on a shared \
          machine: compare within a run, as ratios.\n\n\
-         | scene | instances | awake | integrator | scalar | ns per frame | ns per awake instance |\n\
-         |---|---:|---:|---|---|---:|---:|\n",
+         | scene | layout | instances | awake | integrator | scalar | ns per frame | ns per awake instance |\n\
+         |---|---|---:|---:|---|---|---:|---:|\n",
     );
     for r in rows {
         let awake = (r.awake_fraction * r.instances as f64).round().max(1.0);
         let _ = writeln!(
             out,
-            "| {} | {} | {:.1}% | {} | {} | {:.0} | {:.1} |",
+            "| {} | {} | {} | {:.1}% | {} | {} | {:.0} | {:.1} |",
             r.scene,
+            r.layout,
             r.instances,
             r.awake_fraction * 100.0,
             r.integrator,

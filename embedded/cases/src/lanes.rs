@@ -1,13 +1,13 @@
 //! The lane cases: 16 `f32` pendulums of different lengths stepped by RK4 one by one, the
-//! same in lanes of 4 (gathered once), and the same in a scene's bank (which gathers them
-//! every step where it steps lanes): the same bits, and what each costs per instance and step
-//! on the M4F, which has no vector unit.
+//! same in lanes of 4 (gathered once), and the same in a scene's bank laid out in lanes
+//! (`InLanes`, which steps one by one where there is no vector unit, as here): the same bits,
+//! and what each costs per instance and step on the M4F.
 
 use core::hint::black_box;
 
 use lagrange_core::nalgebra::SVector;
-use lagrange_core::{Error, Lanes, Mechanism, State};
-use lagrange_integrators::scene::{Bank, NeverSleeps, Scene};
+use lagrange_core::{Error, Gather, Lanes, State};
+use lagrange_integrators::scene::{Bank, InLanes, NeverSleeps, Scene};
 use lagrange_integrators::{Integrator, Rk4};
 use lagrange_systems::SimplePendulum;
 
@@ -85,7 +85,7 @@ pub(crate) fn alone_untimed(steps: u32) -> Result<Outcome, Error> {
 /// # Errors
 /// A step's error (none for these values), or a frame that did not take one step.
 pub fn pendulums_in_a_bank(steps: u32) -> Result<Outcome, Error> {
-    let mut bank: Bank<f32, 1, LANE_INSTANCES, SimplePendulum<f32>, Rk4, NeverSleeps> =
+    let mut bank: Bank<f32, 1, LANE_INSTANCES, SimplePendulum<f32>, Rk4, NeverSleeps, InLanes> =
         Bank::new(Rk4, NeverSleeps)?;
     let mut ids = [None; LANE_INSTANCES];
     for (id, (p, s)) in ids.iter_mut().zip(pendulums()?) {
@@ -106,7 +106,7 @@ pub fn pendulums_in_a_bank(steps: u32) -> Result<Outcome, Error> {
     for (state, id) in out.iter_mut().zip(ids.into_iter().flatten()) {
         *state = State {
             t: 0.0,
-            ..*bank.state(id)?
+            ..bank.state(id)?
         };
     }
     Ok(digest(out.into_iter()))
@@ -115,17 +115,14 @@ pub fn pendulums_in_a_bank(steps: u32) -> Result<Outcome, Error> {
 /// The pendulums stepped `steps` times in lanes of 4 (their parameters gathered once).
 ///
 /// # Errors
-/// A step's error (none for these values), or a mechanism that gathers no lanes.
+/// A step's error (none for these values).
 pub fn pendulums_in_lanes(steps: u32) -> Result<Outcome, Error> {
     let all = pendulums()?;
     let dt = black_box(DT);
     let mut out = [State::at_rest([0.0f32]); LANE_INSTANCES];
     for (group, states) in all.chunks_exact(WIDTH).zip(out.chunks_exact_mut(WIDTH)) {
         let instances: [&SimplePendulum<f32>; WIDTH] = core::array::from_fn(|i| &group[i].0);
-        let lanes = SimplePendulum::gather(instances).ok_or(Error::InvalidParameter {
-            name: "mechanism",
-            reason: "gathers no lanes",
-        })?;
+        let lanes = SimplePendulum::gather(instances);
         let starts: [&State<f32, 1>; WIDTH] = core::array::from_fn(|i| &group[i].1);
         let mut s = State {
             t: Lanes::gather(&starts, |s| s.t),

@@ -6,7 +6,7 @@ use core::hint::black_box;
 
 use lagrange_core::nalgebra::SVector;
 use lagrange_core::{Error, Real, State};
-use lagrange_integrators::scene::{Bank, Scene, Sleeps, Status};
+use lagrange_integrators::scene::{Bank, InLanes, Layout, Scene, Sleeps, Status};
 use lagrange_integrators::{Rk4, StormerVerlet};
 use lagrange_systems::{CartPole, SimplePendulum};
 
@@ -29,10 +29,13 @@ const FRAME_TIMES: [f64; 8] = [
 ];
 
 /// Swinging props: 1 m pendulums, damped nearly critically (6 N m s against the critical
-/// 6.26): at rest within about 4 s.
-type Props<T> = Bank<T, 1, 8, SimplePendulum<T>, StormerVerlet<T, 1>, Sleeps<T>>;
+/// 6.26): at rest within about 4 s. Laid out in lanes, as the cart-poles: where there is a
+/// vector unit (the host, the page's `simd128` build) the banks step in lanes, on the
+/// firmware's cores one by one, and the outcome is the same bits everywhere (Stormer-Verlet
+/// does not step lanes: its groups go one by one after trying).
+type Props<T> = Bank<T, 1, 8, SimplePendulum<T>, StormerVerlet<T, 1>, Sleeps<T>, InLanes>;
 /// Cart-poles hanging, pushed by their inputs now and then.
-type Carts<T> = Bank<T, 2, 4, CartPole<T>, Rk4, Sleeps<T>>;
+type Carts<T> = Bank<T, 2, 4, CartPole<T>, Rk4, Sleeps<T>, InLanes>;
 
 /// The sleep rule: 1e-6 J, 1e-3 (m or rad)/s^2, 60 steps.
 fn rule<T: Real>() -> Result<Sleeps<T>, Error> {
@@ -46,13 +49,14 @@ fn fnv(hash: u64, word: u64) -> u64 {
 
 /// Folds every instance of `bank` (by id index, so the order the bank keeps does not enter)
 /// into `hash`: its state's bits and its status.
-fn digest<T: Precision, const N: usize, const K: usize, M, I>(
+fn digest<T: Precision, const N: usize, const K: usize, M, I, Y>(
     mut hash: u64,
-    bank: &Bank<T, N, K, M, I, Sleeps<T>>,
+    bank: &Bank<T, N, K, M, I, Sleeps<T>, Y>,
 ) -> u64
 where
     M: lagrange_core::Mechanism<T, N>,
     I: lagrange_integrators::Integrator<T, N, M> + Clone,
+    Y: Layout<T, N, K, M>,
 {
     for index in 0..K {
         let Some((id, s)) = bank.iter().find(|(id, _)| id.index() == index) else {

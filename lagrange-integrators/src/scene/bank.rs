@@ -1,11 +1,14 @@
 //! [`Bank`]: up to `K` instances of one mechanism type, stepped by one kind of integrator,
 //! with the awake instances packed in front.
 
-use super::{NeverSleeps, Sleep, Sleeps};
+use super::awake::Awake;
+use super::slot::Slot;
+use super::states::States;
+use super::{Layout, NeverSleeps, OneByOne, Sleep, Sleeps};
 use crate::Integrator;
 use heapless::Vec;
 use lagrange_core::nalgebra::SVector;
-use lagrange_core::{all_finite, divergences, Controlled, Error, Lanes, Mechanism, Real, State};
+use lagrange_core::{all_finite, Controlled, Error, Mechanism, Real, State};
 
 /// A handle to an instance of a [`Bank`], given by [`Bank::add`]. It stays valid until the
 /// instance is removed; after that it names nothing ([`Error::NoSuchInstance`]), even when
@@ -79,50 +82,6 @@ impl<T: Real> Energies<T> {
     }
 }
 
-/// One instance: its mechanism (parameters and input), its integrator (and what that keeps
-/// between steps), its last two states.
-#[derive(Debug, Clone)]
-struct Slot<T: Real, const N: usize, M, I> {
-    mechanism: M,
-    integrator: I,
-    current: State<T, N>,
-    previous: State<T, N>,
-    /// Its [`Id::index`].
-    id: u32,
-    /// 0 while not found at rest; else 1 + the steps spanned by its consecutive checks at
-    /// rest.
-    quiet: u32,
-    /// Why its last step failed, while it is set aside.
-    failure: Option<Error>,
-}
-
-impl<T: Real, const N: usize, M: Mechanism<T, N>, I: Integrator<T, N, M>> Slot<T, N, M, I> {
-    /// One step of `dt`, landing at the scene's time `t`; false when it failed (the state is
-    /// then untouched and the error kept).
-    #[inline(always)]
-    fn advance(&mut self, dt: T, t: T) -> bool {
-        match self.integrator.run_step(&self.mechanism, &self.current, dt) {
-            Ok(mut next) => {
-                next.t = t;
-                self.previous = self.current;
-                self.current = next;
-                true
-            }
-            Err(e) => {
-                self.fail(e);
-                false
-            }
-        }
-    }
-
-    /// Keeps the error of a failed step (out of line: rare, and the error is large).
-    #[cold]
-    #[inline(never)]
-    fn fail(&mut self, e: Error) {
-        self.failure = Some(e);
-    }
-}
-
 /// What a bank knows of one id index: where its instance is and which generation of the
 /// index is live. All zeros for an index never given out, so that a bank's table starts
 /// cleared.
@@ -134,113 +93,24 @@ struct Entry {
     generation: u32,
 }
 
-/// Instances stepped side by side where the mechanism and the method allow it
-/// ([`Mechanism::gather`], [`Integrator::step_lanes`]): 8 on x86_64 and aarch64 (two or one
-/// vector registers of `f32`); none elsewhere, where there is no vector unit to use. On the
-/// Cortex-M4F lanes of 4 gathered once cost 0.86 times the instructions of one by one, but a
-/// bank gathers and scatters its slots every step, and a bank in lanes of 4 took 1.09 times
-/// (16 `f32` pendulums by RK4 under `cargo xtask qemu`, with this constant set to 4 for the
-/// measurement), in a third more code.
-#[cfg(any(target_arch = "x86_64", target_arch = "aarch64"))]
-const LANES: usize = 8;
-/// See above.
-#[cfg(not(any(target_arch = "x86_64", target_arch = "aarch64")))]
-const LANES: usize = 1;
-
-/// Steps every slot by `dt`, landing at `t`: [`LANES`] at a time where the mechanism gathers
-/// and the method steps lanes, the others (and any chunk whose lanes diverged or failed) one
-/// by one, which gives the same bits. Returns how many failed.
-#[inline(always)]
-fn step_all<T, const N: usize, M, I>(slots: &mut [Slot<T, N, M, I>], dt: T, t: T) -> u32
-where
-    T: Real,
-    M: Mechanism<T, N>,
-    I: Integrator<T, N, M>,
-{
-    let mut failed = 0;
-    let mut rest = slots;
-    if LANES > 1 {
-        let mut chunks = rest.chunks_exact_mut(LANES);
-        for chunk in &mut chunks {
-            if step_lanes::<T, N, M, I, LANES>(chunk, dt, t).is_none() {
-                failed += step_each(chunk, dt, t);
-            }
-        }
-        rest = chunks.into_remainder();
-    }
-    failed + step_each(rest, dt, t)
-}
-
-/// Steps every slot alone; how many failed.
-#[inline(always)]
-fn step_each<T, const N: usize, M, I>(slots: &mut [Slot<T, N, M, I>], dt: T, t: T) -> u32
-where
-    T: Real,
-    M: Mechanism<T, N>,
-    I: Integrator<T, N, M>,
-{
-    let mut failed = 0;
-    for slot in slots {
-        if !slot.advance(dt, t) {
-            failed += 1;
-        }
-    }
-    failed
-}
-
-/// Steps `L` slots side by side in lanes; `None`, with nothing changed, where the mechanism
-/// does not gather, the method does not step lanes, a step fails or the lanes diverged.
-#[inline(always)]
-fn step_lanes<T, const N: usize, M, I, const L: usize>(
-    chunk: &mut [Slot<T, N, M, I>],
-    dt: T,
-    t: T,
-) -> Option<()>
-where
-    T: Real,
-    M: Mechanism<T, N>,
-    I: Integrator<T, N, M>,
-{
-    let slots: &mut [Slot<T, N, M, I>; L] = chunk.try_into().ok()?;
-    let before = divergences()?;
-    // The gathered mechanism borrows the slots: stepped in a block of its own.
-    let next = {
-        let lanes = M::gather::<L>(core::array::from_fn(|i| &slots[i].mechanism))?;
-        let states: [&State<T, N>; L] = core::array::from_fn(|i| &slots[i].current);
-        let state = State {
-            t: Lanes::gather(&states, |s| s.t),
-            q: SVector::from_fn(|j, _| Lanes::gather(&states, |s| s.q[j])),
-            qd: SVector::from_fn(|j, _| Lanes::gather(&states, |s| s.qd[j])),
-        };
-        slots[0].integrator.step_lanes(&lanes, &state, dt)?.ok()?
-    };
-    if divergences()? != before {
-        return None;
-    }
-    for (i, slot) in slots.iter_mut().enumerate() {
-        slot.previous = slot.current;
-        slot.current = State {
-            t,
-            q: next.q.map(|x| x.0[i]),
-            qd: next.qd.map(|x| x.0[i]),
-        };
-    }
-    Some(())
-}
-
 /// Up to `K` instances of the mechanism type `M`, each with its own parameters and input
 /// (its own value of `M`), its own state and its own copy of the integrator `I` (made from
 /// the bank's, so that what a method keeps between steps is per instance), stepped
 /// together by a [`Scene`](super::Scene). `Z` chooses sleeping: [`NeverSleeps`] (the
-/// default) or [`Sleeps`](super::Sleeps).
+/// default) or [`Sleeps`]. `Y` chooses the layout: [`OneByOne`] (the default, any mechanism)
+/// or [`InLanes`](super::InLanes) (a mechanism that gathers, stepped [`LANES`](super::LANES)
+/// instances at a time where the target has a vector unit, each with the bits it has alone).
 ///
 /// ```text
 /// slots:  [ awake ........ | asleep or failed ...... | free ]
 ///           stepped every step, in slot order         nothing touches them
 /// ```
 ///
-/// The awake instances are packed at the front of one array, so that a step is one tight
-/// loop over them and an asleep instance costs nothing but its memory. Falling asleep and
+/// The awake instances are packed at the front, so that a step is one tight loop over them
+/// and an asleep instance costs nothing but its memory. The states are kept apart from the
+/// rest (in a bank in lanes as structure of arrays: an array of times, one per coordinate, one
+/// per velocity, so that a group of instances is one window of each); they are therefore read
+/// and written by value ([`Bank::state`], [`Bank::set_state`]). Falling asleep and
 /// waking swap an instance across the boundary (its [`Id`] follows it); the order of the
 /// instances within the array therefore depends on their history, but no instance's bits
 /// depend on it: instances do not interact, and each has its own integrator.
@@ -282,10 +152,25 @@ where
 /// # Ok::<(), lagrange_core::Error>(())
 /// ```
 #[derive(Debug, Clone)]
-pub struct Bank<T: Real, const N: usize, const K: usize, M, I, Z = NeverSleeps> {
+pub struct Bank<
+    T: Real,
+    const N: usize,
+    const K: usize,
+    M,
+    I,
+    Z = NeverSleeps,
+    Y: Layout<T, N, K, M> = OneByOne,
+> {
     integrator: I,
     sleep: Z,
-    slots: Vec<Slot<T, N, M, I>, K>,
+    /// By place.
+    slots: Vec<Slot<M, I>, K>,
+    /// Each place's state after the last step.
+    current: Y::States,
+    /// Each place's state before the last step (what [`Bank::interpolated`] draws from).
+    previous: Y::States,
+    /// What the layout keeps of the mechanisms.
+    kept: Y::Kept,
     awake: usize,
     /// By id index.
     entries: [Entry; K],
@@ -299,12 +184,13 @@ pub struct Bank<T: Real, const N: usize, const K: usize, M, I, Z = NeverSleeps> 
     key: u32,
 }
 
-impl<T, const N: usize, const K: usize, M, I, Z> Bank<T, N, K, M, I, Z>
+impl<T, const N: usize, const K: usize, M, I, Z, Y> Bank<T, N, K, M, I, Z, Y>
 where
     T: Real,
     M: Mechanism<T, N>,
     I: Integrator<T, N, M> + Clone,
     Z: Sleep<T>,
+    Y: Layout<T, N, K, M>,
 {
     /// An empty bank of capacity `K` (at least 1) whose instances are stepped by copies of
     /// `integrator`, and fall asleep by `sleep`, at time 0.
@@ -323,6 +209,9 @@ where
             integrator,
             sleep,
             slots: Vec::new(),
+            current: States::new(),
+            previous: States::new(),
+            kept: Y::kept(),
             awake: 0,
             entries: [Entry::default(); K],
             free: Vec::new(),
@@ -349,15 +238,9 @@ where
         };
         let place = self.slots.len();
         let stored = u32::try_from(place + 1).map_err(|_| full)?;
-        let current = State {
-            t: self.time,
-            ..state
-        };
         let slot = Slot {
             mechanism,
             integrator: self.integrator.clone(),
-            current,
-            previous: current,
             id: index,
             quiet: 0,
             failure: None,
@@ -366,11 +249,18 @@ where
         if self.slots.push(slot).is_err() {
             return Err(full);
         }
+        let state = State {
+            t: self.time,
+            ..state
+        };
+        self.current.set(place, &state);
+        self.previous.set(place, &state);
         entry.place = stored;
         let generation = entry.generation;
         if self.free.pop().is_none() {
             self.fresh += 1;
         }
+        self.keep(place);
         self.rouse(place);
         Ok(Id {
             index,
@@ -391,7 +281,9 @@ where
             place = self.awake;
         }
         // The last slot takes the place of the one removed.
-        self.swap(place, self.slots.len().saturating_sub(1));
+        let last = self.slots.len().saturating_sub(1);
+        self.swap(place, last);
+        let state = self.current.get(last);
         let slot = self.slots.pop().ok_or(Error::NoSuchInstance)?;
         if let Some(entry) = self.entries.get_mut(id.index as usize) {
             *entry = Entry {
@@ -401,15 +293,16 @@ where
         }
         // The index was taken from `free` or `fresh`, so there is room to give it back.
         let _ = self.free.push(id.index);
-        Ok((slot.mechanism, slot.current))
+        Ok((slot.mechanism, state))
     }
 
-    /// The instance's state after the last step.
+    /// The instance's state after the last step (a copy: the bank keeps its states as
+    /// structure of arrays).
     ///
     /// # Errors
     /// [`Error::NoSuchInstance`].
-    pub fn state(&self, id: Id) -> Result<&State<T, N>, Error> {
-        Ok(&self.slot(id)?.current)
+    pub fn state(&self, id: Id) -> Result<State<T, N>, Error> {
+        Ok(self.current.get(self.place(id)?))
     }
 
     /// The state to draw: linear interpolation between the instance's last two states by
@@ -420,14 +313,14 @@ where
     /// # Errors
     /// [`Error::NoSuchInstance`]; [`Error::InvalidParameter`] `alpha` outside `[0, 1]`.
     pub fn interpolated(&self, id: Id, alpha: T) -> Result<State<T, N>, Error> {
-        let slot = self.slot(id)?;
+        let place = self.place(id)?;
         if !(alpha >= T::zero() && alpha <= T::one()) {
             return Err(Error::InvalidParameter {
                 name: "alpha",
                 reason: "must be in [0, 1]",
             });
         }
-        let (p, c) = (&slot.previous, &slot.current);
+        let (p, c) = (self.previous.get(place), self.current.get(place));
         Ok(State {
             t: c.t + (alpha - T::one()) * (c.t - p.t),
             q: p.q + (c.q - p.q) * alpha,
@@ -474,10 +367,10 @@ where
     /// [`Error::NoSuchInstance`]; [`Error::NonFiniteState`] when either energy, or their sum
     /// ([`Energies::total`]), is not finite.
     pub fn energies(&self, id: Id) -> Result<Energies<T>, Error> {
-        let slot = self.slot(id)?;
+        let (mechanism, state) = (&self.slot(id)?.mechanism, self.state(id)?);
         let energies = Energies {
-            kinetic: slot.mechanism.kinetic_energy(&slot.current),
-            potential: slot.mechanism.potential_energy(&slot.current),
+            kinetic: mechanism.kinetic_energy(&state),
+            potential: mechanism.potential_energy(&state),
         };
         if energies.total().is_finite() {
             Ok(energies)
@@ -495,10 +388,12 @@ where
     pub fn set_state(&mut self, id: Id, state: State<T, N>) -> Result<(), Error> {
         let place = self.place(id)?;
         state.check_finite()?;
-        let time = self.time;
-        let slot = self.at_mut(place)?;
-        slot.current = State { t: time, ..state };
-        slot.previous = slot.current;
+        let state = State {
+            t: self.time,
+            ..state
+        };
+        self.current.set(place, &state);
+        self.previous.set(place, &state);
         self.restart(place)
     }
 
@@ -518,12 +413,18 @@ where
                 reason: "must be finite",
             });
         }
-        let slot = self.at_mut(place)?;
-        let qd = slot.current.qd + slot.mechanism.velocity_jump(&slot.current, impulse)?;
+        let mut state = self.current.get(place);
+        let mechanism = &self
+            .slots
+            .get(place)
+            .ok_or(Error::NoSuchInstance)?
+            .mechanism;
+        let qd = state.qd + mechanism.velocity_jump(&state, impulse)?;
         if !all_finite(qd.as_slice()) {
             return Err(Error::NonFiniteState);
         }
-        slot.current.qd = qd;
+        state.qd = qd;
+        self.current.set(place, &state);
         self.restart(place)
     }
 
@@ -542,6 +443,7 @@ where
             return Ok(());
         }
         mechanism.set_input(input)?;
+        self.keep(place);
         self.restart(place)
     }
 
@@ -579,6 +481,7 @@ where
         let result = change(&mut changed)?;
         if changed != *mechanism {
             *mechanism = changed;
+            self.keep(place);
             self.restart(place)?;
         }
         Ok(result)
@@ -606,9 +509,10 @@ where
         self.wake(id)
     }
 
-    /// The instances in the bank, awake ones first, with their states.
-    pub fn iter(&self) -> impl Iterator<Item = (Id, &State<T, N>)> + '_ {
-        self.slots.iter().map(|slot| {
+    /// The instances in the bank, awake ones first, with their states (copies, as
+    /// [`Bank::state`]).
+    pub fn iter(&self) -> impl Iterator<Item = (Id, State<T, N>)> + '_ {
+        self.slots.iter().enumerate().map(|(place, slot)| {
             let index = slot.id;
             let generation = self.entries.get(index as usize).map_or(0, |e| e.generation);
             let id = Id {
@@ -616,7 +520,7 @@ where
                 generation,
                 bank: self.key,
             };
-            (id, &slot.current)
+            (id, self.current.get(place))
         })
     }
 
@@ -656,8 +560,13 @@ where
     /// and are set aside: [`Status::Failed`]).
     pub(crate) fn step(&mut self, dt: T, t: T) -> u32 {
         self.time = t;
-        let awake = self.slots.get_mut(..self.awake).unwrap_or_default();
-        let failed = step_all(awake, dt, t);
+        let awake = Awake {
+            slots: self.slots.get_mut(..self.awake).unwrap_or_default(),
+            current: &mut self.current,
+            previous: &mut self.previous,
+            states: core::marker::PhantomData,
+        };
+        let failed = Y::step(&self.kept, awake, dt, t);
         if failed > 0 {
             self.set_aside_failures();
         }
@@ -674,9 +583,9 @@ where
     /// Sets the bank's time, and every instance's, to `t` (a scene's start).
     pub(crate) fn set_time(&mut self, t: T) {
         self.time = t;
-        for slot in &mut self.slots {
-            slot.current.t = t;
-            slot.previous.t = t;
+        for place in 0..self.slots.len() {
+            self.current.set_time(place, t);
+            self.previous.set_time(place, t);
         }
     }
 
@@ -691,8 +600,8 @@ where
                 continue;
             };
             if slot.failure.is_some() {
-                slot.previous = slot.current;
                 slot.quiet = 0;
+                self.previous.set(place, &self.current.get(place));
                 self.awake -= 1;
                 self.swap(place, self.awake);
             }
@@ -714,7 +623,8 @@ where
             let Some(slot) = self.slots.get_mut(place) else {
                 continue;
             };
-            if !rule.rests(&slot.mechanism, &slot.integrator, &slot.current) {
+            let state = self.current.get(place);
+            if !rule.rests(&slot.mechanism, &slot.integrator, &state) {
                 slot.quiet = 0;
                 continue;
             }
@@ -724,9 +634,13 @@ where
                 slot.quiet.saturating_add(interval)
             };
             if slot.quiet > steps {
-                slot.current.qd = SVector::zeros();
-                slot.previous = slot.current;
                 slot.quiet = 0;
+                let still = State {
+                    qd: SVector::zeros(),
+                    ..state
+                };
+                self.current.set(place, &still);
+                self.previous.set(place, &still);
                 self.awake -= 1;
                 self.swap(place, self.awake);
             }
@@ -740,9 +654,9 @@ where
         let slot = self.at_mut(place)?;
         slot.integrator = integrator;
         slot.quiet = 0;
-        slot.current.t = time;
-        slot.previous.t = time;
         slot.failure = None;
+        self.current.set_time(place, time);
+        self.previous.set_time(place, time);
         self.rouse(place);
         Ok(())
     }
@@ -771,7 +685,10 @@ where
             if let Some(entry) = self.entries.get_mut(slot.id as usize) {
                 entry.place = u32::try_from(place + 1).unwrap_or(0);
             }
+            Y::put(&mut self.kept, place, &slot.mechanism);
         }
+        self.current.swap(low, high);
+        self.previous.swap(low, high);
     }
 
     /// The place of the instance `id` names.
@@ -784,22 +701,30 @@ where
         }
     }
 
+    /// Writes the mechanism at `place` into what the layout keeps of it.
+    fn keep(&mut self, place: usize) {
+        if let Some(slot) = self.slots.get(place) {
+            Y::put(&mut self.kept, place, &slot.mechanism);
+        }
+    }
+
     /// The slot of the instance `id` names.
-    fn slot(&self, id: Id) -> Result<&Slot<T, N, M, I>, Error> {
+    fn slot(&self, id: Id) -> Result<&Slot<M, I>, Error> {
         self.slots.get(self.place(id)?).ok_or(Error::NoSuchInstance)
     }
 
     /// The slot at `place`.
-    fn at_mut(&mut self, place: usize) -> Result<&mut Slot<T, N, M, I>, Error> {
+    fn at_mut(&mut self, place: usize) -> Result<&mut Slot<M, I>, Error> {
         self.slots.get_mut(place).ok_or(Error::NoSuchInstance)
     }
 }
 
-impl<T, const N: usize, const K: usize, M, I> Bank<T, N, K, M, I, Sleeps<T>>
+impl<T, const N: usize, const K: usize, M, I, Y> Bank<T, N, K, M, I, Sleeps<T>, Y>
 where
     T: Real,
     M: Mechanism<T, N>,
     I: Integrator<T, N, M> + Clone,
+    Y: Layout<T, N, K, M>,
 {
     /// Adds an instance already at rest, asleep: at `q` with zero velocities (a prop placed
     /// in a level). It costs nothing until something wakes it.
@@ -815,7 +740,9 @@ where
     }
 }
 
-impl<T: Real, const N: usize, const K: usize, M, I, Z> Bank<T, N, K, M, I, Z> {
+impl<T: Real, const N: usize, const K: usize, M, I, Z, Y: Layout<T, N, K, M>>
+    Bank<T, N, K, M, I, Z, Y>
+{
     /// The bank's capacity, `K`.
     #[must_use]
     pub const fn capacity(&self) -> usize {

@@ -1,6 +1,6 @@
 //! [`Banks`]: what a [`Scene`](super::Scene) steps, a [`Bank`] or a tuple or array of them.
 
-use super::{Bank, Sleep};
+use super::{Bank, Layout, Sleep};
 use crate::Integrator;
 use lagrange_core::{Mechanism, Real};
 
@@ -16,12 +16,13 @@ pub trait Banks<T: Real> {
     fn set_time(&mut self, t: T);
 }
 
-impl<T, const N: usize, const K: usize, M, I, Z> Banks<T> for Bank<T, N, K, M, I, Z>
+impl<T, const N: usize, const K: usize, M, I, Z, Y> Banks<T> for Bank<T, N, K, M, I, Z, Y>
 where
     T: Real,
     M: Mechanism<T, N>,
     I: Integrator<T, N, M> + Clone,
     Z: Sleep<T>,
+    Y: Layout<T, N, K, M>,
 {
     #[inline]
     fn step(&mut self, dt: T, t: T) -> u32 {

@@ -509,7 +509,7 @@ where
                 let bank = scene.banks();
                 bank.iter()
                     .filter(|(id, _)| bank.status(*id) == Ok(Status::Awake))
-                    .filter_map(|(id, s)| Some((id, *s, bank.mechanism(id).ok()?.clone())))
+                    .filter_map(|(id, s)| Some((id, s, bank.mechanism(id).ok()?.clone())))
                     .collect()
             } else {
                 Vec::new()
@@ -693,7 +693,7 @@ where
                 }
                 _ => {
                     say!(ctx, "bank.state(id)?;");
-                    let r = scene.banks().state(id).copied();
+                    let r = scene.banks().state(id);
                     let v = verdict(&r, &[]);
                     if v.class().is_finding() {
                         return v;
@@ -757,8 +757,8 @@ where
             return Some(Verdict::Inconsistent(format!("{id:?} lost in a frame")));
         };
         let fine = match alone {
-            Ok(n) => status == Status::Awake && bits(now) == bits(&State { t: time, ..n }),
-            Err(e) => status == Status::Failed(e) && bits(now) == bits(s),
+            Ok(n) => status == Status::Awake && bits(&now) == bits(&State { t: time, ..n }),
+            Err(e) => status == Status::Failed(e) && bits(&now) == bits(s),
         };
         if !fine {
             return Some(Verdict::Inconsistent(format!(
