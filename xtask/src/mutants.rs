@@ -54,6 +54,8 @@
 //! cargo xtask mutants --list                the areas and how many mutants each holds
 //! cargo xtask mutants --iterate             skip the mutants caught by the last run
 //! cargo xtask mutants --report              tally the last run again (after editing the list)
+//! cargo xtask mutants --since REV           only the lines changed since REV, under
+//!                                           target/mutants/since (a change's own run)
 //! ```
 
 use std::collections::BTreeMap;
@@ -70,6 +72,9 @@ const CARGO_MUTANTS_VERSION: &str = "27.1.0";
 
 /// The committed list of surviving mutants that are equivalent to the original code.
 const EQUIVALENT_LIST: &str = "xtask/mutants-equivalent.txt";
+
+/// Where `--since` writes the change it mutates, under its own output directory.
+const SINCE_DIFF: &str = "since.diff";
 
 /// The kill rate each file of the numerical core must reach, over its non-equivalent viable
 /// mutants (a timed-out mutant counts as killed: the run detected it).
@@ -1059,6 +1064,8 @@ struct Options {
     iterate: bool,
     list: bool,
     report_only: bool,
+    /// Mutate only the lines changed since this git revision (`--since REV`).
+    since: Option<String>,
 }
 
 fn options(args: &[String]) -> Result<Options, String> {
@@ -1068,6 +1075,7 @@ fn options(args: &[String]) -> Result<Options, String> {
         iterate: false,
         list: false,
         report_only: false,
+        since: None,
     };
     let mut it = args.iter();
     while let Some(a) = it.next() {
@@ -1090,6 +1098,7 @@ fn options(args: &[String]) -> Result<Options, String> {
             "--iterate" => o.iterate = true,
             "--list" => o.list = true,
             "--report" => o.report_only = true,
+            "--since" => o.since = Some(it.next().ok_or("--since needs a git revision")?.clone()),
             other => return Err(format!("unknown option {other}")),
         }
     }
@@ -1101,7 +1110,26 @@ pub fn run(args: &[String]) -> Result<(), String> {
     let o = options(args)?;
     ensure_cargo_mutants()?;
     let root = cmd::project_root();
-    let out = root.join("target").join("mutants");
+    let mut out = root.join("target").join("mutants");
+    // A change's mutants are a run of their own: its outcomes must not replace the last full
+    // run's, which the report of the whole core reads.
+    if let Some(rev) = &o.since {
+        out = out.join("since");
+        std::fs::create_dir_all(&out).map_err(|e| format!("{}: {e}", out.display()))?;
+        let diff = Command::new("git")
+            .args(["diff", rev, "--", "*.rs"])
+            .current_dir(&root)
+            .output()
+            .map_err(|e| format!("git diff {rev}: {e}"))?;
+        if !diff.status.success() {
+            return Err(format!(
+                "git diff {rev}: {}",
+                String::from_utf8_lossy(&diff.stderr)
+            ));
+        }
+        std::fs::write(out.join(SINCE_DIFF), &diff.stdout)
+            .map_err(|e| format!("{SINCE_DIFF}: {e}"))?;
+    }
     if o.list {
         check_accounted(&root)?;
         for area in &o.areas {
@@ -1180,6 +1208,9 @@ fn mutants_command(area: &Area, out: &Path, o: &Options, timeout: Option<f64>) -
     }
     if let Some(re) = area.only {
         c.args(["--re", re]);
+    }
+    if o.since.is_some() {
+        c.arg("--in-diff").arg(out.join(SINCE_DIFF));
     }
     let Some(timeout) = timeout else {
         c.arg("--list");
