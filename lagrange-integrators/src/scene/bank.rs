@@ -388,12 +388,9 @@ where
     pub fn set_state(&mut self, id: Id, state: State<T, N>) -> Result<(), Error> {
         let place = self.place(id)?;
         state.check_finite()?;
-        let state = State {
-            t: self.time,
-            ..state
-        };
         self.current.set(place, &state);
         self.previous.set(place, &state);
+        // Its time becomes the bank's here.
         self.restart(place)
     }
 
