@@ -54,8 +54,8 @@ pub(crate) fn cos_lanesf<const L: usize>(x: [f32; L]) -> [f32; L] {
 
 #[cfg(test)]
 mod tests {
-    /// With `libm-trig`, the `f32` sines and cosines, alone and by lanes, are libm's bit for
-    /// bit, and so within an ulp of the `f64` ones rounded (libm's `sinf` computes in `f64`).
+    /// With `libm-trig`, the `f32` sines and cosines, alone and by lanes (both together and
+    /// each alone), are libm's bit for bit, and so within an ulp of the `f64` ones rounded (libm's `sinf` computes in `f64`).
     #[cfg(feature = "libm-trig")]
     #[test]
     fn libm_trig_f32_is_libm_bit_for_bit() {
@@ -73,9 +73,12 @@ mod tests {
             assert!(near(c, libm::cos(f64::from(x))), "cos({x:e}) = {c:e}");
         }
         let (s, c) = super::sin_cos_lanesf(xs);
+        let (sin, cos) = (super::sin_lanesf(xs), super::cos_lanesf(xs));
         for (i, x) in xs.into_iter().enumerate() {
             assert_eq!(s[i].to_bits(), libm::sinf(x).to_bits(), "lane sin({x:e})");
             assert_eq!(c[i].to_bits(), libm::cosf(x).to_bits(), "lane cos({x:e})");
+            assert_eq!(sin[i].to_bits(), s[i].to_bits(), "sin_lanes({x:e})");
+            assert_eq!(cos[i].to_bits(), c[i].to_bits(), "cos_lanes({x:e})");
         }
     }
 

@@ -23,7 +23,9 @@ const STEPS: usize = 400;
 
 /// `L` instances built by `make`, started from `start`, stepped by `integrator` in lanes
 /// and alone for [`STEPS`] steps of `dt`: every lane equal to its instance alone, bit for bit,
-/// and no divergence.
+/// and no divergence. The lanes are gathered twice, from the instances at once and by putting
+/// each into a group gathered from the first alone (as a bank does as instances join), and
+/// both step alike.
 fn lanes_equal_alone<T, const N: usize, M, I>(
     integrator: I,
     dt: f64,
@@ -39,6 +41,10 @@ where
     let built: Vec<(M, State<T, N>)> = (0..L).map(|_| make(&mut rng)).collect::<Result<_, _>>()?;
     let instances: [&M; L] = core::array::from_fn(|i| &built[i].0);
     let lanes = M::gather(instances);
+    let mut put = M::gather([instances[0]; L]);
+    for (lane, m) in instances.iter().enumerate() {
+        m.put(&mut put, lane);
+    }
     let dt = T::from_f64(dt);
     let mut alone: Vec<State<T, N>> = built.iter().map(|(_, s)| *s).collect();
     let states: [&State<T, N>; L] = core::array::from_fn(|i| &built[i].1);
@@ -49,12 +55,24 @@ where
     };
     let before = divergences();
     for step in 0..STEPS {
+        let by_put = integrator
+            .step_lanes(&put, &side, dt)
+            .ok_or(Error::InvalidParameter {
+                name: "integrator",
+                reason: "steps no lanes",
+            })??;
         side = integrator
             .step_lanes(&lanes, &side, dt)
             .ok_or(Error::InvalidParameter {
                 name: "integrator",
                 reason: "steps no lanes",
             })??;
+        let bits = |s: &State<Lanes<T, L>, N>| {
+            (0..L)
+                .map(|i| (s.q.map(|x| x.0[i]), s.qd.map(|x| x.0[i])))
+                .collect::<Vec<_>>()
+        };
+        assert!(bits(&by_put) == bits(&side), "{} step {step}: put", I::NAME);
         for (i, (s, (m, _))) in alone.iter_mut().zip(&built).enumerate() {
             *s = integrator.clone().run_step(m, s, dt)?;
             let lane = (side.t.0[i], side.q.map(|x| x.0[i]), side.qd.map(|x| x.0[i]));

@@ -785,7 +785,8 @@ const AREAS: [Area; 29] = [
             "lagrange-systems/src/links.rs",
         ],
         only: None,
-        tests: &["--test", "rigid_body", "--test", "links"],
+        // `lanes`: the body gathered into lanes (its `Gather`).
+        tests: &["--test", "rigid_body", "--test", "links", "--test", "lanes"],
         unit_tests: false,
         optimised: false,
     },
