@@ -22,7 +22,9 @@
 //!   half-planes, stepped together: contacts found by the broad and narrow phases, solved as
 //!   sequential impulses in the bodies' generalized coordinates (momentum kept, a bounded
 //!   cost a step), islands that fall asleep and wake as a whole, contact events, ray and
-//!   point queries. A pyramid of 55 boxes stands and sleeps.
+//!   point queries. A pyramid of 55 boxes stands and sleeps. [`OneOf`] makes a world of two
+//!   kinds of body (balls and the pendulums they strike; nested, more), each with its own
+//!   law and links.
 //! - [`PlaneContacts`]: the contact rows of a mechanism's shapes against static half-planes,
 //!   for `ImpulseStepper` and `ContactStepper` (a crate on the floor, a wheel rolling down a
 //!   slope), from its [`Links`](lagrange_core::links::Links) alone.
@@ -47,6 +49,7 @@
 mod broad;
 mod collide;
 mod manifold;
+mod one_of;
 mod pair;
 mod plane_contacts;
 mod query;
@@ -58,6 +61,7 @@ mod world;
 pub use broad::{BroadPhase, Proxy};
 pub use collide::{collide, collide_half_plane, HalfPlane};
 pub use manifold::{ContactPoint, Manifold};
+pub use one_of::OneOf;
 pub use pair::Pair;
 pub use plane_contacts::PlaneContacts;
 pub use query::RayHit;
