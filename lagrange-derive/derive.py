@@ -25,6 +25,9 @@ A Python file that defines, at module level:
   the coordinates, velocities, time and parameters.
 - `phi` (optional): holonomic constraint rows `phi(q) = 0`, a list of expressions in `q` and
   the parameters.
+- `links` (optional): each link's frame, a list of `(origin x, origin y, angle)` triples in
+  `q` and the parameters (no velocity, no time): the type then implements `Links`, whose
+  `pose` is these and whose points' Jacobians come from dual numbers.
 - `name` (optional): the Rust type's name, CamelCase (else `--name`, else the file name in
   CamelCase).
 - `doc` (optional): what the mechanism is (else the module's docstring).
@@ -118,12 +121,12 @@ RESERVED_METHODS = set(
     "acceleration_with acceleration_jacobian velocity_jump velocity_jumps gather with_force "
     "held_by kinetic potential non_conservative_force kinetic_energy potential_energy energy "
     "mass_formula rhs_formula equations constant_mass position_residual jacobian "
-    "velocity_product residual check_state phi".split()
+    "velocity_product residual check_state phi pose point".split()
 )
 
 # Type names the generated file uses itself (imports, generics, the prelude).
 RESERVED_TYPES = set(
-    "T S Self ClosedForm ConstantMass Constraints HolonomicConstraints SMatrix SVector "
+    "T S Self ClosedForm ConstantMass Constraints HolonomicConstraints Links Pose SMatrix SVector "
     "Lagrangian Real Scalar State Option Result Default Clone Copy Debug PartialEq Send Sync "
     "Sized String Vec Box".split()
 )
@@ -341,6 +344,9 @@ class Spec:
                 self.plain(e, f"phi[{i}]", velocities=False, time=False)
                 for i, e in enumerate(self.phi_written)
             ]
+        self.links = None
+        if ns.get("links") is not None:
+            self.links = self.read_links(ns["links"])
 
     # -- pieces --
 
@@ -498,6 +504,31 @@ class Spec:
                 raise SpecError(f"ranges[{c}] = {r}: low must be below high")
             self.ranges[self.q_functions.index(c)] = (low, high)
 
+    def read_links(self, links):
+        """`links`: each link's frame as (origin x, origin y, angle), functions of q only."""
+        rows = self.as_list(links, "links")
+        if not rows:
+            raise SpecError("links is empty: give each link's (x, y, angle), or no links")
+        out = []
+        for k, row in enumerate(rows):
+            if not isinstance(row, (list, tuple)) or len(row) != 3:
+                raise SpecError(
+                    f"links[{k}] is not a triple: give each link's frame as (origin x, "
+                    f"origin y, angle), the angle counter-clockwise from the world's x axis"
+                )
+            out.append(
+                [
+                    self.plain(
+                        self.sympify(e, f"links[{k}]"),
+                        f"links[{k}]",
+                        velocities=False,
+                        time=False,
+                    )
+                    for e in row
+                ]
+            )
+        return out
+
     def time_hint(self):
         """A note when the spec holds a symbol named like the time that is not the time the
         coordinates are functions of: a derivative by it is zero."""
@@ -560,6 +591,8 @@ class Spec:
                 why = (
                     "the rows are holonomic, phi(q) = 0"
                     if what.startswith("phi")
+                    else "a link's place is a function of q"
+                    if what.startswith("links")
                     else "velocity-dependent terms belong in T or Q"
                 )
                 raise SpecError(
@@ -567,9 +600,12 @@ class Spec:
                     f"coordinates only ({why})"
                 )
             if sym == self.t:
-                raise SpecError(
-                    f"{what} depends on the time {self.time_name}: constraint rows must not"
+                rule = (
+                    "a link's place is a function of q alone (Links::pose takes no time)"
+                    if what.startswith("links")
+                    else "constraint rows must not"
                 )
+                raise SpecError(f"{what} depends on the time {self.time_name}: {rule}")
             raise SpecError(
                 f"{what} uses the unknown symbol `{sym}`: it is neither a parameter (params), "
                 f"a coordinate (q) nor the time"
@@ -662,6 +698,7 @@ class Derivation:
                 check_supported(e, what)
         else:
             self.phi = self.J = self.Jqd = None
+        self.links = [[self.group(e) for e in row] for row in s.links] if s.links else None
 
     def group(self, expr):
         """`expr` expanded, its terms grouped by their state-dependent factor: a sum of
@@ -1265,6 +1302,9 @@ class Generator:
             blocks["phi_generic"] = self.block(d.phi, True, vectors=(self.q, None), time=None)
             blocks["jacobian"] = self.block(list(d.J), False, vectors=(self.q, None), time=None)
             blocks["jqd"] = self.block(d.Jqd, False, vectors=qv, time=None)
+        if d.links is not None:
+            entries = [e for row in d.links for e in row]
+            blocks["links"] = self.block(entries, True, vectors=(self.q, None), time=None)
         self.blocks = blocks
         if d.fixed_mass:
             self.mass_field = s.names.fresh("mass")
@@ -1276,6 +1316,8 @@ class Generator:
         self.closed_form()
         if d.phi is not None:
             self.constraints()
+        if d.links is not None:
+            self.link_poses()
         if self.tests:
             self.test_module()
         return self.header() + "\n".join(self.out) + "\n"
@@ -1311,6 +1353,8 @@ class Generator:
         lines.append(f"use lagrange_core::closed_form::{{{', '.join(closed)}}};")
         if self.d.phi is not None:
             lines.append("use lagrange_core::constraints::{Constraints, HolonomicConstraints};")
+        if self.d.links is not None:
+            lines.append("use lagrange_core::links::{Links, Pose};")
         lines.append("use lagrange_core::nalgebra::{SMatrix, SVector};")
         lines.append("use lagrange_core::{Lagrangian, Real, Scalar, State};")
         lines.append("")
@@ -1550,6 +1594,33 @@ class Generator:
         o.append("}")
         o.append("")
         o.append(f"lagrange_core::closed_form_mechanism!({s.name}, {n});")
+        o.append("")
+
+    def link_poses(self):
+        s, d = self.s, self.d
+        n, count = s.n, len(d.links)
+        b = self.blocks["links"]
+        o = self.out
+        o.append(f"impl<T: Real> Links<T, {n}> for {s.name}<T> {{")
+        o.append(f"    const LINKS: usize = {count};")
+        o.append("")
+        arms = []
+        for k in range(count):
+            x, y, angle = (b.output(3 * k + i, "S") for i in range(3))
+            pattern = str(k) if k + 1 < count else "_"
+            arms.append(f"{pattern} => Pose {{ origin: [{x}, {y}], angle: {angle} }},")
+        q = self.q if b.used_inputs & set(s.qs) else "_" + self.q
+        link = "link" if count > 1 else "_link"
+        result = "match link {\n" + "\n".join("        " + a for a in arms) + "\n    }"
+        if count == 1:
+            result = arms[0].split(" => ", 1)[1].rstrip(",")
+        self.fn(
+            f"fn pose<S: Scalar<Real = T> + 'static>(&self, {q}: &SVector<S, {n}>, {link}: usize) -> Pose<S>",
+            b,
+            result,
+            doc="The frame of each link (the last answers for a link out of range).",
+        )
+        o.append("}")
         o.append("")
 
     def constraints(self):

@@ -23,3 +23,6 @@ T = m * (x.diff(t) ** 2 + y.diff(t) ** 2) / 2
 V = m * g * y
 phi = [(x**2 + y**2 - l**2) / (2 * l)]
 ranges = {x: (-1.5, 1.5), y: (-1.5, 1.5)}
+
+# The bob's frame for shapes in a world (Links): at (x, y), unturned.
+links = [(x, y, 0)]

@@ -24,3 +24,7 @@ x1, y1 = l1 * sin(th1), -l1 * cos(th1)
 x2, y2 = x1 + l2 * sin(th2), y1 - l2 * cos(th2)
 T = m1 * (x1.diff(t) ** 2 + y1.diff(t) ** 2) / 2 + m2 * (x2.diff(t) ** 2 + y2.diff(t) ** 2) / 2
 V = m1 * g * y1 + m2 * g * y2
+
+# The rods' frames for shapes in a world (Links): each from its pivot (the first mass for the
+# second), turned by its angle, the rod along the frame's -y axis.
+links = [(0, 0, th1), (x1, y1, th2)]

@@ -24,3 +24,7 @@ x, y = l * sin(th), -l * cos(th)
 T = m * (x.diff(t) ** 2 + y.diff(t) ** 2) / 2
 V = m * g * y
 Q = [-b * th.diff(t)]
+
+# The rod's frame for shapes in a world (Links): its origin at the pivot, turned by th, the
+# rod along the frame's -y axis (the bob at (0, -l) in it).
+links = [(0, 0, th)]

@@ -28,3 +28,7 @@ T = m_cart * x.diff(t) ** 2 / 2 + m * (bob_x.diff(t) ** 2 + bob_y.diff(t) ** 2) 
 V = k * x**2 / 2 + m * g * bob_y
 Q = [-c * x.diff(t), 0]
 ranges = {x: (-1.0, 1.0)}
+
+# Frames for shapes in a world (Links): the cart at (x, 0), unturned; the rod from the cart,
+# turned by th, along the frame's -y axis.
+links = [(x, 0, 0), (x, 0, th)]

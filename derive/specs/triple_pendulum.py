@@ -25,7 +25,11 @@ t = dynamicsymbols._t
 
 T, V = 0, 0
 x, y = 0, 0
+# Each rod's frame for shapes in a world (Links): from its pivot, turned by its angle, the rod
+# along the frame's -y axis.
+links = []
 for m, l, th in [(m1, l1, th1), (m2, l2, th2), (m3, l3, th3)]:
+    links.append((x, y, th))
     x, y = x + l * sin(th), y - l * cos(th)
     T += m * (x.diff(t) ** 2 + y.diff(t) ** 2) / 2
     V += m * g * y

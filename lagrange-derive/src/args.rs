@@ -30,6 +30,8 @@ THE SPEC (module-level names):
     T, V     kinetic and potential energy (T quadratic in the velocities); time may enter
     Q        optional: generalized non-conservative forces, one per coordinate
     phi      optional: holonomic constraint rows phi(q) = 0
+    links    optional: each link's frame [(x, y, angle), ...] as functions of q: the type
+             then implements Links (shapes on its links in a lagrange-world World)
     name, doc, ranges, simplify   optional: type name, docs, test ranges, trigsimp on/off
     Functions: + - * /, integer and half-integer powers, sqrt, sin, cos, tan, exp, log,
     atan2, pi.

@@ -9,6 +9,7 @@
 
 use lagrange_core::closed_form::{ClosedForm, ConstantMass};
 use lagrange_core::constraints::{Constraints, HolonomicConstraints};
+use lagrange_core::links::{Links, Pose};
 use lagrange_core::nalgebra::{SMatrix, SVector};
 use lagrange_core::{Lagrangian, Real, Scalar, State};
 
@@ -131,6 +132,20 @@ impl<T: Real> HolonomicConstraints<T, 2, 1> for CartesianPendulum<T> {
         let x = q[0];
         let y = q[1];
         SVector::from([(x * x) * self.k2 + (y * y) * self.k2 - self.k3])
+    }
+}
+
+impl<T: Real> Links<T, 2> for CartesianPendulum<T> {
+    const LINKS: usize = 1;
+
+    /// The frame of each link (the last answers for a link out of range).
+    fn pose<S: Scalar<Real = T> + 'static>(&self, q: &SVector<S, 2>, _link: usize) -> Pose<S> {
+        let x = q[0];
+        let y = q[1];
+        Pose {
+            origin: [x, y],
+            angle: S::zero(),
+        }
     }
 }
 

@@ -8,6 +8,7 @@
 //! Spec: `../../specs/double_pendulum.py` (relative to this file). Options: `--tests`.
 
 use lagrange_core::closed_form::ClosedForm;
+use lagrange_core::links::{Links, Pose};
 use lagrange_core::nalgebra::{SMatrix, SVector};
 use lagrange_core::{Lagrangian, Real, Scalar, State};
 
@@ -126,6 +127,27 @@ impl<T: Real> ClosedForm<T, 2> for DoublePendulum<T> {
 }
 
 lagrange_core::closed_form_mechanism!(DoublePendulum, 2);
+
+impl<T: Real> Links<T, 2> for DoublePendulum<T> {
+    const LINKS: usize = 2;
+
+    /// The frame of each link (the last answers for a link out of range).
+    fn pose<S: Scalar<Real = T> + 'static>(&self, q: &SVector<S, 2>, link: usize) -> Pose<S> {
+        let th1 = q[0];
+        let th2 = q[1];
+        let (sin_th1, cos_th1) = th1.sin_cos();
+        match link {
+            0 => Pose {
+                origin: [S::zero(), S::zero()],
+                angle: th1,
+            },
+            _ => Pose {
+                origin: [sin_th1 * self.l1, -cos_th1 * self.l1],
+                angle: th2,
+            },
+        }
+    }
+}
 
 /// The closed form against the automatic path of its own `T` and `V`, in `f64` and `f32`
 /// (`lagrange_core::agreement`).

@@ -8,6 +8,7 @@
 //! Spec: `../../specs/pendulum.py` (relative to this file). Options: `--tests`.
 
 use lagrange_core::closed_form::{ClosedForm, ConstantMass};
+use lagrange_core::links::{Links, Pose};
 use lagrange_core::nalgebra::{SMatrix, SVector};
 use lagrange_core::{Lagrangian, Real, Scalar, State};
 
@@ -101,6 +102,19 @@ impl<T: Real> ClosedForm<T, 1> for Pendulum<T> {
 }
 
 lagrange_core::closed_form_mechanism!(Pendulum, 1);
+
+impl<T: Real> Links<T, 1> for Pendulum<T> {
+    const LINKS: usize = 1;
+
+    /// The frame of each link (the last answers for a link out of range).
+    fn pose<S: Scalar<Real = T> + 'static>(&self, q: &SVector<S, 1>, _link: usize) -> Pose<S> {
+        let th = q[0];
+        Pose {
+            origin: [S::zero(), S::zero()],
+            angle: th,
+        }
+    }
+}
 
 /// The closed form against the automatic path of its own `T` and `V`, in `f64` and `f32`
 /// (`lagrange_core::agreement`).

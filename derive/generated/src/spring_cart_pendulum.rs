@@ -8,6 +8,7 @@
 //! Spec: `../../specs/spring_cart_pendulum.py` (relative to this file). Options: `--tests`.
 
 use lagrange_core::closed_form::ClosedForm;
+use lagrange_core::links::{Links, Pose};
 use lagrange_core::nalgebra::{SMatrix, SVector};
 use lagrange_core::{Lagrangian, Real, Scalar, State};
 
@@ -124,6 +125,26 @@ impl<T: Real> ClosedForm<T, 2> for SpringCartPendulum<T> {
 }
 
 lagrange_core::closed_form_mechanism!(SpringCartPendulum, 2);
+
+impl<T: Real> Links<T, 2> for SpringCartPendulum<T> {
+    const LINKS: usize = 2;
+
+    /// The frame of each link (the last answers for a link out of range).
+    fn pose<S: Scalar<Real = T> + 'static>(&self, q: &SVector<S, 2>, link: usize) -> Pose<S> {
+        let x = q[0];
+        let th = q[1];
+        match link {
+            0 => Pose {
+                origin: [x, S::zero()],
+                angle: S::zero(),
+            },
+            _ => Pose {
+                origin: [x, S::zero()],
+                angle: th,
+            },
+        }
+    }
+}
 
 /// The closed form against the automatic path of its own `T` and `V`, in `f64` and `f32`
 /// (`lagrange_core::agreement`).

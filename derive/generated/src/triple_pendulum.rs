@@ -8,6 +8,7 @@
 //! Spec: `../../specs/triple_pendulum.py` (relative to this file). Options: `--tests`.
 
 use lagrange_core::closed_form::ClosedForm;
+use lagrange_core::links::{Links, Pose};
 use lagrange_core::nalgebra::{SMatrix, SVector};
 use lagrange_core::{Lagrangian, Real, Scalar, State};
 
@@ -190,6 +191,35 @@ impl<T: Real> ClosedForm<T, 3> for TriplePendulum<T> {
 }
 
 lagrange_core::closed_form_mechanism!(TriplePendulum, 3);
+
+impl<T: Real> Links<T, 3> for TriplePendulum<T> {
+    const LINKS: usize = 3;
+
+    /// The frame of each link (the last answers for a link out of range).
+    fn pose<S: Scalar<Real = T> + 'static>(&self, q: &SVector<S, 3>, link: usize) -> Pose<S> {
+        let th1 = q[0];
+        let th2 = q[1];
+        let th3 = q[2];
+        let (sin_th1, cos_th1) = th1.sin_cos();
+        let e0 = sin_th1 * self.l1;
+        let e1 = cos_th1 * self.l1;
+        let (sin_th2, cos_th2) = th2.sin_cos();
+        match link {
+            0 => Pose {
+                origin: [S::zero(), S::zero()],
+                angle: th1,
+            },
+            1 => Pose {
+                origin: [e0, -e1],
+                angle: th2,
+            },
+            _ => Pose {
+                origin: [e0 + sin_th2 * self.l2, -e1 - cos_th2 * self.l2],
+                angle: th3,
+            },
+        }
+    }
+}
 
 /// The closed form against the automatic path of its own `T` and `V`, in `f64` and `f32`
 /// (`lagrange_core::agreement`).

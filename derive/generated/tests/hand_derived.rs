@@ -2,9 +2,12 @@
 //! `derive/specs/` the same one for SymPy (the pendulum, the double pendulum, the three-link
 //! chain, the Cartesian pendulum), the two agree at random states (parameters away from the
 //! defaults), in `f64` and `f32`: accelerations, mass matrices, right-hand sides, forces,
-//! energies, and for the constrained one its rows, constrained accelerations and multipliers.
+//! energies, the links' frames and the points on them (positions and Jacobians, the generated
+//! ones by dual numbers from the spec's `links`, the hand-derived ones by hand), and for the
+//! constrained one its rows, constrained accelerations and multipliers.
 
 use lagrange_core::constraints::Constraints;
+use lagrange_core::links::Links;
 use lagrange_core::{Constrained, Error, Mechanism, Real, State};
 use lagrange_generated as generated;
 use lagrange_systems as hand;
@@ -57,13 +60,41 @@ fn same_free<T: Real, const N: usize>(
     Ok(())
 }
 
+/// Every link's frame, and three points on each (their positions and Jacobians), of two
+/// mechanisms with links.
+fn same_links<T: Real, const N: usize>(
+    a: &impl Links<T, N>,
+    b: &impl Links<T, N>,
+    s: &State<T, N>,
+    links: usize,
+) {
+    for link in 0..links {
+        let (pa, pb) = (a.pose(&s.q, link), b.pose(&s.q, link));
+        close("link origin", s, &pa.origin, &pb.origin);
+        close("link angle", s, &[pa.angle], &[pb.angle]);
+        for local in [[0.0, 0.0], [0.0, -0.6], [0.25, -1.1]] {
+            let local = local.map(T::from_f64);
+            let (xa, xb) = (a.point(&s.q, link, local), b.point(&s.q, link, local));
+            close("point", s, &xa.position, &xb.position);
+            close(
+                "point Jacobian",
+                s,
+                xa.jacobian.as_slice(),
+                xb.jacobian.as_slice(),
+            );
+        }
+    }
+}
+
 fn pendulum<T: Real>() -> Result<(), Error> {
     let p = [1.3, 0.7, 9.81, 0.2].map(T::from_f64);
     let g = generated::Pendulum::new(p[0], p[1], p[2], p[3])?;
     let h = hand::SimplePendulum::new(p[0], p[1], p[2], p[3])?;
     let mut rng = Rng::new(1);
     for _ in 0..STATES {
-        same_free(&g, &h, &random_state(&mut rng, (-4.0, 4.0), (-5.0, 5.0)))?;
+        let s = random_state(&mut rng, (-4.0, 4.0), (-5.0, 5.0));
+        same_free(&g, &h, &s)?;
+        same_links(&g, &h, &s, 1);
     }
     Ok(())
 }
@@ -74,7 +105,9 @@ fn double_pendulum<T: Real>() -> Result<(), Error> {
     let h = hand::DoublePendulum::new(p[0], p[1], p[2], p[3], p[4])?;
     let mut rng = Rng::new(2);
     for _ in 0..STATES {
-        same_free(&g, &h, &random_state(&mut rng, (-4.0, 4.0), (-5.0, 5.0)))?;
+        let s = random_state(&mut rng, (-4.0, 4.0), (-5.0, 5.0));
+        same_free(&g, &h, &s)?;
+        same_links(&g, &h, &s, 2);
     }
     Ok(())
 }
@@ -87,11 +120,9 @@ fn triple_pendulum<T: Real>() -> Result<(), Error> {
     let h = hand::NLinkPendulum::new(m, l, g)?;
     let mut rng = Rng::new(4);
     for _ in 0..STATES {
-        same_free(
-            &generated,
-            &h,
-            &random_state(&mut rng, (-4.0, 4.0), (-5.0, 5.0)),
-        )?;
+        let s = random_state(&mut rng, (-4.0, 4.0), (-5.0, 5.0));
+        same_free(&generated, &h, &s)?;
+        same_links(&generated, &h, &s, 3);
     }
     Ok(())
 }

@@ -9,7 +9,7 @@ use std::process::Command;
 
 /// Specs that must be refused (relative to the workspace root): the spec, and what the
 /// message must say.
-pub const BAD_INPUT: [(&str, &str); 10] = [
+pub const BAD_INPUT: [(&str, &str); 12] = [
     ("derive/bad/syntax_error.py", "syntax error"),
     ("derive/bad/unknown_symbol.py", "unknown symbol `k`"),
     ("derive/bad/undefined_name.py", "name 'k' is not defined"),
@@ -37,6 +37,14 @@ pub const BAD_INPUT: [(&str, &str); 10] = [
     (
         "derive/bad/colliding_names.py",
         "both become `theta` in Rust",
+    ),
+    (
+        "derive/bad/moving_link.py",
+        "links[0] depends on the time t: a link's place is a function of q alone",
+    ),
+    (
+        "derive/bad/link_not_a_triple.py",
+        "links[0] is not a triple",
     ),
 ];
 
