@@ -445,6 +445,9 @@ function runScenario() {
     state.scenario[double ? 'f64' : 'f32'] = line;
     out.push(line);
   }
+  const world = text(ex().lg_world_scenario());
+  state.scenario.world = world;
+  out.push(world);
   document.getElementById('scenario').textContent = out.join('\n');
 }
 

@@ -95,7 +95,7 @@ pub extern "C" fn lg_numbers() -> usize {
     PAGE.with_borrow(|page| page.numbers.as_ptr() as usize)
 }
 
-/// The address of the text [`lg_take_error`] or [`lg_scenario`] wrote.
+/// The address of the text [`lg_take_error`], [`lg_scenario`] or [`lg_world_scenario`] wrote.
 #[no_mangle]
 pub extern "C" fn lg_text() -> usize {
     PAGE.with_borrow(|page| page.text.as_ptr() as usize)
@@ -203,6 +203,17 @@ pub extern "C" fn lg_take_error(panel: u32) -> u32 {
 #[no_mangle]
 pub extern "C" fn lg_scenario(double: u32) -> u32 {
     let text = scenario::text(double != 0);
+    PAGE.with_borrow_mut(|page| {
+        page.text = text;
+        u32::try_from(page.text.len()).unwrap_or(0)
+    })
+}
+
+/// Runs the world's lockstep case into [`lg_text`] (see [`scenario::world_text`]): its length
+/// in bytes.
+#[no_mangle]
+pub extern "C" fn lg_world_scenario() -> u32 {
+    let text = scenario::world_text();
     PAGE.with_borrow_mut(|page| {
         page.text = text;
         u32::try_from(page.text.len()).unwrap_or(0)

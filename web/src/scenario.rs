@@ -2,9 +2,11 @@
 //! firmware's: the lockstep case `lagrange_cases::scripted` (a scene of damped pendulums and
 //! cart-poles that fall asleep and are woken by an impulse, a state write, inputs, a removal,
 //! an explicit wake, a contact and a parameter change), the same function the Cortex-M4F runs
-//! under QEMU (`cargo xtask qemu`) and the host checks it against.
+//! under QEMU (`cargo xtask qemu`) and the host checks it against. And the world's lockstep
+//! case, `lagrange_cases::world_in_a_box` (three balls and a crate dropped into a box: they
+//! bounce, touch, rest and sleep), likewise.
 
-use lagrange_cases::{scripted, Outcome, STEPS};
+use lagrange_cases::{scripted, world_in_a_box, Outcome, STEPS};
 use lagrange_core::Error;
 
 /// Frames of the scenario: the lockstep comparison's.
@@ -32,12 +34,25 @@ pub fn digest(words: &[u64]) -> u64 {
     })
 }
 
-/// What the page shows, and what `cargo xtask web --test` reads:
-/// `"f32 frames=1000 words=<hex>,<hex>,... digest=<hex>"`, or `"f32 error: ..."`.
+/// The outcome words of the world's case (`f32`, [`FRAMES`] steps): the digest of every
+/// body's bits, and how many are asleep.
+///
+/// # Errors
+/// The world's own errors (none for its values).
+pub fn world_words() -> Result<Vec<u64>, Error> {
+    Ok(world_in_a_box(FRAMES)?.words().to_vec())
+}
+
+/// The line the page shows for the world's case: `"world frames=1000 words=<hex>,...
+/// digest=<hex>"`, or `"world error: ..."`.
 #[must_use]
-pub fn text(double: bool) -> String {
-    let name = if double { "f64" } else { "f32" };
-    match words(double) {
+pub fn world_text() -> String {
+    line("world", world_words())
+}
+
+/// `"<name> frames=1000 words=<hex>,<hex>,... digest=<hex>"`, or `"<name> error: ..."`.
+fn line(name: &str, words: Result<Vec<u64>, Error>) -> String {
+    match words {
         Ok(words) => {
             let list: Vec<String> = words.iter().map(|w| format!("{w:016x}")).collect();
             format!(
@@ -48,4 +63,11 @@ pub fn text(double: bool) -> String {
         }
         Err(e) => format!("{name} error: {e}"),
     }
+}
+
+/// What the page shows, and what `cargo xtask web --test` reads:
+/// `"f32 frames=1000 words=<hex>,<hex>,... digest=<hex>"`, or `"f32 error: ..."`.
+#[must_use]
+pub fn text(double: bool) -> String {
+    line(if double { "f64" } else { "f32" }, words(double))
 }

@@ -2,7 +2,7 @@
 //! precisions, bad input is refused with the library's error and resets the instance, and the
 //! scenario's words are the lockstep case's.
 
-use lagrange_cases::{scripted, STEPS};
+use lagrange_cases::{scripted, world_in_a_box, STEPS};
 use lagrange_web::page::Page;
 use lagrange_web::scenario;
 use lagrange_web::setups::{make, twin_angle, KINDS, METHODS};
@@ -68,13 +68,20 @@ fn bad_input_is_refused_and_resets() -> Result<(), lagrange_core::Error> {
     Ok(())
 }
 
-/// The page's scenario is the lockstep case the firmware runs, and its digest is of its words.
+/// The page's scenarios are the lockstep cases the firmware runs (the scene's, the world's), and
+/// their digests are of their words.
 #[test]
 fn scenario_is_the_lockstep_case() -> Result<(), lagrange_core::Error> {
     let words = scenario::words(false)?;
     assert_eq!(words, scripted::<f32>(STEPS)?.words());
     let text = scenario::text(true);
     let digest = scenario::digest(&scenario::words(true)?);
+    assert!(text.ends_with(&format!("digest={digest:016x}")), "{text}");
+    let world = scenario::world_words()?;
+    assert_eq!(world, world_in_a_box(STEPS)?.words());
+    let text = scenario::world_text();
+    assert!(text.starts_with("world frames="), "{text}");
+    let digest = scenario::digest(&world);
     assert!(text.ends_with(&format!("digest={digest:016x}")), "{text}");
     Ok(())
 }

@@ -11,9 +11,9 @@
 //! `--test` drives the page in headless Chromium (Debian's `chromium`, installed by apt-get
 //! when missing) over the DevTools protocol ([`crate::cdp`]) and checks that it loads without
 //! console errors, that frames advance, that it loaded the SIMD module, that the scripted
-//! scenario's words and digest, from the SIMD module and again from the scalar one (the page
-//! loaded with `?scalar`), equal the host's (x86_64, computed here) and the firmware's (under
-//! QEMU, `crate::qemu`), and that bad input (a dt of 0 or NaN, an absurd throw) shows the
+//! scenario's words and digest and the world's (three balls and a crate in a box), from the
+//! SIMD module and again from the scalar one (the page loaded with `?scalar`), equal the
+//! host's (x86_64, computed here) and the firmware's (under QEMU, `crate::qemu`), and that bad input (a dt of 0 or NaN, an absurd throw) shows the
 //! library's error, resets the instance and leaves every drawn value finite. It saves
 //! `target/lagrange-web/screenshot.png`.
 //!
@@ -30,7 +30,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::{Duration, Instant};
 
-use lagrange_cases::{scripted, CASES, STEPS};
+use lagrange_cases::{scripted, world_in_a_box, Outcome, CASES, STEPS};
 
 use crate::cdp::{base64, Browser, Evaluated, Json};
 use crate::cmd;
@@ -48,6 +48,20 @@ const PORT: u16 = 8018;
 
 /// The lockstep case the page's scenario is, by precision.
 const SCENE_CASE: &str = "scene (sleep, wake)";
+
+/// The lockstep case the page's world is (`f32`).
+const WORLD_CASE: &str = "world: 3 balls and a crate in a box";
+
+/// The host's run of a lockstep case for a number of frames.
+type HostRun = fn(u32) -> Result<Outcome, lagrange_core::Error>;
+
+/// The page's scenario lines (its key in the page's state, the lockstep case and precision,
+/// the host's run of it): the scripted scene in `f32` and `f64`, and the world.
+const SCENARIOS: [(&str, &str, &str, HostRun); 3] = [
+    ("f32", SCENE_CASE, "f32", scripted::<f32>),
+    ("f64", SCENE_CASE, "f64", scripted::<f64>),
+    ("world", WORLD_CASE, "f32", world_in_a_box),
+];
 
 /// `cargo xtask web [--no-serve | --test]`.
 pub fn run(args: &[String]) -> Result<(), String> {
@@ -482,8 +496,9 @@ fn drive(
 /// The scripted scenario's lines of a page's state, by precision.
 fn scenario_lines(state: &Json) -> BTreeMap<String, String> {
     let scenario = state.get("scenario");
-    ["f32", "f64"]
-        .into_iter()
+    SCENARIOS
+        .iter()
+        .map(|(key, ..)| *key)
         .filter_map(|p| {
             scenario
                 .get(p)
@@ -507,7 +522,10 @@ fn scalar_scenario(browser: &mut Browser, url: &str) -> Result<BTreeMap<String, 
         browser,
         "the scalar page's scenario",
         READY_DEADLINE,
-        |state| state.get("build").str() == Some("scalar") && scenario_lines(state).len() == 2,
+        |state| {
+            state.get("build").str() == Some("scalar")
+                && scenario_lines(state).len() == SCENARIOS.len()
+        },
     )?;
     println!("page: loaded again with ?scalar: the scalar module");
     Ok(scenario_lines(&state))
@@ -714,23 +732,18 @@ fn compare(
     if let Err(e) = firmware {
         failures.push(format!("no firmware words from QEMU: {e}"));
     }
-    println!("\nscripted scenario ({SCENE_CASE}, {STEPS} frames): words and digest");
-    for precision in ["f32", "f64"] {
-        let host = if precision == "f32" {
-            scripted::<f32>(STEPS)
-        } else {
-            scripted::<f64>(STEPS)
-        };
-        let host = match host {
+    println!("\nscripted scenarios ({STEPS} frames): words and digest");
+    for (key, case, precision, run) in SCENARIOS {
+        let host = match run(STEPS) {
             Ok(outcome) => outcome.words().to_vec(),
             Err(e) => {
-                failures.push(format!("{precision}: the host's scenario failed: {e}"));
+                failures.push(format!("{key}: the host's scenario failed: {e}"));
                 continue;
             }
         };
         let id = CASES
             .iter()
-            .position(|c| c.system == SCENE_CASE && c.precision == precision);
+            .position(|c| c.system == case && c.precision == precision);
         let m4f = firmware
             .as_ref()
             .ok()
@@ -740,12 +753,12 @@ fn compare(
         };
         let mut shown = vec![format!("host x86_64 {}", show(Some(&host)))];
         for (name, page) in pages {
-            let wasm = page.get(precision).map(|line| parse_scenario(line));
+            let wasm = page.get(key).map(|line| parse_scenario(line));
             let wasm_words = match &wasm {
                 Some(Ok((words, digest_shown))) => {
                     if *digest_shown != digest(words) {
                         failures.push(format!(
-                            "{precision}: the {name} page's digest does not match its words"
+                            "{key}: the {name} page's digest does not match its words"
                         ));
                     }
                     Some(words)
@@ -759,16 +772,16 @@ fn compare(
             shown.push(format!("{name} (Chromium) {}", show(wasm_words)));
             if wasm_words != Some(&host) {
                 failures.push(format!(
-                    "{precision}: the {name} page's scenario differs from the host's: page \
+                    "{key}: the {name} page's scenario differs from the host's: page \
                      {wasm:?}, host {host:x?}"
                 ));
             }
         }
         shown.push(format!("M4F (QEMU) {}", show(m4f.as_ref())));
-        println!("  {precision}: {}", shown.join("  "));
+        println!("  {key} ({case}): {}", shown.join("  "));
         if m4f.as_ref() != Some(&host) {
             failures.push(format!(
-                "{precision}: the firmware's scenario differs from the host's: M4F {m4f:x?}, \
+                "{key}: the firmware's scenario differs from the host's: M4F {m4f:x?}, \
                  host {host:x?}"
             ));
         }
