@@ -51,7 +51,8 @@
 //! contacts and islands a step, and the outside probe's own times: its broad phase (the
 //! shapes placed and boxed, `BroadPhase::pairs`) and its narrow phase (`collide` on the
 //! pairs, every shape against every wall). These redo what step 2 of a `World` step does
-//! with the same public functions on the same configuration, so they estimate its detection
+//! with the same public functions on the same configuration (the broad phase's filling,
+//! `BroadPhase::add` of every shape, timed apart), so they estimate its detection
 //! (without the rows' Jacobians and mobilities, which the `World` builds per contact point
 //! as part of detection); the remainder of a step (free motion, rows, impulse solve, drift,
 //! islands and sleep, events, the step's copy of the bodies for its rollback) is
@@ -178,6 +179,7 @@ fn figures(sim: &mut dyn Sim, steps: usize) -> Result<(f64, f64, Probe), String>
         add(&mut sums.contacts, p.contacts);
         add(&mut sums.islands, p.islands);
         add(&mut sums.broad_ns, p.broad_ns);
+        add(&mut sums.fill_ns, p.fill_ns);
         add(&mut sums.narrow_ns, p.narrow_ns);
     }
     let n = steps.max(1) as f64;
@@ -190,6 +192,7 @@ fn figures(sim: &mut dyn Sim, steps: usize) -> Result<(f64, f64, Probe), String>
             contacts: mean(sums.contacts),
             islands: mean(sums.islands),
             broad_ns: mean(sums.broad_ns),
+            fill_ns: mean(sums.fill_ns),
             narrow_ns: mean(sums.narrow_ns),
         },
     ))

@@ -201,6 +201,8 @@ pub struct Probe {
     /// ns of the outside broad phase: the shapes' boxes (grown by the speculative margin)
     /// into a `BroadPhase`, and its pairs.
     pub broad_ns: Option<f64>,
+    /// Of which the filling: each shape placed, boxed and `BroadPhase::add`ed.
+    pub fill_ns: Option<f64>,
     /// ns of the outside narrow phase: `collide` on those pairs and `collide_half_plane` of
     /// every shape on every wall.
     pub narrow_ns: Option<f64>,
@@ -279,6 +281,7 @@ where
             }
             placed.push(p);
         }
+        let fill_ns = clock.elapsed().as_nanos() as f64;
         let pairs_found = self.broad.pairs(&mut *self.pairs).is_ok();
         let broad_ns = clock.elapsed().as_nanos() as f64;
         let clock = Instant::now();
@@ -303,6 +306,7 @@ where
             contacts: Some(f64::from(self.report.contacts)),
             islands: Some(f64::from(self.report.islands)),
             broad_ns: Some(broad_ns),
+            fill_ns: Some(fill_ns),
             narrow_ns: Some(narrow_ns),
         }
     }
