@@ -12,7 +12,10 @@
 //!   acceleration against the hand-derived and generated ones (`automatic.csv`, `automatic.md`).
 //!   `--contacts`: ns per step of the contact steppers (thrown ragdoll, double pendulum on
 //!   the floor, bouncing ball) against a free RK4 step and against rapier2d, with depth and
-//!   energy gain (`contacts.csv`, `contacts.md`).
+//!   energy gain (`contacts.csv`, `contacts.md`). `--world`: ns per step of
+//!   `lagrange_world::World` (pyramids of boxes, a pit of 1,000 balls, piles of ragdolls awake
+//!   and asleep) against rapier2d on the same scenes, with bodies awake and depth
+//!   (`world.csv`, `world.md`).
 //! - `cross`: builds of the library crates for the Cortex-M4F, M0+, M33 and RV32IMAC, with and
 //!   without `defmt`, a linked no_std binary with no allocator, with its size, and the embassy
 //!   example (`embedded/embassy-cartpole`, an nRF52840 application) linted and built.
@@ -145,9 +148,22 @@ const CONTACTS_BENCH: [&str; 7] = [
     "--",
 ];
 
-/// `cargo xtask bench [--scene | --automatic | --contacts] ...`: the work-precision bench,
-/// or with `--scene` the scene bench, with `--automatic` the automatic-path bench, with
-/// `--contacts` the contacts bench, with the other flags passed on.
+/// The world bench (`--world`): a `[[bench]]` target as the contacts bench, for the same
+/// reason (rapier2d is its peer).
+const WORLD_BENCH: [&str; 7] = [
+    "bench",
+    "--quiet",
+    "-p",
+    "lagrange-benches",
+    "--bench",
+    "world",
+    "--",
+];
+
+/// `cargo xtask bench [--scene | --automatic | --contacts | --world] ...`: the
+/// work-precision bench, or with `--scene` the scene bench, with `--automatic` the
+/// automatic-path bench, with `--contacts` the contacts bench, with `--world` the world
+/// bench, with the other flags passed on.
 fn bench(args: &[String]) -> Result<(), String> {
     let which: &[&str] = if args.iter().any(|a| a == "--scene") {
         &SCENE_BENCH
@@ -155,6 +171,8 @@ fn bench(args: &[String]) -> Result<(), String> {
         &AUTOMATIC_BENCH
     } else if args.iter().any(|a| a == "--contacts") {
         &CONTACTS_BENCH
+    } else if args.iter().any(|a| a == "--world") {
+        &WORLD_BENCH
     } else {
         &BENCH
     };

@@ -64,6 +64,8 @@
 //! enabled: one ragdoll is one small island, and lagrange's steppers run on one thread.
 
 mod peer;
+#[path = "../shared/rapier_ragdoll.rs"]
+mod rapier_ragdoll;
 mod report;
 mod run;
 mod scenes;
