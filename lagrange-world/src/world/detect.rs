@@ -62,8 +62,9 @@ where
             let (lo, hi) = self.placed(s).bounds();
             let grow = margin + self.reach(s, dt);
             let body = s.on.map(|(i, _)| i);
+            // Shape keys are unique (add_shape refuses a taken one).
             self.broad
-                .add(Proxy {
+                .add_unique(Proxy {
                     bounds: ([lo[0] - grow, lo[1] - grow], [hi[0] + grow, hi[1] + grow]),
                     body: body.map_or(u32::MAX, |i| u32::try_from(i).unwrap_or(u32::MAX)),
                     key: s.key,
