@@ -182,13 +182,28 @@ fn bench(args: &[String]) -> Result<(), String> {
 /// Host tests of the whole workspace: unit, integration and doc tests, f32 and f64 alike.
 const TEST: [&[&str]; 1] = [&["test", "--workspace", "--all-targets", "--quiet"]];
 
-/// Static checks run before the tests.
-const CHECKS: [&[&str]; 2] = [
+/// Static checks run before the tests. The benches behind `bench --contacts` and `bench
+/// --world` are `bench = false` (a plain `cargo bench` runs only the criterion ones), which
+/// `--all-targets` leaves out: they are named.
+const CHECKS: [&[&str]; 3] = [
     &["fmt", "--all", "--", "--check"],
     &[
         "clippy",
         "--workspace",
         "--all-targets",
+        "--quiet",
+        "--",
+        "-D",
+        "warnings",
+    ],
+    &[
+        "clippy",
+        "-p",
+        "lagrange-benches",
+        "--bench",
+        "contacts",
+        "--bench",
+        "world",
         "--quiet",
         "--",
         "-D",
