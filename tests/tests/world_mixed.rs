@@ -1,7 +1,7 @@
 //! A world of two kinds of body (`lagrange_world::OneOf`): a ball that strikes a hanging
 //! pendulum in one `World`, against the hand-computed impulse and the pair's angular momentum
-//! about the pivot; and the wrapped bodies' own laws, energies and links, the idle
-//! coordinates idle. Both precisions.
+//! about the pivot, and where its shapes are drawn; and the wrapped bodies' own laws,
+//! energies and links, the idle coordinates idle. Both precisions.
 
 use lagrange_core::constraints::contact::ContactModel;
 use lagrange_core::links::Links;
@@ -88,6 +88,27 @@ fn a_ball_strikes_a_pendulum_in_one_world<T: Real>() -> Result<(), Error> {
     assert!(
         b.qd[0].to_f64().abs() < tol && (p.qd[0].to_f64() - 2.0).abs() < tol,
         "{b:?} {p:?}"
+    );
+    // Where a renderer draws them: the ball's disk at its coordinates, the bob at the rod's
+    // end, each with its body, in the shapes' keys' order.
+    let placed: Vec<_> = world.placed_shapes().collect();
+    assert_eq!(
+        placed
+            .iter()
+            .map(|s| (s.key, s.body, s.asleep))
+            .collect::<Vec<_>>(),
+        [(BOB, Some(PENDULUM), false), (DISK, Some(BALL), false)]
+    );
+    let centre = |k: usize| placed[k].shape.vertices()[0].map(|x| x.to_f64());
+    let th = p.q[0].to_f64();
+    let bob = [th.sin(), -th.cos()];
+    let near = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).hypot(a[1] - b[1]) < pick::<T>(1e-6, 1e-14);
+    assert!(near(centre(0), bob), "{:?} against {bob:?}", centre(0));
+    let ball_at = [b.q[0].to_f64(), b.q[1].to_f64()];
+    assert!(
+        near(centre(1), ball_at),
+        "{:?} against {ball_at:?}",
+        centre(1)
     );
     Ok(())
 }

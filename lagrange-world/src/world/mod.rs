@@ -81,6 +81,19 @@ pub struct ContactEvent<T> {
     pub normal: Vec2<T>,
 }
 
+/// A shape of a world where it is now ([`World::placed_shapes`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PlacedShape<T> {
+    /// The shape's key.
+    pub key: u32,
+    /// Its body's key; `None` for a static shape.
+    pub body: Option<u32>,
+    /// Whether its body sleeps.
+    pub asleep: bool,
+    /// The shape in world coordinates.
+    pub shape: Shape<T>,
+}
+
 /// A ray's hit in a world: the shape's key and where.
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -387,6 +400,21 @@ where
         self.body(key)
             .and_then(|i| self.bodies.get(i))
             .map(|b| b.asleep)
+    }
+
+    /// Every shape where it is now, in its keys' order: what a renderer draws. Each shape
+    /// placed at its body's link (a static shape where it is), with its body's key and
+    /// whether that body sleeps (`None` and `false` for a static shape).
+    pub fn placed_shapes(&self) -> impl Iterator<Item = PlacedShape<T>> + '_ {
+        self.shapes.iter().map(|s| {
+            let body = s.on.and_then(|(i, _)| self.bodies.get(i));
+            PlacedShape {
+                key: s.key,
+                body: body.map(|b| b.key),
+                asleep: body.is_some_and(|b| b.asleep),
+                shape: self.placed(s),
+            }
+        })
     }
 
     /// What the last step did.
