@@ -24,6 +24,7 @@
 
 pub mod exports;
 pub mod page;
+pub mod sandbox;
 pub mod scenario;
 pub mod setups;
 pub mod sim;
