@@ -39,6 +39,8 @@ const state = {
   drag: null,
   keys: { left: false, right: false },
   scenario: {},
+  // The sandbox: its drag, its slowest step (ms), and the scripted run's outcome.
+  sandbox: { drag: null, slowest: 0, stepMs: 0, script: null },
   shownErrors: [],
   nonFinite: 0,
 };
@@ -419,6 +421,9 @@ function frame(now) {
       while (ui.samples.length > 2 && tt - ui.samples[0][0] > PLOT_SECONDS) ui.samples.shift();
     });
   }
+  if (!state.paused) stepSandbox(elapsed);
+  drawSandbox();
+  showSandboxInfo();
   state.panels.forEach((ui, p) => {
     drawPanel(p);
     drawPlot(p);
@@ -435,6 +440,151 @@ function init(double) {
   const n = ex().lg_init(double ? 1 : 0);
   if (n === 0) throw new Error(`the page's mechanisms did not build: ${text()}`);
   state.panels.forEach((ui, p) => { ui.view = { ...VIEWS[p] }; refreshDt(p); });
+  if (ex().lg_sandbox_init(double ? 1 : 0) !== 0) throw new Error(`the sandbox did not build: ${text()}`);
+  Object.assign(state.sandbox, { drag: null, slowest: 0, stepMs: 0 });
+}
+
+// --- The sandbox: one World, drawn from its shapes where they are. ---
+
+const SANDBOX_VIEW = { left: -4.2, bottom: -0.2, width: 8.4 };
+const FAILED = 4294967295; // u32::MAX: a step failed
+
+function sandboxScale(canvas) { return canvas.width / SANDBOX_VIEW.width; }
+
+function toScreen(canvas, x, y) {
+  const k = sandboxScale(canvas);
+  return [(x - SANDBOX_VIEW.left) * k, canvas.height - (y - SANDBOX_VIEW.bottom) * k];
+}
+
+function toWorld(canvas, e) {
+  const r = canvas.getBoundingClientRect();
+  const k = sandboxScale(canvas);
+  const px = (e.clientX - r.left) * canvas.width / r.width;
+  const py = (e.clientY - r.top) * canvas.height / r.height;
+  return [px / k + SANDBOX_VIEW.left, (canvas.height - py) / k + SANDBOX_VIEW.bottom];
+}
+
+function drawSandbox() {
+  const canvas = document.getElementById('sandbox');
+  const g = canvas.getContext('2d');
+  const k = sandboxScale(canvas);
+  g.clearRect(0, 0, canvas.width, canvas.height);
+  g.strokeStyle = '#555';
+  g.lineWidth = 2;
+  g.beginPath();
+  const corners = [[-4, 5], [-4, 0], [4, 0], [4, 5]].map(([x, y]) => toScreen(canvas, x, y));
+  corners.forEach(([x, y], i) => (i ? g.lineTo(x, y) : g.moveTo(x, y)));
+  g.stroke();
+  const n = ex().lg_sandbox_shapes();
+  const v = new Float64Array(ex().memory.buffer, ex().lg_numbers(), n);
+  g.lineCap = 'round';
+  g.lineJoin = 'round';
+  for (let at = 0; at < n;) {
+    const [asleep, r, count] = [v[at], v[at + 1], v[at + 2]];
+    const pts = [];
+    for (let i = 0; i < count; i++) pts.push(toScreen(canvas, v[at + 3 + 2 * i], v[at + 4 + 2 * i]));
+    at += 3 + 2 * count;
+    const colour = asleep ? '#b9b9b9' : '#d9822b';
+    g.fillStyle = colour;
+    g.strokeStyle = colour;
+    if (count === 1) {
+      g.beginPath();
+      g.arc(pts[0][0], pts[0][1], r * k, 0, 2 * Math.PI);
+      g.fill();
+    } else {
+      g.beginPath();
+      pts.forEach(([x, y], i) => (i ? g.lineTo(x, y) : g.moveTo(x, y)));
+      if (count > 2) { g.closePath(); g.fill(); }
+      if (r > 0) { g.lineWidth = 2 * r * k; g.stroke(); }
+    }
+  }
+  const d = state.sandbox.drag;
+  if (d && d.trail.length) {
+    const [, x, y] = d.trail[d.trail.length - 1];
+    const [sx, sy] = toScreen(canvas, d.start[0], d.start[1]);
+    const [ex2, ey2] = toScreen(canvas, x, y);
+    g.strokeStyle = '#26303a';
+    g.lineWidth = 1.5;
+    g.beginPath(); g.moveTo(sx, sy); g.lineTo(ex2, ey2); g.stroke();
+  }
+}
+
+function stepSandbox(elapsed) {
+  const start = performance.now();
+  const steps = ex().lg_sandbox_advance(elapsed);
+  const ms = performance.now() - start;
+  const error = document.getElementById('sandbox-error');
+  if (steps === FAILED) {
+    error.textContent = `a step failed and the sandbox was rebuilt: ${text()}`;
+    return;
+  }
+  if (steps > 0) {
+    state.sandbox.stepMs = ms / steps;
+    state.sandbox.slowest = Math.max(state.sandbox.slowest, ms / steps);
+  }
+}
+
+function showSandboxInfo() {
+  const info = (which) => ex().lg_sandbox_info(0, which);
+  const s = state.sandbox;
+  const script = s.script ? `; the scripted pile: digest ${s.script.digest}, slowest step ` +
+    `${s.script.slowestMs.toFixed(2)} ms` : '';
+  document.getElementById('sandbox-info').textContent =
+    `${info(0)} bodies, ${info(1)} awake, ${info(2)} contact points (at most ${info(3)} in a ` +
+    `step, cap ${info(4)}); a step ${s.stepMs.toFixed(2)} ms, the slowest ${s.slowest.toFixed(2)} ms` +
+    `, ${state.double ? 'f64' : 'f32'}${script}`;
+}
+
+function startSandboxDrag(e) {
+  if (!ready()) return;
+  const canvas = document.getElementById('sandbox');
+  const [x, y] = toWorld(canvas, e);
+  const key = ex().lg_sandbox_grab(x, y);
+  if (key === 0) return;
+  state.sandbox.drag = { key: key - 1, start: [x, y], trail: [[performance.now(), x, y]] };
+  e.preventDefault();
+}
+
+window.addEventListener('pointermove', (e) => {
+  const d = state.sandbox.drag;
+  if (!d) return;
+  const [x, y] = toWorld(document.getElementById('sandbox'), e);
+  d.trail.push([performance.now(), x, y]);
+  while (d.trail.length > 2 && performance.now() - d.trail[0][0] > 100) d.trail.shift();
+});
+
+window.addEventListener('pointerup', () => {
+  const d = state.sandbox.drag;
+  if (!d) return;
+  state.sandbox.drag = null;
+  // The throw: the pointer's velocity over its last 100 ms, at most 15 m/s.
+  const [t0, x0, y0] = d.trail[0];
+  const [t1, x1, y1] = d.trail[d.trail.length - 1];
+  const dt = Math.max((t1 - t0) / 1000, 1 / 60);
+  let [vx, vy] = [(x1 - x0) / dt, (y1 - y0) / dt];
+  const speed = Math.hypot(vx, vy);
+  if (speed > 15) [vx, vy] = [15 * vx / speed, 15 * vy / speed];
+  if (ex().lg_sandbox_throw(d.key, vx, vy) !== 0) {
+    document.getElementById('sandbox-error').textContent = text();
+  }
+});
+
+// The scripted pile, step by step, each step timed: its digest (the host computes the same),
+// the slowest step, and the most contact points of a step against the cap.
+function runSandboxScript() {
+  let slowestMs = 0;
+  let failed = null;
+  const steps = ex().lg_script_steps();
+  for (let i = 0; i < steps && failed === null; i++) {
+    const start = performance.now();
+    if (ex().lg_script_step(i) !== 0) failed = text();
+    slowestMs = Math.max(slowestMs, performance.now() - start);
+  }
+  const digest = text(ex().lg_script_digest());
+  state.sandbox.script = {
+    precision: state.double ? 'f64' : 'f32', steps, digest, slowestMs,
+    worst: ex().lg_sandbox_info(1, 3), cap: ex().lg_sandbox_info(1, 4), failed,
+  };
 }
 
 function runScenario() {
@@ -519,6 +669,8 @@ window.lagrangeProbe = function probe() {
     work: state.panels.map((_, p) => [ex().lg_work(p, 0), ex().lg_work(p, 1)]),
     roundsCap: ex().lg_rounds_cap(),
     scenario: state.scenario,
+    sandbox: state.sandbox.script,
+    sandboxSlowest: state.sandbox.slowest,
     build: state.build,
     nonFinite: state.nonFinite,
   });
@@ -544,6 +696,8 @@ async function main() {
   });
   init(true);
   runScenario();
+  runSandboxScript();
+  document.getElementById('sandbox').addEventListener('pointerdown', startSandboxDrag);
   status.textContent = `${(bytes.byteLength / 1024).toFixed(0)} KiB of WebAssembly ` +
     `(${SIMD ? 'with SIMD: banks in lanes' : 'scalar'}); ` +
     'each mechanism steps in a lagrange Scene with a fixed-timestep clock, drawn interpolated.';

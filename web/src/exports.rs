@@ -14,6 +14,7 @@ use std::cell::RefCell;
 use lagrange_core::Error;
 
 use crate::page::Page;
+use crate::sandbox::{AnySandbox, SCRIPT_STEPS};
 use crate::scenario;
 use crate::setups::KINDS;
 use crate::sim::Panel;
@@ -216,6 +217,129 @@ pub extern "C" fn lg_world_scenario() -> u32 {
     let text = scenario::world_text();
     PAGE.with_borrow_mut(|page| {
         page.text = text;
+        u32::try_from(page.text.len()).unwrap_or(0)
+    })
+}
+
+/// Runs `f` on the page's sandbox (`script`: the scripted run's) or returns `missing`; an
+/// error `f` returns is kept as the page's text and answered with `failed`.
+fn with_sandbox<R>(
+    script: bool,
+    missing: R,
+    failed: R,
+    f: impl FnOnce(&mut AnySandbox) -> Result<R, Error>,
+) -> R {
+    PAGE.with_borrow_mut(|page| {
+        let slot = if script {
+            &mut page.script
+        } else {
+            &mut page.sandbox
+        };
+        let Some(sandbox) = slot.as_mut() else {
+            return missing;
+        };
+        match f(sandbox) {
+            Ok(r) => r,
+            Err(e) => {
+                page.text = e.to_string();
+                failed
+            }
+        }
+    })
+}
+
+/// Builds the sandbox in `f64` (`double` = 1) or `f32` (and the scripted run's, at its
+/// start): 0, or 1 with the error in [`lg_text`].
+#[no_mangle]
+pub extern "C" fn lg_sandbox_init(double: u32) -> u32 {
+    PAGE.with_borrow_mut(|page| {
+        match (AnySandbox::new(double != 0), AnySandbox::new(double != 0)) {
+            (Ok(sandbox), Ok(script)) => {
+                page.sandbox = Some(sandbox);
+                page.script = Some(script);
+                0
+            }
+            (Err(e), _) | (_, Err(e)) => {
+                page.text = e.to_string();
+                1
+            }
+        }
+    })
+}
+
+/// Advances the sandbox by `frame_time` s: the steps taken, or `u32::MAX` when one failed
+/// (the sandbox is then rebuilt; the error in [`lg_text`]).
+#[no_mangle]
+pub extern "C" fn lg_sandbox_advance(frame_time: f64) -> u32 {
+    let steps = with_sandbox(false, 0, u32::MAX, |s| s.advance(frame_time));
+    if steps == u32::MAX {
+        PAGE.with_borrow_mut(|page| {
+            let double = matches!(page.sandbox, Some(AnySandbox::Double(_)));
+            page.sandbox = AnySandbox::new(double).ok();
+        });
+    }
+    steps
+}
+
+/// Writes the sandbox's shapes to [`lg_numbers`] (see `Sandbox::shapes`): the count of
+/// numbers.
+#[no_mangle]
+pub extern "C" fn lg_sandbox_shapes() -> u32 {
+    PAGE.with_borrow_mut(|page| {
+        let Page {
+            sandbox, numbers, ..
+        } = page;
+        numbers.clear();
+        if let Some(s) = sandbox {
+            s.shapes(numbers);
+        }
+        u32::try_from(numbers.len()).unwrap_or(0)
+    })
+}
+
+/// The key of the body under `(x, y)` plus one, or 0 for none.
+#[no_mangle]
+pub extern "C" fn lg_sandbox_grab(x: f64, y: f64) -> u32 {
+    with_sandbox(false, 0, 0, |s| {
+        Ok(s.grab(x, y).map_or(0, |k| k.saturating_add(1)))
+    })
+}
+
+/// Throws body `key` at `(vx, vy)` m/s: 0, or 1 with the error in [`lg_text`].
+#[no_mangle]
+pub extern "C" fn lg_sandbox_throw(key: u32, vx: f64, vy: f64) -> u32 {
+    with_sandbox(false, 1, 1, |s| s.throw(key, vx, vy).map(|()| 0))
+}
+
+/// The sandbox's figure `which` of `[bodies, awake, contacts of the last step, the most of
+/// any step, the cap]`, of the scripted run's where `script` = 1.
+#[no_mangle]
+pub extern "C" fn lg_sandbox_info(script: u32, which: u32) -> u32 {
+    with_sandbox(script != 0, 0, 0, |s| {
+        Ok(s.info().get(which as usize).copied().unwrap_or(0))
+    })
+}
+
+/// Step `i` of the scripted run: 0, or 1 with the error in [`lg_text`].
+#[no_mangle]
+pub extern "C" fn lg_script_step(i: u32) -> u32 {
+    with_sandbox(true, 1, 1, |s| s.script_step(i).map(|()| 0))
+}
+
+/// The steps of the scripted run.
+#[no_mangle]
+pub extern "C" fn lg_script_steps() -> u32 {
+    SCRIPT_STEPS
+}
+
+/// The scripted run's digest as text in [`lg_text`] (`"<hex>"`): its length.
+#[no_mangle]
+pub extern "C" fn lg_script_digest() -> u32 {
+    PAGE.with_borrow_mut(|page| {
+        page.text = page
+            .script
+            .as_ref()
+            .map_or_else(String::new, |s| format!("{:016x}", s.digest()));
         u32::try_from(page.text.len()).unwrap_or(0)
     })
 }

@@ -3,8 +3,9 @@
 //! The library compiled to WebAssembly for the interactive page (`cargo xtask web`): seven
 //! mechanisms, each in a scene with one fixed-timestep clock, stepped from the browser's
 //! frame times and drawn from interpolated states by `web/site/app.js`; an integrator and a
-//! step for each, `f32` or `f64`; drags (impulses), the cart-pole's input, and the scripted
-//! scenario whose bits the page shows ([`scenario`]).
+//! step for each, `f32` or `f64`; drags (impulses), the cart-pole's input, the scripted
+//! scenario whose bits the page shows ([`scenario`]), and a sandbox of bodies that touch each
+//! other in one `lagrange_world::World` ([`sandbox`]).
 //!
 //! The exports are plain C ABI functions of numbers (module [`exports`]); arrays come back
 //! through a buffer whose address an export returns, read by the page as a `Float64Array`

@@ -19,6 +19,10 @@ pub struct Page {
     pub numbers: Vec<f64>,
     /// Text for the page (UTF-8).
     pub text: String,
+    /// The sandbox the page shows.
+    pub sandbox: Option<crate::sandbox::AnySandbox>,
+    /// The sandbox of the scripted run the test drives, step by step.
+    pub script: Option<crate::sandbox::AnySandbox>,
 }
 
 impl Page {

@@ -412,3 +412,82 @@ pub fn scripted<T: Real>(steps: u32) -> Result<u64, Error> {
     }
     Ok(sandbox.digest())
 }
+
+/// A sandbox in the page's precision.
+pub enum AnySandbox {
+    /// In `f32`.
+    Single(Sandbox<f32>),
+    /// In `f64`.
+    Double(Sandbox<f64>),
+}
+
+/// Calls the same method on either precision's sandbox.
+macro_rules! either {
+    ($s:expr, $x:ident => $call:expr) => {
+        match $s {
+            AnySandbox::Single($x) => $call,
+            AnySandbox::Double($x) => $call,
+        }
+    };
+}
+
+impl AnySandbox {
+    /// A new sandbox in `f64` (`double`) or `f32`.
+    ///
+    /// # Errors
+    /// As [`Sandbox::new`].
+    pub fn new(double: bool) -> Result<Self, Error> {
+        Ok(if double {
+            Self::Double(Sandbox::new()?)
+        } else {
+            Self::Single(Sandbox::new()?)
+        })
+    }
+
+    /// [`Sandbox::advance`].
+    ///
+    /// # Errors
+    /// As [`Sandbox::advance`].
+    pub fn advance(&mut self, frame_time: f64) -> Result<u32, Error> {
+        either!(self, s => s.advance(frame_time))
+    }
+
+    /// [`Sandbox::shapes`].
+    pub fn shapes(&self, out: &mut Vec<f64>) -> usize {
+        either!(self, s => s.shapes(out))
+    }
+
+    /// [`Sandbox::grab`].
+    #[must_use]
+    pub fn grab(&self, x: f64, y: f64) -> Option<u32> {
+        either!(self, s => s.grab(x, y))
+    }
+
+    /// [`Sandbox::throw`].
+    ///
+    /// # Errors
+    /// As [`Sandbox::throw`].
+    pub fn throw(&mut self, key: u32, vx: f64, vy: f64) -> Result<(), Error> {
+        either!(self, s => s.throw(key, vx, vy))
+    }
+
+    /// [`Sandbox::info`].
+    #[must_use]
+    pub fn info(&self) -> [u32; 5] {
+        either!(self, s => s.info())
+    }
+
+    /// Step `i` of the scripted run ([`script_step`]).
+    ///
+    /// # Errors
+    /// As [`script_step`].
+    pub fn script_step(&mut self, i: u32) -> Result<(), Error> {
+        either!(self, s => script_step(s, i))
+    }
+
+    /// [`Sandbox::digest`].
+    #[must_use]
+    pub fn digest(&self) -> u64 {
+        either!(self, s => s.digest())
+    }
+}

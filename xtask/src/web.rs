@@ -13,7 +13,10 @@
 //! console errors, that frames advance, that it loaded the SIMD module, that the scripted
 //! scenario's words and digest and the world's (three balls and a crate in a box), from the
 //! SIMD module and again from the scalar one (the page loaded with `?scalar`), equal the
-//! host's (x86_64, computed here) and the firmware's (under QEMU, `crate::qemu`), and that bad input (a dt of 0 or NaN, an absurd throw) shows the
+//! host's (x86_64, computed here) and the firmware's (under QEMU, `crate::qemu`), that the
+//! sandbox's scripted pile (boxes, balls, pendulums, a chain and ragdolls in one world, a
+//! ragdoll and a box thrown into it; each step timed, the slowest printed as a figure) ends
+//! with the host's digest and never found more contact points than the world's cap, and that bad input (a dt of 0 or NaN, an absurd throw) shows the
 //! library's error, resets the instance and leaves every drawn value finite. It saves
 //! `target/lagrange-web/screenshot.png`.
 //!
@@ -297,10 +300,9 @@ fn test(site: &Path) -> Result<(), String> {
             console.join("\n  ")
         ));
     }
-    failures.extend(compare(
-        &[("wasm simd128", &simd), ("wasm scalar", &scalar)],
-        &firmware,
-    ));
+    let pages = [("wasm simd128", &simd), ("wasm scalar", &scalar)];
+    failures.extend(compare(&pages, &firmware));
+    failures.extend(check_sandbox(&pages));
     println!("xtask web --test: {:.0} s", clock.elapsed().as_secs_f64());
     if failures.is_empty() {
         println!("xtask web --test: all checks passed");
@@ -496,7 +498,7 @@ fn drive(
 /// The scripted scenario's lines of a page's state, by precision.
 fn scenario_lines(state: &Json) -> BTreeMap<String, String> {
     let scenario = state.get("scenario");
-    SCENARIOS
+    let mut lines: BTreeMap<String, String> = SCENARIOS
         .iter()
         .map(|(key, ..)| *key)
         .filter_map(|p| {
@@ -505,7 +507,80 @@ fn scenario_lines(state: &Json) -> BTreeMap<String, String> {
                 .str()
                 .map(|s| (p.to_string(), s.to_string()))
         })
-        .collect()
+        .collect();
+    // The sandbox's scripted pile, as a line of the same map.
+    let pile = state.get("sandbox");
+    if let (Some(precision), Some(digest)) = (pile.get("precision").str(), pile.get("digest").str())
+    {
+        let number = |key: &str| pile.get(key).num().unwrap_or(f64::NAN);
+        lines.insert(
+            SANDBOX.into(),
+            format!(
+                "{precision} steps={} digest={digest} slowest_ms={} worst={} cap={} failed={}",
+                number("steps"),
+                number("slowestMs"),
+                number("worst"),
+                number("cap"),
+                pile.get("failed").str().unwrap_or("no"),
+            ),
+        );
+    }
+    lines
+}
+
+/// The key of the sandbox's scripted pile among the page's lines.
+const SANDBOX: &str = "sandbox";
+
+/// Checks the sandbox's scripted pile on each page: its digest the host's (`f64`), no step
+/// beyond the contact cap, and prints its slowest step (a figure, not a check).
+fn check_sandbox(pages: &[(&str, &BTreeMap<String, String>)]) -> Vec<String> {
+    let mut failures = Vec::new();
+    let host = match lagrange_web::sandbox::scripted::<f64>(lagrange_web::sandbox::SCRIPT_STEPS) {
+        Ok(digest) => format!("{digest:016x}"),
+        Err(e) => return vec![format!("sandbox: the host's scripted pile failed: {e}")],
+    };
+    println!(
+        "\nsandbox, the scripted pile (f64, {} steps): digest",
+        lagrange_web::sandbox::SCRIPT_STEPS
+    );
+    let mut shown = vec![format!("host x86_64 {host}")];
+    for (name, lines) in pages {
+        let Some(line) = lines.get(SANDBOX) else {
+            failures.push(format!("sandbox: the {name} page ran no scripted pile"));
+            continue;
+        };
+        let field = |key: &str| {
+            line.split_whitespace()
+                .find_map(|f| f.strip_prefix(key).and_then(|v| v.strip_prefix('=')))
+                .unwrap_or("")
+        };
+        shown.push(format!("{name} (Chromium) {}", field("digest")));
+        let slowest = field("slowest_ms").parse::<f64>().unwrap_or(f64::NAN);
+        println!(
+            "  {name}: slowest step {slowest:.2} ms in WebAssembly; most contact points in a \
+             step {} (cap {})",
+            field("worst"),
+            field("cap")
+        );
+        if field("failed") != "no" {
+            failures.push(format!(
+                "sandbox: the {name} page's scripted pile failed: {line}"
+            ));
+        }
+        if !line.starts_with("f64 ") || field("digest") != host {
+            failures.push(format!(
+                "sandbox: the {name} page's scripted pile differs from the host's: page {line:?}, host {host}"
+            ));
+        }
+        let (worst, cap) = (field("worst").parse::<f64>(), field("cap").parse::<f64>());
+        if !matches!((worst, cap), (Ok(w), Ok(c)) if w > 0.0 && w <= c) {
+            failures.push(format!(
+                "sandbox: the {name} page's pile did more work than its cap, or none: {line}"
+            ));
+        }
+    }
+    println!("  {}", shown.join("  "));
+    failures
 }
 
 /// The page loaded again with `?scalar`, which makes it take the module without SIMD (what a
@@ -524,7 +599,7 @@ fn scalar_scenario(browser: &mut Browser, url: &str) -> Result<BTreeMap<String, 
         READY_DEADLINE,
         |state| {
             state.get("build").str() == Some("scalar")
-                && scenario_lines(state).len() == SCENARIOS.len()
+                && scenario_lines(state).len() == SCENARIOS.len() + 1
         },
     )?;
     println!("page: loaded again with ?scalar: the scalar module");
