@@ -482,7 +482,101 @@ fn refuses_bad_input<T: Real>() -> Result<(), Error> {
     Ok(())
 }
 
+/// The settings keep what they were given: the slop, the sweeps, the margin (`4 slop` unless
+/// set), and a sleeping rule only where both its speed and its time are above zero.
+fn settings_keep_what_they_were_given<T: Real>() -> Result<(), Error> {
+    let model = ContactModel::new(T::zero(), T::one(), T::one())?;
+    let s = WorldSettings::new(model, T::from_f64(0.25), 7)?;
+    assert_eq!(
+        (s.slop(), s.sweeps(), s.margin()),
+        (T::from_f64(0.25), 7, T::one())
+    );
+    let wider = s.with_margin(T::from_f64(2.5))?;
+    assert_eq!(wider.margin(), T::from_f64(2.5));
+    assert_eq!((wider.slop(), wider.sweeps()), (T::from_f64(0.25), 7));
+    for (speed, time, name) in [
+        (-1.0, 1.0, "speed"),
+        (1.0, 0.0, "time"),
+        (1.0, -1.0, "time"),
+    ] {
+        assert!(
+            matches!(
+                s.with_sleep(T::from_f64(speed), T::from_f64(time)),
+                Err(Error::InvalidParameter { name: n, .. }) if n == name
+            ),
+            "{speed} {time}"
+        );
+    }
+    Ok(())
+}
+
+/// Rays against a box on the floor between two walls (keys: the right wall 7, the left 8, the
+/// floor 9; the box's shape 20), worked by hand: straight down onto the box's top at 4 m; down
+/// beside it onto the floor; along the floor to the right wall 3 m away, its normal facing
+/// back; none away from every surface, none beyond `t_max`, none from inside a half-plane
+/// looking out, none along a wall; where a wall and the floor meet the ray at once (at their
+/// corner), the lesser key. A point query: on the box's face, inside it, in the wall.
+fn rays_and_points<T: Real>() -> Result<(), Error> {
+    let mut world = Box::new(Bodies::<T>::new(stacking::<T>()?));
+    world.add_plane(
+        7,
+        HalfPlane::new([-T::one(), T::zero()], T::from_f64(-3.0))?,
+    )?;
+    world.add_plane(8, HalfPlane::new([T::one(), T::zero()], T::from_f64(-3.0))?)?;
+    world.add_plane(9, HalfPlane::floor())?;
+    let body = RigidBody::rectangle(T::one(), T::one(), T::one(), T::from_f64(G))?;
+    let q = [0.0, 0.5, 0.0].map(T::from_f64);
+    world.add_body(1, body, State::new(T::zero(), q, [T::zero(); 3]))?;
+    world.add_shape(20, 1, 0, Shape::rectangle(T::one(), T::one())?)?;
+    let v = |x: f64, y: f64| [T::from_f64(x), T::from_f64(y)];
+    let hit = |o: [T; 2], d: [T; 2], t_max: f64| {
+        world.ray(o, d, T::from_f64(t_max)).map(|h| {
+            (
+                h.shape,
+                h.hit.t.to_f64(),
+                h.hit.point.map(|x| x.to_f64()),
+                h.hit.normal.map(|x| x.to_f64()),
+            )
+        })
+    };
+    let close = |got: Option<(u32, f64, [f64; 2], [f64; 2])>,
+                 want: (u32, f64, [f64; 2], [f64; 2])| {
+        let tol = pick::<T>(1e-6, 1e-12);
+        let Some((shape, t, p, n)) = got else {
+            return false;
+        };
+        shape == want.0
+            && (t - want.1).abs() < tol
+            && (p[0] - want.2[0]).abs() < tol
+            && (p[1] - want.2[1]).abs() < tol
+            && (n[0] - want.3[0]).abs() < tol
+            && (n[1] - want.3[1]).abs() < tol
+    };
+    let got = hit(v(0.2, 5.0), v(0.0, -1.0), 10.0);
+    assert!(close(got, (20, 4.0, [0.2, 1.0], [0.0, 1.0])), "{got:?}");
+    let got = hit(v(2.0, 5.0), v(0.0, -1.0), 10.0);
+    assert!(close(got, (9, 5.0, [2.0, 0.0], [0.0, 1.0])), "{got:?}");
+    let got = hit(v(0.0, 2.0), v(1.0, 0.0), 10.0);
+    assert!(close(got, (7, 3.0, [3.0, 2.0], [-1.0, 0.0])), "{got:?}");
+    let got = hit(v(0.0, 2.0), v(-2.0, 0.0), 10.0);
+    assert!(close(got, (8, 1.5, [-3.0, 2.0], [1.0, 0.0])), "{got:?}");
+    assert_eq!(hit(v(0.0, 2.0), v(0.0, 1.0), 10.0), None);
+    assert_eq!(hit(v(2.0, 5.0), v(0.0, -1.0), 4.9), None);
+    assert_eq!(hit(v(2.0, -1.0), v(0.0, -1.0), 10.0), None);
+    assert_eq!(hit(v(3.5, 2.0), v(1.0, 0.0), 10.0), None);
+    assert_eq!(hit(v(2.0, 2.0), v(0.0, 1.0), 10.0), None);
+    let got = hit(v(2.0, 1.0), v(1.0, -1.0), 10.0);
+    assert!(close(got, (7, 1.0, [3.0, 0.0], [-1.0, 0.0])), "{got:?}");
+    assert_eq!(world.shape_at(v(0.5, 0.5)), Some(20));
+    assert_eq!(world.shape_at(v(0.0, 0.25)), Some(20));
+    assert_eq!(world.shape_at(v(3.5, 2.0)), Some(7));
+    assert_eq!(world.shape_at(v(2.0, 2.0)), None);
+    Ok(())
+}
+
 for_f32_and_f64!(
+    settings_keep_what_they_were_given,
+    rays_and_points,
     momentum_and_restitution,
     pyramid_stands_ten_seconds,
     pyramid_falls_asleep_and_wakes,
