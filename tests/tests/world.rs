@@ -511,7 +511,9 @@ fn settings_keep_what_they_were_given<T: Real>() -> Result<(), Error> {
 }
 
 /// Rays against a box on the floor between two walls (keys: the right wall 7, the left 8, the
-/// floor 9; the box's shape 20), worked by hand: straight down onto the box's top at 4 m; down
+/// floor 9; the box's shape 20) and a ball above it (21), worked by hand: straight down onto
+/// the box's top at 4 m, or onto the ball where it lies over the box (the nearer, not the
+/// lesser key); down
 /// beside it onto the floor; along the floor to the right wall 3 m away, its normal facing
 /// back; none away from every surface, none beyond `t_max`, none from inside a half-plane
 /// looking out, none along a wall; where a wall and the floor meet the ray at once (at their
@@ -528,6 +530,11 @@ fn rays_and_points<T: Real>() -> Result<(), Error> {
     let q = [0.0, 0.5, 0.0].map(T::from_f64);
     world.add_body(1, body, State::new(T::zero(), q, [T::zero(); 3]))?;
     world.add_shape(20, 1, 0, Shape::rectangle(T::one(), T::one())?)?;
+    // A ball held 2.5 m above the box's centre (no gravity acts: the world is not stepped).
+    let ball = RigidBody::disk(T::one(), T::from_f64(0.25), T::from_f64(G))?;
+    let q = [0.0, 3.0, 0.0].map(T::from_f64);
+    world.add_body(2, ball, State::new(T::zero(), q, [T::zero(); 3]))?;
+    world.add_shape(21, 2, 0, Shape::circle(T::from_f64(0.25))?)?;
     let v = |x: f64, y: f64| [T::from_f64(x), T::from_f64(y)];
     let hit = |o: [T; 2], d: [T; 2], t_max: f64| {
         world.ray(o, d, T::from_f64(t_max)).map(|h| {
@@ -552,19 +559,23 @@ fn rays_and_points<T: Real>() -> Result<(), Error> {
             && (n[0] - want.3[0]).abs() < tol
             && (n[1] - want.3[1]).abs() < tol
     };
+    let got = hit(v(0.4, 5.0), v(0.0, -1.0), 10.0);
+    assert!(close(got, (20, 4.0, [0.4, 1.0], [0.0, 1.0])), "{got:?}");
+    // Straight down through the ball above the box: the ball first (at 5 - 3.15 m), though
+    // the box's key is the lesser.
     let got = hit(v(0.2, 5.0), v(0.0, -1.0), 10.0);
-    assert!(close(got, (20, 4.0, [0.2, 1.0], [0.0, 1.0])), "{got:?}");
+    assert!(close(got, (21, 1.85, [0.2, 3.15], [0.8, 0.6])), "{got:?}");
     let got = hit(v(2.0, 5.0), v(0.0, -1.0), 10.0);
     assert!(close(got, (9, 5.0, [2.0, 0.0], [0.0, 1.0])), "{got:?}");
     let got = hit(v(0.0, 2.0), v(1.0, 0.0), 10.0);
     assert!(close(got, (7, 3.0, [3.0, 2.0], [-1.0, 0.0])), "{got:?}");
     let got = hit(v(0.0, 2.0), v(-2.0, 0.0), 10.0);
     assert!(close(got, (8, 1.5, [-3.0, 2.0], [1.0, 0.0])), "{got:?}");
-    assert_eq!(hit(v(0.0, 2.0), v(0.0, 1.0), 10.0), None);
+    assert_eq!(hit(v(-2.0, 2.0), v(0.0, 1.0), 10.0), None);
     assert_eq!(hit(v(2.0, 5.0), v(0.0, -1.0), 4.9), None);
     assert_eq!(hit(v(2.0, -1.0), v(0.0, -1.0), 10.0), None);
     assert_eq!(hit(v(3.5, 2.0), v(1.0, 0.0), 10.0), None);
-    assert_eq!(hit(v(2.0, 2.0), v(0.0, 1.0), 10.0), None);
+    assert_eq!(hit(v(3.0, 2.0), v(0.0, 1.0), 10.0), None);
     let got = hit(v(2.0, 1.0), v(1.0, -1.0), 10.0);
     assert!(close(got, (7, 1.0, [3.0, 0.0], [-1.0, 0.0])), "{got:?}");
     assert_eq!(world.shape_at(v(0.5, 0.5)), Some(20));
