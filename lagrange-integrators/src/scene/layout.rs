@@ -2,7 +2,8 @@
 //! [`OneByOne`] (any mechanism) or [`InLanes`] (a mechanism that [`Gather`]s).
 
 use super::awake::Awake;
-use super::states::{LaneStates, Rows, States};
+use super::columns::Columns;
+use super::states::{Rows, States};
 use crate::Integrator;
 use core::fmt::Debug;
 use lagrange_core::{Gather, Mechanism, Real, VECTOR_UNIT};
@@ -262,4 +263,26 @@ where
         Some(()) => 0,
         None => awake.step_each(at, count, dt, t),
     }
+}
+
+/// The storage of a bank in lanes on the target built for: [`Columns`] where it steps
+/// [`LANES`] instances side by side, [`Rows`] where it steps them one by one.
+pub type LaneStates<T, const N: usize, const K: usize> =
+    <Pick<{ LANES > 1 }> as Storage<T, N, K>>::States;
+
+/// Chooses [`LaneStates`] by whether lanes are used.
+pub struct Pick<const COLUMNS: bool>;
+
+/// The storage [`Pick`] chooses.
+pub trait Storage<T: Real, const N: usize, const K: usize> {
+    /// Columns or rows.
+    type States: States<T, N, K>;
+}
+
+impl<T: Real, const N: usize, const K: usize> Storage<T, N, K> for Pick<true> {
+    type States = Columns<T, N, K>;
+}
+
+impl<T: Real, const N: usize, const K: usize> Storage<T, N, K> for Pick<false> {
+    type States = Rows<T, N, K>;
 }

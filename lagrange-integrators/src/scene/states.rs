@@ -1,10 +1,9 @@
 //! [`States`]: how a bank stores its instances' states, by place: as rows ([`Rows`], one
 //! `State` per instance, what stepping one by one reads) or as columns
 //! ([`Columns`](super::columns::Columns), one array per component, what stepping in lanes
-//! reads); and [`LaneStates`], the one a bank in lanes uses on the target built for.
+//! reads). Which of the two a bank in lanes uses is its layout's choice
+//! ([`LaneStates`](super::layout::LaneStates)).
 
-use super::columns::Columns;
-use super::layout::LANES;
 use lagrange_core::nalgebra::SVector;
 use lagrange_core::{Lanes, Real, State};
 
@@ -110,7 +109,7 @@ impl<T: Real, const N: usize, const K: usize> States<T, N, K> for Rows<T, N, K> 
         }
     }
 
-    /// Lane by lane (a bank steps in lanes from rows nowhere: [`LaneStates`] are columns
+    /// Lane by lane (a bank steps in lanes from rows nowhere: [`LaneStates`](super::layout::LaneStates) are columns
     /// where it does).
     fn window<const L: usize>(&self, at: usize, count: usize) -> State<Lanes<T, L>, N> {
         let rows: [State<T, N>; L] =
@@ -133,26 +132,4 @@ impl<T: Real, const N: usize, const K: usize> States<T, N, K> for Rows<T, N, K> 
             self.set(at.saturating_add(i), &row);
         }
     }
-}
-
-/// The storage of a bank in lanes on the target built for: [`Columns`] where it steps
-/// [`LANES`] instances side by side, [`Rows`] where it steps them one by one.
-pub type LaneStates<T, const N: usize, const K: usize> =
-    <Pick<{ LANES > 1 }> as Storage<T, N, K>>::States;
-
-/// Chooses [`LaneStates`] by whether lanes are used.
-pub struct Pick<const COLUMNS: bool>;
-
-/// The storage [`Pick`] chooses.
-pub trait Storage<T: Real, const N: usize, const K: usize> {
-    /// Columns or rows.
-    type States: States<T, N, K>;
-}
-
-impl<T: Real, const N: usize, const K: usize> Storage<T, N, K> for Pick<true> {
-    type States = Columns<T, N, K>;
-}
-
-impl<T: Real, const N: usize, const K: usize> Storage<T, N, K> for Pick<false> {
-    type States = Rows<T, N, K>;
 }
