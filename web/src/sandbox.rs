@@ -132,22 +132,18 @@ impl<T: Real> Sandbox<T> {
             key += 1;
             Ok(())
         };
+        // A box or a ball at (x, y), at rest, with its one shape.
+        let mut rigid = |s: &mut Self, body: RigidBody<T>, shape: Shape<T>, x: f64, y: f64| {
+            let kind = small(OneOf::First(body));
+            add(s, kind, &[x, y], Kind::Rigid, [0.0; 2], &[(0, shape)], free)
+        };
         // A pyramid of four rows of 0.5 m boxes on the left.
         for row in 0..4u32 {
             for col in 0..(4 - row) {
                 let x = -3.2 + 0.55 * f64::from(col) + 0.275 * f64::from(row);
                 let y = 0.25 + 0.5 * f64::from(row);
                 let crate_ = RigidBody::rectangle(T::one(), T::HALF, T::HALF, T::from_f64(9.81))?;
-                let shape = Shape::rectangle(T::HALF, T::HALF)?;
-                add(
-                    &mut s,
-                    small(OneOf::First(crate_)),
-                    &[x, y],
-                    Kind::Rigid,
-                    [0.0; 2],
-                    &[(0, shape)],
-                    free,
-                )?;
+                rigid(&mut s, crate_, Shape::rectangle(T::HALF, T::HALF)?, x, y)?;
             }
         }
         // Six balls dropped in the middle.
@@ -156,16 +152,7 @@ impl<T: Real> Sandbox<T> {
             let ball = RigidBody::disk(T::from_f64(0.5), T::from_f64(r), T::from_f64(9.81))?;
             let x = -0.6 + 0.3 * f64::from(k);
             let y = 2.5 + 0.5 * f64::from(k % 2);
-            let shape = Shape::circle(T::from_f64(r))?;
-            add(
-                &mut s,
-                small(OneOf::First(ball)),
-                &[x, y],
-                Kind::Rigid,
-                [0.0; 2],
-                &[(0, shape)],
-                free,
-            )?;
+            rigid(&mut s, ball, Shape::circle(T::from_f64(r))?, x, y)?;
         }
         // Two pendulums hanging from the ceiling, one pulled aside.
         for (k, angle) in [(0u32, 0.0), (1, 0.9)] {
