@@ -69,6 +69,6 @@ pub use shape::{Shape, MAX_VERTICES};
 pub use shape_pairs::{OnLink, ShapePairs};
 pub use vec2::Vec2;
 pub use world::{
-    ContactEvent, CoordinateLimits, Limits, NoLimits, PlacedShape, World, WorldHit, WorldReport,
-    WorldSettings, MAX_OWN_ROWS, MAX_PLANES,
+    Clock, ContactEvent, CoordinateLimits, Limits, NoLimits, PlacedShape, Profile, World, WorldHit,
+    WorldReport, WorldSettings, MAX_OWN_ROWS, MAX_PLANES,
 };

@@ -8,7 +8,7 @@ use lagrange_core::constraints::contact::ContactModel;
 use lagrange_core::{Error, Lagrangian, Real, State};
 use lagrange_systems::{RigidBody, SimplePendulum};
 use lagrange_tests::{for_f32_and_f64, pick};
-use lagrange_world::{collide, HalfPlane, Shape, World, WorldSettings};
+use lagrange_world::{collide, HalfPlane, Profile, Shape, World, WorldSettings};
 
 const G: f64 = 9.81;
 
@@ -257,6 +257,49 @@ fn the_order_bodies_were_added_in_does_not_matter<T: Real>() -> Result<(), Error
     for key in 0..count {
         assert_eq!(a.state(key), b.state(key), "box {key}");
     }
+    Ok(())
+}
+
+/// A clock that ticks once a read.
+fn ticks() -> u64 {
+    use std::sync::atomic::{AtomicU64, Ordering};
+    static TICKS: AtomicU64 = AtomicU64::new(0);
+    TICKS.fetch_add(1, Ordering::Relaxed)
+}
+
+/// A world given a clock (`World::set_clock`) steps to the same bits as one without: a
+/// pyramid of 21 boxes settling for 2 s. Its profile reads the clock at least once after each
+/// part of every step (each part at least one tick a step); the world without reads none
+/// (every part zero).
+fn a_clock_changes_no_bits<T: Real>() -> Result<(), Error> {
+    let (mut timed, count) = pyramid(stacking::<T>()?, 6, false)?;
+    let (mut plain, _) = pyramid(stacking::<T>()?, 6, false)?;
+    timed.set_clock(Some(ticks));
+    let steps = 120;
+    let (mut with, mut without) = (Profile::default(), Profile::default());
+    for _ in 0..steps {
+        with = with.plus(&timed.step(T::from_f64(1.0 / 60.0))?.profile);
+        without = without.plus(&plain.step(T::from_f64(1.0 / 60.0))?.profile);
+    }
+    for key in 0..count {
+        assert_eq!(timed.state(key), plain.state(key), "box {key}");
+    }
+    for part in [
+        with.free,
+        with.broad,
+        with.narrow,
+        with.solve,
+        with.drift,
+        with.sleep,
+    ] {
+        assert!(part >= steps, "{with:?}");
+    }
+    assert_eq!(without, Profile::default());
+    timed.set_clock(None);
+    assert_eq!(
+        timed.step(T::from_f64(1.0 / 60.0))?.profile,
+        Profile::default()
+    );
     Ok(())
 }
 
@@ -592,6 +635,7 @@ for_f32_and_f64!(
     pyramid_stands_ten_seconds,
     pyramid_falls_asleep_and_wakes,
     the_order_bodies_were_added_in_does_not_matter,
+    a_clock_changes_no_bits,
     events_and_queries,
     newtons_cradle,
     refuses_bad_input

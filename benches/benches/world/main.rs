@@ -46,17 +46,11 @@
 //! contact manifolds (the poses its collision detection saw, those at the step's start: the
 //! previous step's end).
 //!
-//! **Where lagrange's time goes.** The `World` reports counts ([`WorldReport`]: contacts,
-//! islands, awake, asleep, woke, guarded), no times per phase. The Markdown gives the mean
-//! contacts and islands a step, and the outside probe's own times: its broad phase (the
-//! shapes placed and boxed, `BroadPhase::pairs`) and its narrow phase (`collide` on the
-//! pairs, every shape against every wall). These redo what step 2 of a `World` step does
-//! with the same public functions on the same configuration (the broad phase's filling,
-//! `BroadPhase::add` of every shape, timed apart), so they estimate its detection
-//! (without the rows' Jacobians and mobilities, which the `World` builds per contact point
-//! as part of detection); the remainder of a step (free motion, rows, impulse solve, drift,
-//! islands and sleep, events, the step's copy of the bodies for its rollback) is
-//! `ns_per_step` less the two. An estimate from outside, not the `World`'s own counters.
+//! **Where lagrange's time goes.** In the untimed run each lagrange world is given a clock
+//! (`World::set_clock`, nanoseconds since the bench started) and its own profile
+//! (`WorldReport::profile`: free, broad, narrow, solve, drift, sleep) is averaged over the
+//! steps; the Markdown gives the means a step, with the mean contacts and islands. The timed
+//! rounds read no clock inside a step.
 //!
 //! Output under `target/lagrange-bench/`: `world.csv`
 //! (`scene,engine,scalar,bodies,awake,ns_per_step,max_penetration`) and `world.md` (the
@@ -162,8 +156,9 @@ fn timed(sim: &mut dyn Sim, steps: usize) -> Result<f64, String> {
     Ok(clock.elapsed().as_nanos() as f64)
 }
 
-/// The untimed run: `steps` steps, the world probed after each.
+/// The untimed run: `steps` steps, the world probed after each, its parts timed.
 fn figures(sim: &mut dyn Sim, steps: usize) -> Result<(f64, f64, Probe), String> {
+    sim.time_parts();
     let (mut awake, mut depth) = (0.0, 0.0_f64);
     let mut sums = Probe::default();
     let add = |sum: &mut Option<f64>, x: Option<f64>| {
@@ -178,9 +173,12 @@ fn figures(sim: &mut dyn Sim, steps: usize) -> Result<(f64, f64, Probe), String>
         depth = depth.max(p.depth);
         add(&mut sums.contacts, p.contacts);
         add(&mut sums.islands, p.islands);
-        add(&mut sums.broad_ns, p.broad_ns);
-        add(&mut sums.fill_ns, p.fill_ns);
-        add(&mut sums.narrow_ns, p.narrow_ns);
+        if let Some(parts) = p.parts_ns {
+            let sum = sums.parts_ns.get_or_insert([0.0; 6]);
+            for (s, x) in sum.iter_mut().zip(parts) {
+                *s += x;
+            }
+        }
     }
     let n = steps.max(1) as f64;
     let mean = |x: Option<f64>| x.map(|x| x / n);
@@ -191,9 +189,7 @@ fn figures(sim: &mut dyn Sim, steps: usize) -> Result<(f64, f64, Probe), String>
             depth,
             contacts: mean(sums.contacts),
             islands: mean(sums.islands),
-            broad_ns: mean(sums.broad_ns),
-            fill_ns: mean(sums.fill_ns),
-            narrow_ns: mean(sums.narrow_ns),
+            parts_ns: sums.parts_ns.map(|p| p.map(|x| x / n)),
         },
     ))
 }

@@ -142,10 +142,9 @@ pub fn markdown(quick: bool, rows: &[Row], seconds: f64) -> String {
          whole run (median over rounds beside it). awake: mean over the steps of the bodies \
          awake after each. depth: the deepest overlap after any step, mm (lagrange: found \
          again from outside; rapier2d: its contact manifolds). contacts, islands: means \
-         over the steps of lagrange's `WorldReport`. broad, narrow: lagrange's detection \
-         redone from outside with its public `BroadPhase` and `collide` on the same \
-         configuration, ns a step (an estimate; see the notes); rest: ns/step less the \
-         two.\n",
+         over the steps of lagrange's `WorldReport`. free ... sleep: where a lagrange step's \
+         time goes, ns a step, the means of the `World`'s own profile (`WorldReport::profile`, \
+         its clock reading nanoseconds) over the untimed run (see the notes).\n",
         if quick {
             "**Quick run** (not for figures): "
         } else {
@@ -154,26 +153,19 @@ pub fn markdown(quick: bool, rows: &[Row], seconds: f64) -> String {
     );
     md.push_str(
         "| scene | engine | scalar | bodies | awake | ns/step | median ns/step | depth mm | \
-         contacts | islands | broad ns | of which fill ns | narrow ns | rest ns | notes |\n\
-         |---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|\n",
+         contacts | islands | free | broad | narrow | solve | drift | sleep | notes |\n\
+         |---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|\n",
     );
     for r in rows {
         let p = &r.probe;
-        let rest = r
-            .ns_per_step
-            .zip(p.broad_ns)
-            .zip(p.narrow_ns)
-            .map(|((t, b), n)| t - b - n)
-            // The probe does more than an asleep world's step (it places and collides
-            // every shape): no remainder to give.
-            .filter(|&rest| rest >= 0.0);
+        let part = |k: usize| p.parts_ns.map(|parts| parts[k]);
         let mut notes = r.note.clone();
         if let Some(f) = &r.failure {
             notes = format!("{notes} FAILED: {f}").trim().to_string();
         }
         let _ = writeln!(
             md,
-            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
             r.scene,
             r.engine,
             r.scalar,
@@ -184,10 +176,12 @@ pub fn markdown(quick: bool, rows: &[Row], seconds: f64) -> String {
             cell(r.depth.map(|d| d * 1e3), 2),
             cell(p.contacts, 0),
             cell(p.islands, 1),
-            cell(p.broad_ns, 0),
-            cell(p.fill_ns, 0),
-            cell(p.narrow_ns, 0),
-            cell(rest, 0),
+            cell(part(0), 0),
+            cell(part(1), 0),
+            cell(part(2), 0),
+            cell(part(3), 0),
+            cell(part(4), 0),
+            cell(part(5), 0),
             notes,
         );
     }
@@ -199,24 +193,16 @@ pub fn markdown(quick: bool, rows: &[Row], seconds: f64) -> String {
         "\nRatios are lagrange's ns per step over rapier2d's (or awake over asleep), on the \
          fastest rounds; the medians' ratio beside them.\n\n\
          ## Where lagrange's time goes\n\n\
-         The `World` exposes counts (`WorldReport`: contacts solved, islands, awake, asleep, \
-         woke, guarded), not times per phase, and this bench does not change the library. \
-         The broad and narrow columns are therefore the same detection redone from outside \
-         on the same configuration after each step: every shape placed at its body's state \
-         and boxed (grown by the speculative margin, not by each body's reach in the step as \
-         the `World` also does), paired by the public `BroadPhase`, and collided with the \
-         public `collide` (pairs) and `collide_half_plane` (every shape against every wall; \
-         the `World` skips asleep ones). The `World`'s own detection does this and more: it \
-         also builds each contact point's rows (Jacobians, mobilities: a mass solve per \
-         body), which falls in the rest, with the free motion, the impulse solve, the drift, \
-         islands and sleeping, events and the copy of the bodies each step keeps to roll a \
-         failed step back. For an asleep pile the rest is that copy, the sleeping pass and \
-         the events; the broad phase still boxes and sorts every shape.\n\n\
-         The fill column is the part of the broad phase spent adding the boxes: \
-         `BroadPhase::add` checks a new proxy's key against every proxy already in (a linear \
-         scan), so filling it is quadratic in the shapes, and the `World` refills it every \
-         step (`World::step`, detection). Where it is most of the broad column (1,000 balls, \
-         50 ragdolls, asleep or not) that scan is what the broad phase costs.\n\n\
+         Each lagrange row's last six columns are the `World`'s own profile \
+         (`World::set_clock` given a nanosecond clock; `WorldReport::profile`), averaged over \
+         the untimed run after the timed rounds: free (each awake body's own law, and the \
+         copy of the bodies a failed step is rolled back to), broad (every shape's box, \
+         grown by the margin and how far its body moves, and the sweep and prune), narrow \
+         (each pair's manifold, the half-planes', the bodies' own rows such as joint limits, \
+         and every contact point's rows: Jacobians and mobilities through the bodies' mass \
+         solves), solve (the impulses' sweeps, the energy guard), drift (the split impulses \
+         and the move), sleep (islands, sleeping, events). Their sum is a little above \
+         ns/step (eight clock reads a step, and a run that is not the fastest round).\n\n\
          ## Peer\n\n\
          rapier2d 0.36 (`f32`; its `f64` build is the separate crate `rapier2d-f64`, not a \
          dependency here), default features, the bench profile (release, thin LTO, one \

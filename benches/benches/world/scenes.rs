@@ -3,7 +3,6 @@
 //! bodies and probes it from outside (the deepest overlap, found again with the crate's own
 //! public broad and narrow phases, each timed).
 
-use std::hint::black_box;
 use std::time::Instant;
 
 use lagrange_core::constraints::contact::ContactModel;
@@ -198,14 +197,9 @@ pub struct Probe {
     pub contacts: Option<f64>,
     /// Islands of awake bodies in the step (lagrange's `WorldReport::islands`).
     pub islands: Option<f64>,
-    /// ns of the outside broad phase: the shapes' boxes (grown by the speculative margin)
-    /// into a `BroadPhase`, and its pairs.
-    pub broad_ns: Option<f64>,
-    /// Of which the filling: each shape placed, boxed and `BroadPhase::add`ed.
-    pub fill_ns: Option<f64>,
-    /// ns of the outside narrow phase: `collide` on those pairs and `collide_half_plane` of
-    /// every shape on every wall.
-    pub narrow_ns: Option<f64>,
+    /// ns of each part of the step, as the `World`'s own profile reports them (its clock
+    /// set by [`Sim::time_parts`]): free, broad, narrow, solve, drift, sleep.
+    pub parts_ns: Option<[f64; 6]>,
 }
 
 /// A world of either engine, as the bench drives it.
@@ -219,6 +213,15 @@ pub trait Sim {
     fn awake(&self) -> usize;
     /// The deepest overlap now, and what else the engine tells.
     fn probe(&mut self) -> Probe;
+    /// From now on, time the parts of each step where the engine can say them (lagrange's
+    /// `World::set_clock`); the timed runs never do.
+    fn time_parts(&mut self) {}
+}
+
+/// Nanoseconds since the first call: the clock a lagrange world's profile is read from.
+fn nanos() -> u64 {
+    static START: std::sync::OnceLock<Instant> = std::sync::OnceLock::new();
+    u64::try_from(START.get_or_init(Instant::now).elapsed().as_nanos()).unwrap_or(u64::MAX)
 }
 
 /// A lagrange world, its bodies all of one mechanism, and what its probe needs: the
@@ -255,7 +258,6 @@ where
 
     fn probe(&mut self) -> Probe {
         let margin = self.world.settings().margin();
-        let clock = Instant::now();
         let mut placed = Vec::with_capacity(self.shapes.len());
         self.broad.clear();
         for (i, &(body, link, shape)) in self.shapes.iter().enumerate() {
@@ -281,10 +283,7 @@ where
             }
             placed.push(p);
         }
-        let fill_ns = clock.elapsed().as_nanos() as f64;
         let pairs_found = self.broad.pairs(&mut *self.pairs).is_ok();
-        let broad_ns = clock.elapsed().as_nanos() as f64;
-        let clock = Instant::now();
         let mut deepest = 0.0_f64;
         for &(a, b) in self.pairs.iter() {
             let (Some(x), Some(y)) = (placed.get(a as usize), placed.get(b as usize)) else {
@@ -299,16 +298,18 @@ where
                 deepest = deepest.max(-m.gap().map_or(0.0, |g| g.to_f64()));
             }
         }
-        let narrow_ns = clock.elapsed().as_nanos() as f64;
-        black_box(deepest);
+        let t = self.report.profile;
+        let parts = [t.free, t.broad, t.narrow, t.solve, t.drift, t.sleep].map(|x| x as f64);
         Probe {
             depth: if pairs_found { deepest } else { f64::NAN },
             contacts: Some(f64::from(self.report.contacts)),
             islands: Some(f64::from(self.report.islands)),
-            broad_ns: Some(broad_ns),
-            fill_ns: Some(fill_ns),
-            narrow_ns: Some(narrow_ns),
+            parts_ns: (t.total() > 0).then_some(parts),
         }
+    }
+
+    fn time_parts(&mut self) {
+        self.world.set_clock(Some(nanos));
     }
 }
 

@@ -3,6 +3,7 @@
 
 use super::bodies::Attached;
 use super::limits::{Limits, MAX_OWN_ROWS};
+use super::profile::{Profile, Stopwatch};
 use super::rows::{Contact, Row};
 use super::{World, OWN_ROWS};
 use crate::broad::Proxy;
@@ -30,11 +31,16 @@ where
 {
     /// The step's contacts, sorted by key, warm-started from the last step's impulses; the
     /// number of bodies woken.
-    pub(super) fn detect(&mut self, dt: T) -> Result<u32, Error> {
+    pub(super) fn detect(
+        &mut self,
+        dt: T,
+        watch: &mut Stopwatch,
+        profile: &mut Profile,
+    ) -> Result<u32, Error> {
         let mut woke = 0;
         loop {
             // A body woken has had no free step; its contacts are found again with it.
-            let woken = self.find(dt)?;
+            let woken = self.find(dt, watch, profile)?;
             if woken == 0 {
                 break;
             }
@@ -49,12 +55,13 @@ where
                 }
             }
         }
+        profile.narrow += watch.lap();
         Ok(woke)
     }
 
     /// One pass of detection; the number of sleeping bodies it woke (their contacts are then
     /// incomplete: the caller finds them again).
-    fn find(&mut self, dt: T) -> Result<u32, Error> {
+    fn find(&mut self, dt: T, watch: &mut Stopwatch, profile: &mut Profile) -> Result<u32, Error> {
         self.contacts.clear();
         self.broad.clear();
         let margin = self.settings.margin;
@@ -78,6 +85,7 @@ where
         }
         let mut pairs: Vec<(u32, u32), K> = Vec::new();
         self.broad.pairs(&mut pairs)?;
+        profile.broad += watch.lap();
         let mut woken = 0;
         for &(ka, kb) in &pairs {
             let (Some(a), Some(b)) = (self.shape_copy(ka), self.shape_copy(kb)) else {
@@ -123,6 +131,7 @@ where
         for i in 0..self.bodies.len() {
             self.own_rows(i, dt)?;
         }
+        profile.narrow += watch.lap();
         Ok(woken)
     }
 

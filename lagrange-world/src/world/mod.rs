@@ -5,11 +5,13 @@ mod bodies;
 mod detect;
 mod islands;
 mod limits;
+mod profile;
 mod rows;
 mod settings;
 mod solve;
 
 pub use limits::{CoordinateLimits, Limits, NoLimits, MAX_OWN_ROWS};
+pub use profile::{Clock, Profile};
 pub use settings::WorldSettings;
 
 use crate::broad::BroadPhase;
@@ -23,6 +25,7 @@ use islands::Islands;
 use lagrange_core::links::Links;
 use lagrange_core::nalgebra::SVector;
 use lagrange_core::{Error, Mechanism, Real, State};
+use profile::Stopwatch;
 use rows::{Contact, Kept};
 
 /// The first key of a body's own rows' contacts, `(OWN_ROWS, body, row)`: a key no shape
@@ -57,6 +60,9 @@ pub struct WorldReport {
     /// at once, or last step's impulses applied again), so that the step was solved again
     /// without them: never more kinetic energy than the free step's.
     pub guarded: bool,
+    /// Where the step's time went, in the ticks of the clock given to
+    /// [`World::set_clock`] (all zero without one).
+    pub profile: Profile,
 }
 
 /// Two shapes began or ended touching (pushing on each other) in the last step.
@@ -201,6 +207,8 @@ pub struct World<
     events: Vec<ContactEvent<T>, K>,
     broad: BroadPhase<T, S>,
     report: WorldReport,
+    /// What the steps' profiles are read from, if anything.
+    clock: Option<Clock>,
 }
 
 impl<T, M, L, const N: usize, const B: usize, const S: usize, const K: usize>
@@ -225,7 +233,44 @@ where
             events: Vec::new(),
             broad: BroadPhase::new(),
             report: WorldReport::default(),
+            clock: None,
         }
+    }
+
+    /// Steps from now on read `clock` before and after each of their parts, and say where
+    /// their time went in [`WorldReport::profile`] (in the clock's ticks); `None` (the
+    /// default) reads no clock. The clock changes no result: the same bits come out with
+    /// and without it.
+    ///
+    /// ```
+    /// use lagrange_core::constraints::contact::ContactModel;
+    /// use lagrange_core::State;
+    /// use lagrange_systems::RigidBody;
+    /// use lagrange_world::{HalfPlane, Shape, World, WorldSettings};
+    ///
+    /// /// A clock that ticks once a read (a desktop would read nanoseconds, firmware a cycle
+    /// /// counter).
+    /// fn reads() -> u64 {
+    ///     use core::sync::atomic::{AtomicU64, Ordering};
+    ///     static TICKS: AtomicU64 = AtomicU64::new(0);
+    ///     TICKS.fetch_add(1, Ordering::Relaxed)
+    /// }
+    ///
+    /// let settings = WorldSettings::new(ContactModel::new(0.2, 0.1, 1e-6)?, 1e-3, 8)?;
+    /// let mut world = World::<f64, RigidBody<f64>, 3, 4, 4, 16>::new(settings);
+    /// world.add_plane(100, HalfPlane::floor())?;
+    /// let body = RigidBody::rectangle(1.0, 0.5, 0.5, 9.81)?;
+    /// world.add_body(1, body, State::new(0.0, [0.0, 1.0, 0.3], [0.0; 3]))?;
+    /// world.add_shape(10, 1, 0, Shape::rectangle(0.5, 0.5)?)?;
+    /// world.set_clock(Some(reads));
+    /// let report = world.step(1.0 / 60.0)?;
+    /// // A read at the start and at least one after each of the six parts.
+    /// assert_eq!(report.profile.free, 1);
+    /// assert!(report.profile.total() >= 6);
+    /// # Ok::<(), lagrange_core::Error>(())
+    /// ```
+    pub fn set_clock(&mut self, clock: Option<Clock>) {
+        self.clock = clock;
     }
 
     /// The settings.
@@ -497,9 +542,10 @@ where
                 reason: "must be positive and finite",
             });
         }
+        let mut watch = Stopwatch::start(self.clock);
         let saved: Vec<Body<T, M, L, N>, B> = self.bodies.clone();
         let kept = self.kept.clone();
-        let result = self.advance(dt);
+        let result = self.advance(dt, &mut watch);
         if result.is_err() {
             self.bodies = saved;
             self.kept = kept;
@@ -508,8 +554,8 @@ where
         result
     }
 
-    /// The step, unchecked.
-    fn advance(&mut self, dt: T) -> Result<WorldReport, Error> {
+    /// The step, unchecked, its parts timed by `watch`.
+    fn advance(&mut self, dt: T, watch: &mut Stopwatch) -> Result<WorldReport, Error> {
         self.kept.clear();
         for c in &self.contacts {
             // Capacity K holds every contact of the last step.
@@ -523,8 +569,13 @@ where
         for body in self.bodies.iter_mut().filter(|b| !b.asleep) {
             body.free(dt)?;
         }
-        report.woke = self.detect(dt)?;
+        let mut profile = Profile {
+            free: watch.lap(),
+            ..Profile::default()
+        };
+        report.woke = self.detect(dt, watch, &mut profile)?;
         report.guarded = self.solve();
+        profile.solve = watch.lap();
         let mut pseudo = [SVector::<T, N>::zeros(); B];
         let velocities: [SVector<T, N>; B] =
             core::array::from_fn(|i| self.bodies.get(i).map_or(SVector::zeros(), |b| b.state.qd));
@@ -552,10 +603,13 @@ where
             body.state.check_finite()?;
             report.awake += 1;
         }
+        profile.drift = watch.lap();
         report.contacts = count(self.contacts.len());
         report.islands = self.sleep(dt);
         report.asleep = count(self.bodies.iter().filter(|b| b.asleep).count());
         self.record_events();
+        profile.sleep = watch.lap();
+        report.profile = profile;
         self.report = report;
         Ok(report)
     }
