@@ -141,20 +141,33 @@ impl<T: Real> RagdollContacts<T> {
     }
 
     /// The Jacobian of every row (floor points' heights, then the limits) and the tangent
-    /// Jacobian (the floor points' horizontal positions; zero rows for the limits).
-    fn rows(
+    /// Jacobian (the floor points' horizontal positions; zero rows for the limits), written
+    /// into `j` and `t` (every entry: nothing of what they held is kept).
+    fn write_rows(
         &self,
         q: &SVector<T, N>,
-    ) -> (
-        SMatrix<T, RAGDOLL_CONTACTS, N>,
-        SMatrix<T, RAGDOLL_CONTACTS, N>,
+        j: &mut SMatrix<T, RAGDOLL_CONTACTS, N>,
+        t: &mut SMatrix<T, RAGDOLL_CONTACTS, N>,
     ) {
-        let points = self.point_jacobians(q);
-        let (mut j, mut t) = (SMatrix::zeros(), SMatrix::zeros());
-        for (i, (dy, dx)) in points.iter().enumerate() {
-            for c in 0..N {
-                j[(i, c)] = dy[c];
-                t[(i, c)] = dx[c];
+        let pose = self.ragdoll.pose(q);
+        // In storage order: nalgebra's `fill` walks a strided iterator an entry at a time.
+        j.as_mut_slice().fill(T::zero());
+        t.as_mut_slice().fill(T::zero());
+        for (i, m) in self.points.iter().enumerate() {
+            let i = i.min(RAGDOLL_CONTACTS - 1);
+            let p = pose.point(m.link, m.along, m.across);
+            j[(i, 1)] = T::one();
+            t[(i, 0)] = T::one();
+            // The torso turns about its centre of mass, the origin of the pose.
+            j[(i, 2)] = p[0];
+            t[(i, 2)] = -p[1];
+            let mut k = m.link;
+            while k != 0 {
+                let link = k.min(RAGDOLL_LINKS - 1);
+                let o = pose.origin[link];
+                j[(i, link + 2)] = p[0] - o[0];
+                t[(i, link + 2)] = -(p[1] - o[1]);
+                k = PARENT[link];
             }
         }
         for joint in 0..RAGDOLL_LINKS - 1 {
@@ -162,30 +175,19 @@ impl<T: Real> RagdollContacts<T> {
             j[(row, joint + 3)] = T::one();
             j[(row + 1, joint + 3)] = -T::one();
         }
-        (j, t)
     }
 
-    /// Floor rows' Jacobians: `(d y_p / dq, d x_p / dq)` for each point.
-    fn point_jacobians(&self, q: &SVector<T, N>) -> [([T; N], [T; N]); RAGDOLL_FLOOR_POINTS] {
-        let pose = self.ragdoll.pose(q);
-        self.points.map(|m| {
-            let p = pose.point(m.link, m.along, m.across);
-            let (mut dy, mut dx) = ([T::zero(); N], [T::zero(); N]);
-            dy[1] = T::one();
-            dx[0] = T::one();
-            // The torso turns about its centre of mass, the origin of the pose.
-            dy[2] = p[0];
-            dx[2] = -p[1];
-            let mut k = m.link;
-            while k != 0 {
-                let link = k.min(RAGDOLL_LINKS - 1);
-                let o = pose.origin[link];
-                dy[link + 2] = p[0] - o[0];
-                dx[link + 2] = -(p[1] - o[1]);
-                k = PARENT[link];
-            }
-            (dy, dx)
-        })
+    /// [`RagdollContacts::write_rows`] into new matrices.
+    fn rows(
+        &self,
+        q: &SVector<T, N>,
+    ) -> (
+        SMatrix<T, RAGDOLL_CONTACTS, N>,
+        SMatrix<T, RAGDOLL_CONTACTS, N>,
+    ) {
+        let (mut j, mut t) = (SMatrix::zeros(), SMatrix::zeros());
+        self.write_rows(q, &mut j, &mut t);
+        (j, t)
     }
 }
 
@@ -255,11 +257,10 @@ impl<T: Real> Contacts<T, N, RAGDOLL_CONTACTS> for RagdollContacts<T> {
     fn jacobians(
         &self,
         q: &SVector<T, N>,
-    ) -> (
-        SMatrix<T, RAGDOLL_CONTACTS, N>,
-        Option<SMatrix<T, RAGDOLL_CONTACTS, N>>,
-    ) {
-        let (j, t) = self.rows(q);
-        (j, Some(t))
+        normal: &mut SMatrix<T, RAGDOLL_CONTACTS, N>,
+        tangent: &mut SMatrix<T, RAGDOLL_CONTACTS, N>,
+    ) -> bool {
+        self.write_rows(q, normal, tangent);
+        true
     }
 }

@@ -2,7 +2,7 @@
 //! directions, each with its mobility through the mechanism's own mass solve), in storage
 //! kept from step to step; and the rows' checks.
 
-use lagrange_core::constraints::contact::Delassus;
+use lagrange_core::constraints::contact::{Contacts, Delassus};
 use lagrange_core::nalgebra::{SMatrix, SVector};
 use lagrange_core::{Error, Mechanism, Real, State};
 
@@ -15,6 +15,10 @@ pub(super) struct Workspace<T: Real, const N: usize, const C: usize> {
     pub(super) normal: Delassus<T, N, C>,
     /// The tangents of the contacts with friction.
     pub(super) tangent: [Option<Direction<T, N>>; C],
+    /// The rows' Jacobian at the step's free state, and their tangents (read where the
+    /// contacts have friction): written in place by [`Contacts::jacobians`].
+    pub(super) jacobian: SMatrix<T, C, N>,
+    pub(super) tangents: SMatrix<T, C, N>,
     /// The columns handed to the mechanism's mass solve.
     jumps: SMatrix<T, N, C>,
 }
@@ -25,12 +29,36 @@ impl<T: Real, const N: usize, const C: usize> Workspace<T, N, C> {
         Self {
             normal: Delassus::empty(),
             tangent: [None; C],
+            jacobian: SMatrix::zeros(),
+            tangents: SMatrix::zeros(),
             jumps: SMatrix::zeros(),
         }
     }
 
-    /// The rows of a step at `state`: the normal rows of `jacobian` in `touching`, and the
-    /// tangents (rows of `tangents`) of the contacts in `frictional`, their mobilities from
+    /// The rows of `contacts` at `q` into [`Workspace::jacobian`] and
+    /// [`Workspace::tangents`]: whether the tangents count (the contacts give them and
+    /// `friction` is on).
+    ///
+    /// # Errors
+    /// [`Error::NonFiniteRow`] for the first row whose Jacobian, or whose tangent where it
+    /// counts and the row is in `frictional`, is not finite.
+    pub(super) fn jacobians<K: Contacts<T, N, C>>(
+        &mut self,
+        contacts: &K,
+        q: &SVector<T, N>,
+        friction: bool,
+        frictional: &[bool; C],
+    ) -> Result<bool, Error> {
+        let tangents = contacts.jacobians(q, &mut self.jacobian, &mut self.tangents) && friction;
+        finite_rows(&self.jacobian, &[true; C])?;
+        if tangents {
+            finite_rows(&self.tangents, frictional)?;
+        }
+        Ok(tangents)
+    }
+
+    /// The rows of a step at `state`: the normal rows of the Jacobian in `touching`, and the
+    /// tangents (with `tangents`) of the contacts in `frictional`, their mobilities from
     /// one call of [`Mechanism::velocity_jumps`] where the tangents fit in the columns the
     /// normal rows leave free (two calls where they do not).
     ///
@@ -40,11 +68,12 @@ impl<T: Real, const N: usize, const C: usize> Workspace<T, N, C> {
         &mut self,
         mechanism: &M,
         state: &State<T, N>,
-        jacobian: &SMatrix<T, C, N>,
-        tangents: Option<&SMatrix<T, C, N>>,
+        tangents: bool,
         touching: &[bool; C],
         frictional: &[bool; C],
     ) -> Result<(), Error> {
+        let jacobian = &self.jacobian;
+        let tangents = tangents.then_some(&self.tangents);
         // Normal rows in their own columns; each tangent in a column no normal row uses.
         let mut slot = [None::<usize>; C];
         let mut spare = (0..C).filter(|&k| !touching[k]);
@@ -155,15 +184,21 @@ impl<T: Real, const N: usize> Direction<T, N> {
     }
 }
 
-/// `rows` when every entry of the rows marked `used` is finite, else
-/// [`Error::NonFiniteRow`] naming the first that is not.
-pub(super) fn finite_rows<T: Real, const N: usize, const C: usize>(
-    rows: SMatrix<T, C, N>,
+/// [`Error::NonFiniteRow`] naming the first of the rows marked `used` with an entry that is
+/// not finite.
+fn finite_rows<T: Real, const N: usize, const C: usize>(
+    rows: &SMatrix<T, C, N>,
     used: &[bool; C],
-) -> Result<SMatrix<T, C, N>, Error> {
+) -> Result<(), Error> {
+    // All finite, the common case, read in storage order (a row of a matrix stored by
+    // columns is read with a stride: nalgebra's strided iterator made this check a quarter
+    // of a resting ragdoll's step).
+    if rows.as_slice().iter().all(|x| x.is_finite()) {
+        return Ok(());
+    }
     match (0..C).find(|&i| used[i] && !rows.row(i).iter().all(|x| x.is_finite())) {
         Some(row) => Err(Error::NonFiniteRow { row }),
-        None => Ok(rows),
+        None => Ok(()),
     }
 }
 

@@ -4,7 +4,7 @@
 
 use super::energy::guard;
 use super::report::ImpulseReport;
-use super::rows::{finite_gaps, finite_rows, Workspace};
+use super::rows::{finite_gaps, Workspace};
 use super::settings::ImpulseSettings;
 use super::solve::{Impulses, Problem, Solved};
 use crate::integrator::continues;
@@ -237,24 +237,17 @@ impl<T: Real, const C: usize, K> Setup<T, C, K> {
                 reason: "more rows are in contact than max_rows allows",
             });
         }
-        let (jacobian, tangents) = self.contacts.jacobians(&free.q);
-        let jacobian = finite_rows(jacobian, &[true; C])?;
         let frictional: [bool; C] = core::array::from_fn(|i| touching[i] && !self.bilateral[i]);
-        let tangents = match tangents {
-            Some(t) if self.model.friction() > T::zero() => Some(finite_rows(t, &frictional)?),
-            _ => None,
-        };
-        work.fill(
-            mechanism,
-            &free,
-            &jacobian,
-            tangents.as_ref(),
-            &touching,
-            &frictional,
-        )?;
+        let friction = self.model.friction() > T::zero();
+        let tangents = work.jacobians(&self.contacts, &free.q, friction, &frictional)?;
+        work.fill(mechanism, &free, tangents, &touching, &frictional)?;
         let Workspace {
-            normal, tangent, ..
+            normal,
+            tangent,
+            jacobian,
+            ..
         } = work;
+        let jacobian = &*jacobian;
         let tangent = &*tangent;
         let kinds = Row::kinds(&self.bilateral);
         // The rows that pushed in the last step: the first guess of each solve's active rows.
@@ -293,7 +286,7 @@ impl<T: Real, const C: usize, K> Setup<T, C, K> {
             if share <= T::zero() || !joining.iter().any(|&j| j) {
                 break;
             }
-            normal.extend(&jacobian, jump, &joining)?;
+            normal.extend(jacobian, jump, &joining)?;
             for i in (0..C).filter(|&i| joining[i]) {
                 target[i] = w[i] - gaps[i] / share;
                 speculative += 1;
@@ -315,9 +308,9 @@ impl<T: Real, const C: usize, K> Setup<T, C, K> {
         };
         let shift = (plastic.velocity - free.qd) * share;
         let (dq, corrected) =
-            self.drift(normal, &jacobian, jacobian * shift + gaps, &kinds, jump)?;
+            self.drift(normal, jacobian, jacobian * shift + gaps, &kinds, jump)?;
         let (q, drift_rounds, held_back) =
-            self.settle(normal, &jacobian, &kinds, jump, &s.q, free.q + shift + dq)?;
+            self.settle(normal, jacobian, &kinds, jump, &s.q, free.q + shift + dq)?;
         let end = State {
             t: free.t,
             q,

@@ -23,10 +23,45 @@ pub trait Contacts<T: Real, const N: usize, const C: usize>: Constraints<T, N, C
     }
 
     /// The Jacobian and the tangent Jacobian together (as [`Constraints::jacobian`] and
-    /// [`Contacts::tangent_jacobian`]): what a contact solver asks for each step. A set whose
-    /// two share work (a ragdoll's link poses and point Jacobians) overrides it.
-    fn jacobians(&self, q: &SVector<T, N>) -> (SMatrix<T, C, N>, Option<SMatrix<T, C, N>>) {
-        (self.jacobian(q), self.tangent_jacobian(q))
+    /// [`Contacts::tangent_jacobian`]), written into `normal` and `tangent`: what a contact
+    /// solver asks for each step, into storage it keeps from step to step: every entry of
+    /// `normal` is written, and of `tangent` where there is one. Whether there is a tangent
+    /// (where there is none, `tangent` is left as it was). A set whose two share work (a
+    /// ragdoll's link poses and point Jacobians) overrides it, and writes in place.
+    ///
+    /// ```
+    /// use lagrange_core::constraints::contact::Contacts;
+    /// use lagrange_core::nalgebra::{SMatrix, SVector};
+    /// use lagrange_core::{Holonomic, HolonomicConstraints, Scalar};
+    ///
+    /// /// A point at (q0, q1) above the ground y = 0.
+    /// struct Ground;
+    /// impl HolonomicConstraints<f64, 2, 1> for Ground {
+    ///     fn phi<S: Scalar<Real = f64> + 'static>(&self, q: &SVector<S, 2>) -> SVector<S, 1> {
+    ///         SVector::from([q[1]])
+    ///     }
+    /// }
+    ///
+    /// let (mut normal, mut tangent) = (SMatrix::<f64, 1, 2>::zeros(), SMatrix::zeros());
+    /// let friction = Holonomic::new(Ground).jacobians(&SVector::from([0.5, 2.0]), &mut normal, &mut tangent);
+    /// assert_eq!(normal, SMatrix::<f64, 1, 2>::new(0.0, 1.0));
+    /// // A holonomic set has no tangent: frictionless.
+    /// assert!(!friction);
+    /// ```
+    fn jacobians(
+        &self,
+        q: &SVector<T, N>,
+        normal: &mut SMatrix<T, C, N>,
+        tangent: &mut SMatrix<T, C, N>,
+    ) -> bool {
+        *normal = self.jacobian(q);
+        match self.tangent_jacobian(q) {
+            Some(t) => {
+                *tangent = t;
+                true
+            }
+            None => false,
+        }
     }
 }
 
