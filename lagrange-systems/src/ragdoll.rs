@@ -748,12 +748,7 @@ impl<T: Real> Mechanism<T, RAGDOLL_COORDINATES> for Ragdoll<T> {
             qd: SVector::zeros(),
             ..*s
         }))?;
-        for k in 0..K {
-            if impulses.column(k).iter().any(|x| *x != T::zero()) {
-                let jump = factor.solve(&impulses.column(k).into_owned());
-                impulses.set_column(k, &jump);
-            }
-        }
+        factor.solve_columns(impulses);
         if all_finite(impulses.as_slice()) {
             Ok(())
         } else {
