@@ -103,7 +103,7 @@ impl<T: Real, const N: usize, const C: usize> Problem<'_, T, N, C> {
         while taken < rounds.max(1) && !settled {
             taken += 1;
             let sliding = self.tangent_response(v0, &p.tangent);
-            let b = self.normal.jacobian() * sliding - target;
+            let b = self.normal.speeds(&sliding) - target;
             let solved = match self.normal.complementary_from(&b, self.kinds, &guess) {
                 Ok(solved) => solved,
                 // Targets no impulses reach, or a degenerate set the exact method cycles on

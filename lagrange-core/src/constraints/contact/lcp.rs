@@ -248,7 +248,26 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
     /// `M^-1 J^T lambda`: the change of the motion the multipliers `lambda` cause.
     #[must_use]
     pub fn response(&self, lambda: &SVector<T, C>) -> SVector<T, N> {
-        self.mobility * lambda
+        // The candidates' columns alone, in order (the same sum as the whole product: the
+        // others are zero), so that a step's few rows of a large set cost a few columns.
+        let mut out = SVector::<T, N>::zeros();
+        for (i, column) in self.mobility.column_iter().enumerate() {
+            let l = lambda[within::<C>(i)];
+            if self.candidate[within::<C>(i)] && l != T::zero() {
+                out += column * l;
+            }
+        }
+        out
+    }
+
+    /// `J v`, the candidate rows' speeds at velocities `v` (zero on the other rows).
+    #[must_use]
+    pub fn speeds(&self, v: &SVector<T, N>) -> SVector<T, C> {
+        let mut out = SVector::<T, C>::zeros();
+        for i in (0..C).filter(|&i| self.candidate[i]).map(within::<C>) {
+            out[i] = self.jacobian.row(i).transpose().dot(v);
+        }
+        out
     }
 
     /// The multipliers `lambda` of the candidate rows for which `a = W lambda + b` is zero on
@@ -761,6 +780,23 @@ mod tests {
     /// Only candidates take part: the dependent third row left out, the corner's two rows
     /// solve as before; a bilateral row that depends on another bilateral row is an error
     /// naming it.
+    /// The candidates' speeds and the response of their multipliers, the other rows left
+    /// out: a mass of 2 (mobility `J^T / 2`), the third row no candidate.
+    #[test]
+    fn speeds_and_response_read_the_candidates() -> Result<(), Error> {
+        let j = SMatrix::<f64, 3, 2>::new(0.0, 1.0, 1.0, 0.0, 1.0, 1.0);
+        let half = |m: &mut SMatrix<f64, 2, 3>| {
+            *m *= 0.5;
+            Ok(())
+        };
+        let d = Delassus::new(&j, half, &[true, true, false])?;
+        let v = SVector::<f64, 2>::new(3.0, -5.0);
+        assert_eq!(d.speeds(&v), SVector::<f64, 3>::new(-5.0, 3.0, 0.0));
+        let lambda = SVector::<f64, 3>::new(2.0, 4.0, 100.0);
+        assert_eq!(d.response(&lambda), SVector::<f64, 2>::new(2.0, 1.0));
+        Ok(())
+    }
+
     #[test]
     fn candidates_and_dependent_bilateral_rows() -> Result<(), Error> {
         let j = SMatrix::<f64, 3, 2>::new(0.0, 1.0, 1.0, 0.0, 1.0, 1.0);
