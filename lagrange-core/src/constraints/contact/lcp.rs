@@ -79,6 +79,11 @@ pub struct Delassus<T: Real, const N: usize, const C: usize> {
     /// The Cholesky factor of the active rows, `factor[(p, q)]` for positions `q <= p` in
     /// the active set (scratch, kept so that a solve does not clear `C^2` numbers a pass).
     factor: SMatrix<T, C, C>,
+    /// The rows the factor holds, in its order: `factored[..factored_n]` (cleared whenever
+    /// `W` changes), so that a solve of the same rows again (the next round of a contact
+    /// step, its drift correction) factors none of them.
+    factored: [usize; C],
+    factored_n: usize,
     candidate: [bool; C],
 }
 
@@ -113,6 +118,8 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
             mobility: SMatrix::zeros(),
             w: SMatrix::zeros(),
             factor: SMatrix::zeros(),
+            factored: [0; C],
+            factored_n: 0,
             candidate: [false; C],
         }
     }
@@ -131,6 +138,7 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
     where
         F: FnOnce(&mut SMatrix<T, N, C>) -> Result<(), Error>,
     {
+        self.factored_n = 0;
         // The entries of W of rows that stop being candidates are cleared (W is zero off
         // the candidates); the candidates' are all written below.
         for i in (0..C)
@@ -210,6 +218,7 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
                 reason: "must be below the set's size",
             });
         }
+        self.factored_n = 0;
         self.jacobian.set_row(i, &j.transpose());
         self.mobility.set_column(i, b);
         self.candidate[i] = true;
@@ -360,8 +369,11 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
                 n += 1;
             }
         }
-        // The rows of the factor still valid: those before the first change of `order`.
-        let mut kept = 0;
+        // The rows of the factor still valid: those before the first change of `order` (at
+        // first, those the last solve left that this one starts with).
+        let mut kept = (0..n.min(self.factored_n))
+            .take_while(|&p| self.factored[p] == order[p])
+            .count();
         let mut blocked = [false; C];
         let mut lambda = SVector::<T, C>::zeros();
         // The row that joined last, the way it moves off its bound, and whether its pull was
@@ -619,10 +631,15 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
         r: &SVector<T, C>,
     ) -> Result<SVector<T, C>, Error> {
         let n = n.min(C);
+        let kept = kept.min(n);
         let threshold = T::EPSILON.sqrt();
+        for p in 0..kept {
+            self.factored[p] = order[p];
+        }
+        self.factored_n = kept;
         let l = &mut self.factor;
         let row = |p: usize| within::<C>(order[p]);
-        for p in kept.min(n)..n {
+        for p in kept..n {
             let row_p = row(p);
             for q in 0..p {
                 let x = (0..q).fold(self.w[(row_p, row(q))], |x, k| x - l[(p, k)] * l[(q, k)]);
@@ -637,6 +654,8 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
                 return Err(Error::RedundantConstraints { row: row_p });
             }
             l[(p, p)] = d.sqrt();
+            self.factored[p] = order[p];
+            self.factored_n = p + 1;
         }
         let mut y = [T::zero(); C];
         for p in 0..n {
