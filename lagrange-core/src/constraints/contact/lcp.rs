@@ -633,8 +633,8 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
         let n = n.min(C);
         let kept = kept.min(n);
         let threshold = T::EPSILON.sqrt();
-        for p in 0..kept {
-            self.factored[p] = order[p];
+        for (f, &o) in self.factored.iter_mut().zip(order).take(kept) {
+            *f = o;
         }
         self.factored_n = kept;
         let l = &mut self.factor;
