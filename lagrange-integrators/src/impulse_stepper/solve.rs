@@ -127,7 +127,7 @@ impl<T: Real, const N: usize, const C: usize> Problem<'_, T, N, C> {
             let mut v = sliding + self.normal.response(&p.normal);
             for sweep in 0..rounds.max(1) {
                 let (mut change, mut allowed) = (T::zero(), tolerance);
-                let rows = self.tangent.iter().zip(&p.normal).zip(&mut p.tangent);
+                let rows = self.tangent.iter().zip(p.normal.as_slice()).zip(&mut p.tangent);
                 for ((t, normal), tangent) in rows {
                     let Some(t) = t else { continue };
                     let u = t.j.dot(&v);
