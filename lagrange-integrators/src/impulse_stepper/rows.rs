@@ -141,7 +141,7 @@ impl<T: Real, const N: usize, const C: usize> Workspace<T, N, C> {
 /// `i`, a row of a set of `C` counted here (so below `C`), clamped below `C`: a no-op that
 /// tells the optimiser that no bounds check is needed (a bounds check is a panic path, which
 /// the firmware's panic-free image refuses).
-fn within<const C: usize>(i: usize) -> usize {
+pub(super) fn within<const C: usize>(i: usize) -> usize {
     i.min(C.saturating_sub(1))
 }
 

@@ -2,7 +2,7 @@
 //! ([`Delassus::complementary`]), alternated with Coulomb friction sweeps, at most a capped
 //! number of times.
 
-use super::rows::Direction;
+use super::rows::{within, Direction};
 use lagrange_core::constraints::contact::{Delassus, Row};
 use lagrange_core::nalgebra::SVector;
 use lagrange_core::{Error, Real};
@@ -96,7 +96,17 @@ impl<T: Real, const N: usize, const C: usize> Problem<'_, T, N, C> {
                 p.tangent[i] = warm.tangent[i];
             }
         }
-        let frictional = self.friction > T::zero() && self.tangent.iter().any(Option::is_some);
+        // The rows with a tangent, listed: the sweeps run over them alone.
+        let mut with_tangent = [0_usize; C];
+        let mut count = 0;
+        for (slot, i) in with_tangent
+            .iter_mut()
+            .zip((0..C).filter(|&i| self.tangent[i].is_some()))
+        {
+            *slot = within::<C>(i);
+            count += 1;
+        }
+        let frictional = self.friction > T::zero() && count > 0;
         let rounding = T::from_f64(16.0) * T::EPSILON;
         let (mut taken, mut settled, mut exact) = (0, false, true);
         let mut guess = *self.pushed;
@@ -127,11 +137,11 @@ impl<T: Real, const N: usize, const C: usize> Problem<'_, T, N, C> {
             let mut v = sliding + self.normal.response(&p.normal);
             for sweep in 0..rounds.max(1) {
                 let (mut change, mut allowed) = (T::zero(), tolerance);
-                let rows = self.tangent.iter().zip(p.normal.as_slice()).zip(&mut p.tangent);
-                for ((t, normal), tangent) in rows {
-                    let Some(t) = t else { continue };
+                for &i in with_tangent.iter().take(count) {
+                    let Some(t) = &self.tangent[i] else { continue };
                     let u = t.j.dot(&v);
-                    let bound = self.friction * *normal;
+                    let bound = self.friction * p.normal[i];
+                    let tangent = &mut p.tangent[i];
                     let next = (*tangent - u * t.inverse).max(-bound).min(bound);
                     let dp = next - *tangent;
                     v += t.b * dp;

@@ -4,7 +4,7 @@
 //! level), a projection's displacements (at the position level).
 
 use crate::nalgebra::{SMatrix, SVector};
-use crate::{Error, Real};
+use crate::{all_finite, Error, Real};
 
 mod relaxed;
 
@@ -342,7 +342,6 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
                 reason: "a bounded row's bound must be finite and not negative",
             });
         }
-        let bounds: [(T, T); C] = core::array::from_fn(|i| kinds[i].bounds());
         // The candidates, listed: every loop below runs over them alone.
         let mut cand = [0usize; C];
         let mut m = 0;
@@ -351,6 +350,10 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
             m += 1;
         }
         let listed = cand.iter().take(m).map(|&i| within::<C>(i));
+        let mut bounds = [(T::zero(), T::zero()); C];
+        for i in listed.clone() {
+            bounds[i] = kinds[i].bounds();
+        }
         // Solved for (a = 0 between its bounds), in the order they joined (so that a row
         // that depends on the others is always the one joining, at its bound: leaving it out
         // changes no multiplier); the other candidates are held at a bound, or left out at
@@ -523,7 +526,10 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
                     // The way it moves off its bound: up from the lower, down from the upper,
                     // against a from inside.
                     let (lo, hi) = bounds[row];
-                    let a = self.w.row(row).dot(&lambda.transpose()) + b[row];
+                    let a = listed
+                        .clone()
+                        .fold(T::zero(), |a, k| a + self.w[(row, k)] * lambda[k])
+                        + b[row];
                     let way = if lambda[row] <= lo {
                         T::one()
                     } else if lambda[row] >= hi || a > T::zero() {
@@ -539,7 +545,7 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
                     let beyond = pull > T::EPSILON.sqrt().sqrt() * size;
                     joined = Some((row, way, beyond));
                 }
-                None if lambda.iter().all(|x| x.is_finite()) => {
+                None if all_finite(lambda.as_slice()) => {
                     return Ok(Complementary {
                         lambda,
                         active: free,
