@@ -141,22 +141,28 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
         self.factored_n = 0;
         // The entries of W of rows that stop being candidates are cleared (W is zero off
         // the candidates); the candidates' are all written below.
-        for i in (0..C)
-            .filter(|&i| self.candidate[i] && !candidate[i])
-            .map(within::<C>)
-        {
-            self.w.row_mut(i).fill(T::zero());
-            self.w.column_mut(i).fill(T::zero());
+        let leaving: [bool; C] = core::array::from_fn(|i| self.candidate[i] && !candidate[i]);
+        if leaving.contains(&true) {
+            clear(&mut self.w, &leaving);
         }
         self.candidate = [false; C];
-        for (i, &on) in candidate.iter().enumerate() {
-            let i = within::<C>(i);
-            if on {
-                self.jacobian.set_row(i, &jacobian.row(i));
-                self.mobility.set_column(i, &jacobian.row(i).transpose());
-            } else {
-                self.jacobian.row_mut(i).fill(T::zero());
-                self.mobility.column_mut(i).fill(T::zero());
+        // In storage order (nalgebra's row and column fills walk a strided iterator an
+        // entry at a time): the candidates' rows of the Jacobian, zero elsewhere, and their
+        // transposes as the mobilities' columns before the mass solve.
+        let rows = jacobian.as_slice().chunks_exact(C);
+        for (to, from) in self.jacobian.as_mut_slice().chunks_exact_mut(C).zip(rows) {
+            for ((x, &y), &on) in to.iter_mut().zip(from).zip(candidate) {
+                *x = if on { y } else { T::zero() };
+            }
+        }
+        let columns = self.mobility.as_mut_slice().chunks_exact_mut(N);
+        for ((i, column), &on) in columns.enumerate().zip(candidate) {
+            for (c, x) in column.iter_mut().enumerate() {
+                *x = if on {
+                    jacobian[(within::<C>(i), c.min(N.saturating_sub(1)))]
+                } else {
+                    T::zero()
+                };
             }
         }
         if let Err(e) = mobility_of(&mut self.mobility) {
@@ -673,6 +679,18 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
             x[row(p)] = s / l[(p, p)];
         }
         Ok(x)
+    }
+}
+
+/// The rows and columns of `w` marked in `rows` set to zero.
+fn clear<T: Real, const C: usize>(w: &mut SMatrix<T, C, C>, rows: &[bool; C]) {
+    for (k, column) in w.as_mut_slice().chunks_exact_mut(C).enumerate() {
+        let whole = rows.get(k).copied().unwrap_or(false);
+        for (x, &on) in column.iter_mut().zip(rows) {
+            if whole || on {
+                *x = T::zero();
+            }
+        }
     }
 }
 
