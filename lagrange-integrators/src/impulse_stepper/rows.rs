@@ -78,19 +78,26 @@ impl<T: Real, const N: usize, const C: usize> Workspace<T, N, C> {
         let mut slot = [None::<usize>; C];
         let mut spare = (0..C).filter(|&k| !touching[k]);
         let mut overflow = false;
-        for (k, &on) in touching.iter().enumerate() {
-            let k = within::<C>(k);
+        for ((k, column), &on) in self
+            .jumps
+            .as_mut_slice()
+            .chunks_exact_mut(N)
+            .enumerate()
+            .zip(touching)
+        {
             if on {
-                self.jumps.set_column(k, &jacobian.row(k).transpose());
+                put_row(column, jacobian, k);
             } else {
-                self.jumps.column_mut(k).fill(T::zero());
+                column.fill(T::zero());
             }
         }
         if let Some(t) = tangents {
             for i in (0..C).filter(|&i| frictional[i]).map(within::<C>) {
                 match spare.next().map(within::<C>) {
                     Some(k) => {
-                        self.jumps.set_column(k, &t.row(i).transpose());
+                        if let Some(column) = self.jumps.as_mut_slice().chunks_exact_mut(N).nth(k) {
+                            put_row(column, t, i);
+                        }
                         slot[i] = Some(k);
                     }
                     None => overflow = true,
@@ -102,8 +109,13 @@ impl<T: Real, const N: usize, const C: usize> Workspace<T, N, C> {
         self.normal.rebuild(
             jacobian,
             |m| {
-                for k in (0..C).filter(|&k| touching[k]).map(within::<C>) {
-                    m.set_column(k, &jumps.column(k));
+                let from = jumps.as_slice().chunks_exact(N).zip(touching);
+                for (to, (from, &on)) in m.as_mut_slice().chunks_exact_mut(N).zip(from) {
+                    if on {
+                        for (x, y) in to.iter_mut().zip(from) {
+                            *x = *y;
+                        }
+                    }
                 }
                 Ok(())
             },
@@ -143,6 +155,18 @@ impl<T: Real, const N: usize, const C: usize> Workspace<T, N, C> {
 /// the firmware's panic-free image refuses).
 pub(super) fn within<const C: usize>(i: usize) -> usize {
     i.min(C.saturating_sub(1))
+}
+
+/// Row `i` of `rows` into `column` (a column of a matrix stored by columns), read entry by
+/// entry (nalgebra's `set_column` from a row walks a strided iterator).
+fn put_row<T: Real, const N: usize, const C: usize>(
+    column: &mut [T],
+    rows: &SMatrix<T, C, N>,
+    i: usize,
+) {
+    for (c, x) in column.iter_mut().enumerate() {
+        *x = rows[(within::<C>(i), c.min(N.saturating_sub(1)))];
+    }
 }
 
 /// Column `k` of `m`, copied (nalgebra's `into_owned` keeps a length check, a panic path, in
