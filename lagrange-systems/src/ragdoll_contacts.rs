@@ -5,7 +5,7 @@ use lagrange_core::constraints::contact::Contacts;
 use lagrange_core::nalgebra::{SMatrix, SVector};
 use lagrange_core::{entry_names, validate, Constraints, Error, Real};
 
-use crate::ragdoll::{Mark, PARENT, RAGDOLL_COORDINATES as N, RAGDOLL_LINKS};
+use crate::ragdoll::{Mark, Pose, PARENT, RAGDOLL_COORDINATES as N, RAGDOLL_LINKS};
 use crate::Ragdoll;
 
 /// Points of a [`Ragdoll`] that touch the floor.
@@ -133,10 +133,34 @@ impl<T: Real> RagdollContacts<T> {
     #[must_use]
     pub fn floor_points(&self, q: &SVector<T, N>) -> [[T; 2]; RAGDOLL_FLOOR_POINTS] {
         // One pose for all the points (a pose per point cost thirteen poses a residual).
-        let pose = self.ragdoll.pose(q);
+        self.points_at(&self.ragdoll.pose(q), q)
+    }
+
+    /// [`RagdollContacts::floor_points`] at `q` posed as `pose`.
+    fn points_at(&self, pose: &Pose<T>, q: &SVector<T, N>) -> [[T; 2]; RAGDOLL_FLOOR_POINTS] {
         self.points.map(|m| {
             let [px, py] = pose.point(m.link, m.along, m.across);
             [px + q[0], py + q[1]]
+        })
+    }
+
+    /// Every row's gap at `q` posed as `pose`: the floor points' heights above the floor,
+    /// then each joint's distance from its lower and upper limits.
+    fn gaps_at(&self, pose: &Pose<T>, q: &SVector<T, N>) -> SVector<T, RAGDOLL_CONTACTS> {
+        let points = self.points_at(pose, q);
+        SVector::from_fn(|i, _| match points.get(i) {
+            Some(p) => p[1] - self.floor,
+            None => {
+                let row = i - RAGDOLL_FLOOR_POINTS;
+                let (joint, upper) = (row / 2, row % 2 == 1);
+                let [lower_bound, upper_bound] = self.limits[joint];
+                let x = q[joint + 3];
+                if upper {
+                    upper_bound - x
+                } else {
+                    x - lower_bound
+                }
+            }
         })
     }
 
@@ -145,11 +169,10 @@ impl<T: Real> RagdollContacts<T> {
     /// into `j` and `t` (every entry: nothing of what they held is kept).
     fn write_rows(
         &self,
-        q: &SVector<T, N>,
+        pose: &Pose<T>,
         j: &mut SMatrix<T, RAGDOLL_CONTACTS, N>,
         t: &mut SMatrix<T, RAGDOLL_CONTACTS, N>,
     ) {
-        let pose = self.ragdoll.pose(q);
         // In storage order: nalgebra's `fill` walks a strided iterator an entry at a time.
         j.as_mut_slice().fill(T::zero());
         t.as_mut_slice().fill(T::zero());
@@ -177,7 +200,7 @@ impl<T: Real> RagdollContacts<T> {
         }
     }
 
-    /// [`RagdollContacts::write_rows`] into new matrices.
+    /// [`RagdollContacts::write_rows`] at `q`, into new matrices.
     fn rows(
         &self,
         q: &SVector<T, N>,
@@ -186,28 +209,14 @@ impl<T: Real> RagdollContacts<T> {
         SMatrix<T, RAGDOLL_CONTACTS, N>,
     ) {
         let (mut j, mut t) = (SMatrix::zeros(), SMatrix::zeros());
-        self.write_rows(q, &mut j, &mut t);
+        self.write_rows(&self.ragdoll.pose(q), &mut j, &mut t);
         (j, t)
     }
 }
 
 impl<T: Real> Constraints<T, N, RAGDOLL_CONTACTS> for RagdollContacts<T> {
     fn position_residual(&self, q: &SVector<T, N>) -> SVector<T, RAGDOLL_CONTACTS> {
-        let points = self.floor_points(q);
-        SVector::from_fn(|i, _| match points.get(i) {
-            Some(p) => p[1] - self.floor,
-            None => {
-                let row = i - RAGDOLL_FLOOR_POINTS;
-                let (joint, upper) = (row / 2, row % 2 == 1);
-                let [lower_bound, upper_bound] = self.limits[joint];
-                let x = q[joint + 3];
-                if upper {
-                    upper_bound - x
-                } else {
-                    x - lower_bound
-                }
-            }
-        })
+        self.gaps_at(&self.ragdoll.pose(q), q)
     }
 
     fn jacobian(&self, q: &SVector<T, N>) -> SMatrix<T, RAGDOLL_CONTACTS, N> {
@@ -260,7 +269,21 @@ impl<T: Real> Contacts<T, N, RAGDOLL_CONTACTS> for RagdollContacts<T> {
         normal: &mut SMatrix<T, RAGDOLL_CONTACTS, N>,
         tangent: &mut SMatrix<T, RAGDOLL_CONTACTS, N>,
     ) -> bool {
-        self.write_rows(q, normal, tangent);
+        self.write_rows(&self.ragdoll.pose(q), normal, tangent);
+        true
+    }
+
+    /// All three from one pose.
+    fn gaps_and_jacobians(
+        &self,
+        q: &SVector<T, N>,
+        gaps: &mut SVector<T, RAGDOLL_CONTACTS>,
+        normal: &mut SMatrix<T, RAGDOLL_CONTACTS, N>,
+        tangent: &mut SMatrix<T, RAGDOLL_CONTACTS, N>,
+    ) -> bool {
+        let pose = self.ragdoll.pose(q);
+        *gaps = self.gaps_at(&pose, q);
+        self.write_rows(&pose, normal, tangent);
         true
     }
 }

@@ -4,7 +4,7 @@
 //! thrown onto a floor it never gains kinetic energy at an impact, never sinks into the
 //! floor, comes to rest and falls asleep in a scene.
 
-use lagrange_core::nalgebra::SVector;
+use lagrange_core::nalgebra::{SMatrix, SVector};
 use lagrange_core::{Constraints, Error, Lagrangian, Mechanism, Projection, Real, State};
 use lagrange_integrators::scene::{Bank, Scene, Sleeps, Status};
 use lagrange_integrators::{ContactModel, ContactStepper, Contacts, Rk4};
@@ -126,7 +126,7 @@ fn velocity_jumps_are_mass_solves<T: Real>() -> Result<(), Error> {
         let doll = Ragdoll::new(random_body::<T>(&mut rng))?;
         for _ in 0..40 {
             let s = random_state::<T>(&mut rng);
-            let mut columns = lagrange_core::nalgebra::SMatrix::<T, N, 14>::zeros();
+            let mut columns = SMatrix::<T, N, 14>::zeros();
             for k in 0..N {
                 columns[(k, k + 1)] = T::from_f64(1.0 + k as f64);
             }
@@ -398,6 +398,10 @@ fn contact_rows_are_the_derivatives_of_the_gaps() -> Result<(), Error> {
                     name: "contacts",
                     reason: "no tangents",
                 })?;
+            // What a contact solver asks for at once: the same bits as the calls one by one.
+            let (mut gaps, mut jj, mut tt) = (SVector::zeros(), SMatrix::zeros(), SMatrix::zeros());
+            assert!(contacts.gaps_and_jacobians(&q, &mut gaps, &mut jj, &mut tt));
+            assert_eq!((gaps, jj, tt), (contacts.position_residual(&q), j, t));
             let scale = j.amax().max(t.amax());
             for k in 0..N {
                 let mut e = SVector::<f64, N>::zeros();

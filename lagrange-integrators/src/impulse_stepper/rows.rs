@@ -49,7 +49,38 @@ impl<T: Real, const N: usize, const C: usize> Workspace<T, N, C> {
         friction: bool,
         frictional: &[bool; C],
     ) -> Result<bool, Error> {
-        let tangents = contacts.jacobians(q, &mut self.jacobian, &mut self.tangents) && friction;
+        let tangents = contacts.jacobians(q, &mut self.jacobian, &mut self.tangents);
+        self.checked(tangents && friction, frictional)
+    }
+
+    /// The gaps of `contacts` at `q` and, where `rows_too` (a step that expects rows in
+    /// contact), their Jacobians from the same call ([`Contacts::gaps_and_jacobians`]:
+    /// a ragdoll's one pose), with whether the contacts gave tangents; else the gaps alone.
+    ///
+    /// # Errors
+    /// [`Error::NonFiniteRow`] for the first gap that is not finite.
+    pub(super) fn gaps<K: Contacts<T, N, C>>(
+        &mut self,
+        contacts: &K,
+        q: &SVector<T, N>,
+        rows_too: bool,
+    ) -> Result<(SVector<T, C>, Option<bool>), Error> {
+        if rows_too {
+            let mut gaps = SVector::zeros();
+            let tangents =
+                contacts.gaps_and_jacobians(q, &mut gaps, &mut self.jacobian, &mut self.tangents);
+            Ok((finite_gaps(gaps)?, Some(tangents)))
+        } else {
+            Ok((finite_gaps(contacts.position_residual(q))?, None))
+        }
+    }
+
+    /// Whether the tangents count (`tangents`: the contacts gave them and friction is on),
+    /// the Jacobian and (where they count) the tangents of `frictional` checked.
+    ///
+    /// # Errors
+    /// As [`Workspace::jacobians`].
+    pub(super) fn checked(&self, tangents: bool, frictional: &[bool; C]) -> Result<bool, Error> {
         finite_rows(&self.jacobian, &[true; C])?;
         if tangents {
             finite_rows(&self.tangents, frictional)?;

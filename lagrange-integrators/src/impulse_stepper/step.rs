@@ -217,7 +217,9 @@ impl<T: Real, const C: usize, K> Setup<T, C, K> {
             _ => (Impulses::zero(), None),
         };
         memory.dt = Some(dt);
-        let gaps = finite_gaps(self.contacts.position_residual(&free.q))?;
+        // After a step with rows in contact, the gaps and the rows at once (one pose of a
+        // ragdoll); in flight, the gaps alone.
+        let (gaps, given) = work.gaps(&self.contacts, &free.q, memory.report.rows > 0)?;
         let touching: [bool; C] =
             core::array::from_fn(|i| self.bilateral[i] || gaps[i] <= T::zero());
         let in_contact = touching.iter().filter(|&&t| t).count();
@@ -239,7 +241,10 @@ impl<T: Real, const C: usize, K> Setup<T, C, K> {
         }
         let frictional: [bool; C] = core::array::from_fn(|i| touching[i] && !self.bilateral[i]);
         let friction = self.model.friction() > T::zero();
-        let tangents = work.jacobians(&self.contacts, &free.q, friction, &frictional)?;
+        let tangents = match given {
+            Some(tangents) => work.checked(tangents && friction, &frictional)?,
+            None => work.jacobians(&self.contacts, &free.q, friction, &frictional)?,
+        };
         work.fill(mechanism, &free, tangents, &touching, &frictional)?;
         let Workspace {
             normal,

@@ -63,6 +63,21 @@ pub trait Contacts<T: Real, const N: usize, const C: usize>: Constraints<T, N, C
             None => false,
         }
     }
+
+    /// The gaps ([`Constraints::position_residual`]) with [`Contacts::jacobians`], written
+    /// into `gaps`, `normal` and `tangent`: what a contact solver asks for in a step it
+    /// expects rows in contact. By default the two calls; a set whose gaps and rows share
+    /// work (a ragdoll's one pose) overrides it.
+    fn gaps_and_jacobians(
+        &self,
+        q: &SVector<T, N>,
+        gaps: &mut SVector<T, C>,
+        normal: &mut SMatrix<T, C, N>,
+        tangent: &mut SMatrix<T, C, N>,
+    ) -> bool {
+        *gaps = self.position_residual(q);
+        self.jacobians(q, normal, tangent)
+    }
 }
 
 impl<T, const N: usize, const C: usize, P> Contacts<T, N, C> for Holonomic<P>
