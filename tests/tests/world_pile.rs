@@ -7,7 +7,6 @@
 
 use lagrange_core::constraints::contact::ContactModel;
 use lagrange_core::links::Links;
-use lagrange_core::nalgebra::SVector;
 use lagrange_core::{Error, Lagrangian, Mechanism, Real, State};
 use lagrange_systems::{
     Ragdoll, RagdollBody, ADULT_JOINT_LIMITS, RAGDOLL_COORDINATES as N, RAGDOLL_LINKS,
@@ -23,28 +22,6 @@ type Pile<T> = World<T, Ragdoll<T>, N, 16, 160, 1024, CoordinateLimits<9>>;
 
 /// The slop, m (and rad, on a joint's limit).
 const SLOP: f64 = 5e-3;
-
-/// The capsule of each link in its frame: the torso about its centre, a limb from its joint
-/// along `-y`, radii 0.12 m (torso), 0.1 (head), 0.05 (limbs), lengths the ragdoll's own.
-fn capsules<T: Real>(doll: &Ragdoll<T>) -> Result<[Shape<T>; RAGDOLL_LINKS], Error> {
-    let rest = doll.segments(&SVector::zeros());
-    let mut out = [Shape::circle(T::one())?; RAGDOLL_LINKS];
-    for (k, slot) in out.iter_mut().enumerate() {
-        let [a, b] = rest[k];
-        let length = (a[0] - b[0]).to_f64().hypot((a[1] - b[1]).to_f64());
-        let radius = match k {
-            0 => 0.12,
-            1 => 0.1,
-            _ => 0.05,
-        };
-        let centre = if k == 0 { 0.0 } else { -length / 2.0 };
-        *slot = Shape::capsule(T::from_f64(length / 2.0), T::from_f64(radius))?.offset(
-            [T::zero(), T::from_f64(centre)],
-            T::from_f64(core::f64::consts::FRAC_PI_2),
-        );
-    }
-    Ok(out)
-}
 
 /// What a pile's run measured.
 #[derive(Debug)]
@@ -80,7 +57,7 @@ fn pile<T: Real>(dolls: u32, steps: usize) -> Result<Measured, Error> {
         world.add_plane(key, wall)?;
     }
     let doll = Ragdoll::new(RagdollBody::<T>::adult())?;
-    let shapes = capsules(&doll)?;
+    let shapes = lagrange_cases::ragdoll_capsules(&doll)?;
     let limits = CoordinateLimits::new(core::array::from_fn(|j| j + 3), ADULT_JOINT_LIMITS)?;
     let mut rng = Rng::new(12345);
     for d in 0..dolls {

@@ -8,7 +8,7 @@ use lagrange_core::nalgebra::SVector;
 use lagrange_core::{Error, Real, State};
 use lagrange_systems::{
     NLinkPendulum, Ragdoll, RagdollBody, RigidBody, SimplePendulum, ADULT_JOINT_LIMITS,
-    RAGDOLL_COORDINATES, RAGDOLL_LINKS,
+    RAGDOLL_COORDINATES,
 };
 use lagrange_world::{CoordinateLimits, HalfPlane, Limits, OneOf, Shape, World, WorldSettings};
 
@@ -192,7 +192,7 @@ impl<T: Real> Sandbox<T> {
         )?;
         // Two ragdolls dropped from above.
         let doll = Ragdoll::new(RagdollBody::<T>::adult())?;
-        let capsules = capsules(&doll)?;
+        let capsules = lagrange_cases::ragdoll_capsules(&doll)?;
         let limits = Joints {
             on: true,
             limits: adult,
@@ -338,28 +338,6 @@ impl<T: Real> Sandbox<T> {
 /// A box, a ball or a swing as a body.
 fn small<T: Real>(body: Small<T>) -> Body<T> {
     OneOf::Second(body)
-}
-
-/// A capsule along each of a ragdoll's links (the torso a thick one about its centre, the head
-/// thinner, the limbs 5 cm), in the link's frame.
-fn capsules<T: Real>(doll: &Ragdoll<T>) -> Result<[Shape<T>; RAGDOLL_LINKS], Error> {
-    let rest = doll.segments(&SVector::zeros());
-    let mut out = [Shape::circle(T::one())?; RAGDOLL_LINKS];
-    for (k, slot) in out.iter_mut().enumerate() {
-        let [a, b] = rest[k];
-        let length = (a[0] - b[0]).to_f64().hypot((a[1] - b[1]).to_f64());
-        let radius = match k {
-            0 => 0.12,
-            1 => 0.1,
-            _ => 0.05,
-        };
-        let centre = if k == 0 { 0.0 } else { -length / 2.0 };
-        *slot = Shape::capsule(T::from_f64(length / 2.0), T::from_f64(radius))?.offset(
-            [T::zero(), T::from_f64(centre)],
-            T::from_f64(core::f64::consts::FRAC_PI_2),
-        );
-    }
-    Ok(out)
 }
 
 /// Steps of the scripted run.

@@ -163,7 +163,7 @@ pub fn balls(count: usize) -> Rapier {
 pub fn pile(dolls: usize, sleep: bool) -> Result<Rapier, String> {
     let mut world = world(PILE, Some(scenes::pile_pit(dolls)));
     let colliders = rapier_ragdoll::Colliders {
-        radii: scenes::capsule_radii(),
+        radii: lagrange_cases::RAGDOLL_CAPSULE_RADII,
         friction: PILE.friction,
         restitution: PILE.restitution,
     };

@@ -7,10 +7,9 @@ use std::time::Instant;
 
 use lagrange_core::constraints::contact::ContactModel;
 use lagrange_core::links::Links;
-use lagrange_core::nalgebra::SVector;
 use lagrange_core::{Error, Mechanism, Real, State};
 use lagrange_systems::{
-    Ragdoll, RagdollBody, RigidBody, ADULT_JOINT_LIMITS, RAGDOLL_COORDINATES as RN, RAGDOLL_LINKS,
+    Ragdoll, RagdollBody, RigidBody, ADULT_JOINT_LIMITS, RAGDOLL_COORDINATES as RN,
 };
 use lagrange_world::{
     collide, collide_half_plane, BroadPhase, CoordinateLimits, HalfPlane, Limits, NoLimits, Proxy,
@@ -157,34 +156,6 @@ pub fn throw(dolls: usize) -> Vec<State<f64, RN>> {
             State::new(0.0, q, qd)
         })
         .collect()
-}
-
-/// The capsule radius of each ragdoll link, m: torso 0.12, head 0.1, limbs 0.05 (the pile
-/// test's).
-pub fn capsule_radii() -> [f64; RAGDOLL_LINKS] {
-    core::array::from_fn(|k| match k {
-        0 => 0.12,
-        1 => 0.1,
-        _ => 0.05,
-    })
-}
-
-/// The capsule of each link in its frame: the torso about its centre, a limb from its joint
-/// along `-y`, the ragdoll's own lengths (the pile test's).
-fn capsules<T: Real>(doll: &Ragdoll<T>) -> Result<[Shape<T>; RAGDOLL_LINKS], Error> {
-    let rest = doll.segments(&SVector::zeros());
-    let radii = capsule_radii();
-    let mut out = [Shape::circle(T::one())?; RAGDOLL_LINKS];
-    for (k, slot) in out.iter_mut().enumerate() {
-        let [a, b] = rest[k];
-        let length = (a[0] - b[0]).to_f64().hypot((a[1] - b[1]).to_f64());
-        let centre = if k == 0 { 0.0 } else { -length / 2.0 };
-        *slot = Shape::capsule(T::from_f64(length / 2.0), T::from_f64(radii[k]))?.offset(
-            [T::zero(), T::from_f64(centre)],
-            T::from_f64(core::f64::consts::FRAC_PI_2),
-        );
-    }
-    Ok(out)
 }
 
 /// What a probe of a world found, after a step.
@@ -434,7 +405,7 @@ pub fn lagrange_pile<T: Real, const B: usize, const S: usize, const K: usize>(
         world.add_plane(key, *p)?;
     }
     let doll = Ragdoll::new(RagdollBody::<T>::adult())?;
-    let capsules = capsules(&doll)?;
+    let capsules = lagrange_cases::ragdoll_capsules(&doll)?;
     let limits = CoordinateLimits::new(core::array::from_fn(|j| j + 3), ADULT_JOINT_LIMITS)?;
     let mut shapes = Vec::new();
     for (d, s) in (0..).zip(throw(dolls)) {

@@ -29,6 +29,7 @@ mod kernels;
 mod lanes;
 mod libm_trig_pendulum;
 mod ragdoll;
+mod ragdoll_capsules;
 mod scenes;
 mod setups;
 mod spring_chain;
@@ -42,6 +43,7 @@ pub use ragdoll::{
     ragdoll_free, ragdoll_landing, ragdoll_thrown, RAGDOLL_DT, RAGDOLL_FREE, RAGDOLL_ITERATIONS,
     RAGDOLL_LANDING, RAGDOLL_ROWS,
 };
+pub use ragdoll_capsules::{ragdoll_capsules, RAGDOLL_CAPSULE_RADII};
 pub use scenes::{many_sleepers, no_sleepers, scripted, with_sleepers, SLEEPERS};
 pub use setups::{
     CartPoleLagrangianSetup, CartPoleSetup, DoublePendulumSetup, LibmTrigPendulumSetup,
