@@ -173,13 +173,14 @@ impl<T: Real, const N: usize> Cholesky<T, N> {
     /// [`Cholesky::solve`] of each of the `LANES` columns of `x` (by coordinate), the same
     /// operations in the same order on each.
     fn substitute(&self, x: &mut [[T; LANES]; N]) {
+        // The loops of `solve`, by index (the bounds then provably hold: no panic path).
         let l = &self.l;
         for i in 0..N {
             let mut s = x[i];
-            for (k, xk) in x.iter().enumerate().take(i) {
-                let lik = l[(i, k)];
+            for k in 0..i {
+                let (lik, xk) = (l[(i, k)], x[k]);
                 for (a, b) in s.iter_mut().zip(xk) {
-                    *a -= lik * *b;
+                    *a -= lik * b;
                 }
             }
             x[i] = s;
@@ -187,10 +188,10 @@ impl<T: Real, const N: usize> Cholesky<T, N> {
         for i in (0..N).rev() {
             let inv = self.inv_d[i];
             let mut s = x[i].map(|v| v * inv);
-            for (k, xk) in x.iter().enumerate().skip(i + 1) {
-                let lki = l[(k, i)];
+            for k in i + 1..N {
+                let (lki, xk) = (l[(k, i)], x[k]);
                 for (a, b) in s.iter_mut().zip(xk) {
-                    *a -= lki * *b;
+                    *a -= lki * b;
                 }
             }
             x[i] = s;

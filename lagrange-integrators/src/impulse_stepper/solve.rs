@@ -138,6 +138,9 @@ impl<T: Real, const N: usize, const C: usize> Problem<'_, T, N, C> {
             for sweep in 0..rounds.max(1) {
                 let (mut change, mut allowed) = (T::zero(), tolerance);
                 for &i in with_tangent.iter().take(count) {
+                    // Clamped (a no-op): the optimiser does not follow a row number
+                    // through an array, and a bounds check is a panic path.
+                    let i = within::<C>(i);
                     let Some(t) = &self.tangent[i] else { continue };
                     let u = t.j.dot(&v);
                     let bound = self.friction * p.normal[i];

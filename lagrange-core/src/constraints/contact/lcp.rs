@@ -380,8 +380,12 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
         }
         // The rows of the factor still valid: those before the first change of `order` (at
         // first, those the last solve left that this one starts with).
-        let mut kept = (0..n.min(self.factored_n))
-            .take_while(|&p| self.factored[p] == order[p])
+        let mut kept = self
+            .factored
+            .iter()
+            .zip(&order)
+            .take(n.min(self.factored_n))
+            .take_while(|(a, b)| a == b)
             .count();
         let mut blocked = [false; C];
         let mut lambda = SVector::<T, C>::zeros();
