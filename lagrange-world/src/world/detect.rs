@@ -65,16 +65,18 @@ where
         self.contacts.clear();
         self.broad.clear();
         let margin = self.settings.margin;
-        for s in &self.shapes {
+        for (index, s) in self.shapes.iter().enumerate() {
             let (lo, hi) = self.placed(s).bounds();
             let grow = margin + self.reach(s, dt);
             let body = s.on.map(|(i, _)| i);
-            // Shape keys are unique (add_shape refuses a taken one).
+            // Each proxy known by its shape's place: unique, and in the order of the shapes'
+            // keys (the shapes are sorted by key), so the pairs come in the keys' order, and
+            // a pair's shapes are found without a search.
             self.broad
                 .add_unique(Proxy {
                     bounds: ([lo[0] - grow, lo[1] - grow], [hi[0] + grow, hi[1] + grow]),
                     body: body.map_or(u32::MAX, |i| u32::try_from(i).unwrap_or(u32::MAX)),
-                    key: s.key,
+                    key: u32::try_from(index).unwrap_or(u32::MAX),
                     group: s.group,
                     mask: s.mask,
                     fixed: body.is_none(),
@@ -87,8 +89,9 @@ where
         self.broad.pairs(&mut pairs)?;
         profile.broad += watch.lap();
         let mut woken = 0;
-        for &(ka, kb) in &pairs {
-            let (Some(a), Some(b)) = (self.shape_copy(ka), self.shape_copy(kb)) else {
+        for &(ia, ib) in &pairs {
+            let at = |i: u32| self.shapes.get(i as usize).copied();
+            let (Some(a), Some(b)) = (at(ia), at(ib)) else {
                 continue;
             };
             let reach = margin + self.reach(&a, dt) + self.reach(&b, dt);
@@ -225,11 +228,6 @@ where
             n += 1;
         }
         Ok(n)
-    }
-
-    /// Shape `key`, copied.
-    fn shape_copy(&self, key: u32) -> Option<Attached<T>> {
-        self.shape(key).and_then(|i| self.shapes.get(i)).copied()
     }
 
     /// How far any point of shape `s` moves in the step at its body's velocity (zero for a
