@@ -402,6 +402,9 @@ fn contact_rows_are_the_derivatives_of_the_gaps() -> Result<(), Error> {
             let (mut gaps, mut jj, mut tt) = (SVector::zeros(), SMatrix::zeros(), SMatrix::zeros());
             assert!(contacts.gaps_and_jacobians(&q, &mut gaps, &mut jj, &mut tt));
             assert_eq!((gaps, jj, tt), (contacts.position_residual(&q), j, t));
+            let (mut jj, mut tt) = (SMatrix::from_element(f64::NAN), SMatrix::from_element(7.0));
+            assert!(contacts.jacobians(&q, &mut jj, &mut tt));
+            assert_eq!((jj, tt), (j, t));
             let scale = j.amax().max(t.amax());
             for k in 0..N {
                 let mut e = SVector::<f64, N>::zeros();
