@@ -109,23 +109,9 @@ impl<T: Real, const N: usize> Cholesky<T, N> {
     /// place.
     #[must_use]
     pub fn solve(&self, b: &SVector<T, N>) -> SVector<T, N> {
-        let l = &self.l;
-        let mut x = *b;
-        for i in 0..N {
-            let mut s = x[i];
-            for k in 0..i {
-                s -= l[(i, k)] * x[k];
-            }
-            x[i] = s;
-        }
-        for i in (0..N).rev() {
-            let mut s = x[i] * self.inv_d[i];
-            for k in i + 1..N {
-                s -= l[(k, i)] * x[k];
-            }
-            x[i] = s;
-        }
-        x
+        let mut x: [[T; 1]; N] = core::array::from_fn(|i| [b[i]]);
+        self.substitute(&mut x);
+        SVector::from_fn(|i, _| x[i][0])
     }
 
     /// Each column of `b` that is not zero replaced by its [`Cholesky::solve`] (bit for bit;
@@ -170,10 +156,12 @@ impl<T: Real, const N: usize> Cholesky<T, N> {
         }
     }
 
-    /// [`Cholesky::solve`] of each of the `LANES` columns of `x` (by coordinate), the same
-    /// operations in the same order on each.
-    fn substitute(&self, x: &mut [[T; LANES]; N]) {
-        // The loops of `solve`, by index (the bounds then provably hold: no panic path).
+    /// `L y = b` forward, `x = D^-1 y`, then `L^T x = ...` backward, in place, on each of
+    /// the `L` columns of `x` (by coordinate: `x[i][c]` is coordinate `i` of column `c`), the
+    /// same operations in the same order on each: one column for [`Cholesky::solve`],
+    /// `LANES` for [`Cholesky::solve_columns`].
+    fn substitute<const L: usize>(&self, x: &mut [[T; L]; N]) {
+        // By index: the bounds then provably hold (no panic path in optimised code).
         let l = &self.l;
         for i in 0..N {
             let mut s = x[i];

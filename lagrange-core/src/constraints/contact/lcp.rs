@@ -824,9 +824,6 @@ mod tests {
         Ok(())
     }
 
-    /// Only candidates take part: the dependent third row left out, the corner's two rows
-    /// solve as before; a bilateral row that depends on another bilateral row is an error
-    /// naming it.
     /// The candidates' speeds and the response of their multipliers, the other rows left
     /// out: a mass of 2 (mobility `J^T / 2`), the third row no candidate.
     #[test]
@@ -844,6 +841,9 @@ mod tests {
         Ok(())
     }
 
+    /// Only candidates take part: the dependent third row left out, the corner's two rows
+    /// solve as before; a bilateral row that depends on another bilateral row is an error
+    /// naming it.
     #[test]
     fn candidates_and_dependent_bilateral_rows() -> Result<(), Error> {
         let j = SMatrix::<f64, 3, 2>::new(0.0, 1.0, 1.0, 0.0, 1.0, 1.0);
