@@ -74,6 +74,38 @@ pub trait Links<T: Real, const N: usize> {
     /// of range is the caller's error: return any pose (never panic).
     fn pose<S: Scalar<Real = T> + 'static>(&self, q: &SVector<S, N>, link: usize) -> Pose<S>;
 
+    /// The poses of links `0, 1, ...` at coordinates `q`, as many as `poses` holds (entries
+    /// past [`Links::LINKS`] are left as they are); by default one [`Links::pose`] each. A
+    /// mechanism whose links share their work (a tree's angles, its trigonometry) overrides
+    /// it with the same poses from one pass: what a world places a body's shapes with.
+    ///
+    /// ```
+    /// use lagrange_core::links::{Links, Pose};
+    /// use lagrange_core::{nalgebra::SVector, Scalar};
+    ///
+    /// /// Two rods of length 1 end to end, `q` their absolute angles from the downward vertical.
+    /// struct Chain;
+    /// impl Links<f64, 2> for Chain {
+    ///     const LINKS: usize = 2;
+    ///     fn pose<S: Scalar<Real = f64> + 'static>(&self, q: &SVector<S, 2>, link: usize) -> Pose<S> {
+    ///         let origin = if link == 0 { [S::zero(); 2] } else { [q[0].sin(), -q[0].cos()] };
+    ///         Pose { origin, angle: q[link.min(1)] }
+    ///     }
+    /// }
+    ///
+    /// let q = SVector::from([0.3, -0.2]);
+    /// let mut poses = [Pose { origin: [0.0; 2], angle: 0.0 }; 3];
+    /// Chain.poses(&q, &mut poses);
+    /// assert_eq!(poses[1], Chain.pose(&q, 1));
+    /// // A third entry is past the chain's links: left as it was.
+    /// assert_eq!(poses[2].angle, 0.0);
+    /// ```
+    fn poses(&self, q: &SVector<T, N>, poses: &mut [Pose<T>]) {
+        for (link, pose) in poses.iter_mut().enumerate().take(Self::LINKS) {
+            *pose = self.pose(q, link);
+        }
+    }
+
     /// The point `local` of link `link` at coordinates `q`: where it is and its Jacobian, by
     /// one evaluation of [`Links::pose`] in dual numbers.
     fn point(&self, q: &SVector<T, N>, link: usize, local: [T; 2]) -> LinkPoint<T, N> {

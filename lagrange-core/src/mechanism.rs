@@ -248,10 +248,14 @@ pub trait Mechanism<T: Real, const N: usize>: Lagrangian<T, N> {
         state: &State<T, N>,
         impulses: &mut SMatrix<T, N, K>,
     ) -> Result<(), Error> {
-        for k in 0..K {
-            if impulses.column(k).iter().any(|x| *x != T::zero()) {
-                let jump = self.velocity_jump(state, &impulses.column(k).into_owned())?;
-                impulses.set_column(k, &jump);
+        if N == 0 {
+            return Ok(());
+        }
+        // Column by column in storage order (nalgebra's column views walk by stride).
+        for column in impulses.as_mut_slice().chunks_exact_mut(N) {
+            if column.iter().any(|x| *x != T::zero()) {
+                let jump = self.velocity_jump(state, &SVector::from_column_slice(column))?;
+                column.copy_from_slice(jump.as_slice());
             }
         }
         Ok(())

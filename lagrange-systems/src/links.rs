@@ -3,9 +3,11 @@
 //! angle 0 from the downward vertical) or, for the cart-pole's pole, `+y` (upright at 0). A
 //! point at `(0, -l)` of a pendulum's link is its bob. The point Jacobians of the chains are
 //! by hand (the origin's derivative plus the offset turned a quarter turn per coordinate that
-//! turns the link); the ragdoll's come from its poses in dual numbers ([`Links::point`]'s
-//! default).
+//! turns the link); the ragdoll's too (the point turned about each joint between it and the
+//! torso), from one pose: a world's narrow phase asks for one per contact point, and the
+//! dual-number default ([`Links::point`]) carried twelve derivatives through ten sines.
 
+use crate::ragdoll::{PARENT, TORSO};
 use crate::{
     Acrobot, CartPole, DoublePendulum, NLinkPendulum, Ragdoll, SimplePendulum, RAGDOLL_COORDINATES,
     RAGDOLL_LINKS,
@@ -179,5 +181,50 @@ impl<T: Real> Links<T, RAGDOLL_COORDINATES> for Ragdoll<T> {
         // The ragdoll's own pose of every link (its inherent method, not this one).
         let origin = self.pose(q).origin[link];
         at([q[0] + origin[0], q[1] + origin[1]], self.angles(q)[link])
+    }
+
+    /// Every link from one pose.
+    fn poses(&self, q: &SVector<T, RAGDOLL_COORDINATES>, poses: &mut [Pose<T>]) {
+        let (pose, angle) = (self.pose(q), self.angles(q));
+        for (link, out) in poses.iter_mut().enumerate().take(RAGDOLL_LINKS) {
+            let origin = pose.origin[link];
+            *out = at([q[0] + origin[0], q[1] + origin[1]], angle[link]);
+        }
+    }
+
+    /// By hand, from one pose: the torso's translation moves the point as it is; each
+    /// coordinate that turns the link (the torso's angle and every joint from the torso out
+    /// to it) turns the point about that joint, `perp(point - joint)`.
+    fn point(
+        &self,
+        q: &SVector<T, RAGDOLL_COORDINATES>,
+        link: usize,
+        local: [T; 2],
+    ) -> LinkPoint<T, RAGDOLL_COORDINATES> {
+        let link = link.min(RAGDOLL_LINKS - 1);
+        let pose = self.pose(q);
+        let (s, c) = (pose.sin[link], pose.cos[link]);
+        let [ox, oy] = pose.origin[link];
+        // Relative to the torso's centre of mass, where the torso's angle turns it about.
+        let p = [
+            ox + c * local[0] - s * local[1],
+            oy + s * local[0] + c * local[1],
+        ];
+        let mut jacobian = SMatrix::<T, 2, RAGDOLL_COORDINATES>::zeros();
+        jacobian[(0, 0)] = T::one();
+        jacobian[(1, 1)] = T::one();
+        jacobian[(0, 2)] = -p[1];
+        jacobian[(1, 2)] = p[0];
+        let mut k = link;
+        while k != TORSO {
+            let [jx, jy] = pose.origin[k];
+            jacobian[(0, k + 2)] = jy - p[1];
+            jacobian[(1, k + 2)] = p[0] - jx;
+            k = PARENT[k];
+        }
+        LinkPoint {
+            position: [q[0] + p[0], q[1] + p[1]],
+            jacobian,
+        }
     }
 }

@@ -16,7 +16,7 @@ pub const RAGDOLL_COORDINATES: usize = 12;
 pub const RAGDOLL_LINKS: usize = 10;
 
 /// The links in order (link `k >= 1` turns about joint `k`, coordinate `q[k + 2]`).
-const TORSO: usize = 0;
+pub(crate) const TORSO: usize = 0;
 /// The head.
 const HEAD: usize = 1;
 /// Left upper arm; its forearm is `LEFT_ARM + 1`.

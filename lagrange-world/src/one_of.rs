@@ -190,6 +190,19 @@ where
         })
     }
 
+    /// The body's own batched solve (one factorisation for all the columns where it has
+    /// one); the idle coordinates' entries left as they are, as in `solve_mass`.
+    fn velocity_jumps<const K: usize>(
+        &self,
+        state: &State<T, N>,
+        impulses: &mut SMatrix<T, N, K>,
+    ) -> Result<(), Error> {
+        match self {
+            Self::First(m) => jumps_of(m, state, impulses),
+            Self::Second(m) => jumps_of(m, state, impulses),
+        }
+    }
+
     /// The body's own law, with the extra force's first entries; an idle coordinate
     /// accelerates by its entry of the extra force (unit mass).
     fn law<F: GeneralizedForce<T, N>>(
@@ -240,6 +253,14 @@ where
         }
     }
 
+    /// The body's own poses (from one pass where it shares them).
+    fn poses(&self, q: &SVector<T, N>, poses: &mut [Pose<T>]) {
+        match self {
+            Self::First(a) => a.poses(&cut(q), poses),
+            Self::Second(b) => b.poses(&cut(q), poses),
+        }
+    }
+
     /// The body's own point (its hand-derived Jacobian where it has one), with zero columns
     /// for the idle coordinates.
     fn point(&self, q: &SVector<T, N>, link: usize, local: [T; 2]) -> LinkPoint<T, N> {
@@ -255,6 +276,23 @@ where
         };
         LinkPoint { position, jacobian }
     }
+}
+
+/// `mechanism`'s [`Mechanism::velocity_jumps`] of the first `NM` rows of `impulses`, the
+/// rows past them left as they are.
+fn jumps_of<T: Real, M: Mechanism<T, NM>, const NM: usize, const N: usize, const K: usize>(
+    mechanism: &M,
+    state: &State<T, N>,
+    impulses: &mut SMatrix<T, N, K>,
+) -> Result<(), Error> {
+    let mut own = SMatrix::<T, NM, K>::from_fn(|i, k| impulses[(i, k)]);
+    mechanism.velocity_jumps(&narrowed(state), &mut own)?;
+    for k in 0..K {
+        for i in 0..NM {
+            impulses[(i, k)] = own[(i, k)];
+        }
+    }
+    Ok(())
 }
 
 /// `j`'s `K` columns, then zero columns up to `N`.

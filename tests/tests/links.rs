@@ -306,7 +306,7 @@ fn out_of_range_is_no_panic<T: Real, L: Links<T, N>, const N: usize>(l: &L, rng:
     }
 }
 
-/// The chains' hand-derived points and Jacobians equal the dual-number default's, to 8 ulps of
+/// The chains' and the ragdoll's hand-derived points and Jacobians equal the dual-number default's, to 8 ulps of
 /// the sizes (the same sums in another order).
 fn hand_points_agree_with_duals<T: Real>() -> Result<(), Error> {
     let mut rng = Rng::new(345);
@@ -328,6 +328,7 @@ fn hand_points_agree_with_duals<T: Real>() -> Result<(), Error> {
             &mut rng,
         ),
         hand_against_duals(&acrobot, &mut rng),
+        hand_against_duals(&Ragdoll::new(RagdollBody::<T>::adult())?, &mut rng),
     ];
     println!("{}: {worst:?}", core::any::type_name::<T>());
     assert!(
@@ -353,7 +354,45 @@ fn out_of_range_links<T: Real>() -> Result<(), Error> {
     Ok(())
 }
 
+/// `Links::poses` gives each link's `Links::pose`, bit for bit, at 20 random states, and
+/// leaves the entries past the links as they were.
+fn poses_are_each_pose<T: Real, L: Links<T, N>, const N: usize>(l: &L, rng: &mut Rng) {
+    let marker = Pose {
+        origin: [T::from_f64(7.0); 2],
+        angle: T::from_f64(-7.0),
+    };
+    for _ in 0..20 {
+        let q = random_state::<T, N>(rng, (-3.2, 3.2), (0.0, 0.0)).q;
+        let mut poses = [marker; 12];
+        l.poses(&q, &mut poses);
+        for (link, pose) in poses.iter().enumerate() {
+            let expected = if link < L::LINKS {
+                l.pose(&q, link)
+            } else {
+                marker
+            };
+            assert_eq!(*pose, expected, "{}, link {link}", core::any::type_name::<L>());
+        }
+    }
+}
+
+/// Every standard mechanism's poses from one call.
+fn all_poses_at_once<T: Real>() -> Result<(), Error> {
+    let mut rng = Rng::new(347);
+    let g = T::from_f64(G);
+    let (h, l) = (T::from_f64(0.7), T::from_f64(1.1));
+    poses_are_each_pose(&SimplePendulum::new(T::one(), h, g, T::zero())?, &mut rng);
+    poses_are_each_pose(&DoublePendulum::new(T::one(), T::one(), h, l, g)?, &mut rng);
+    poses_are_each_pose(&NLinkPendulum::new([T::one(); 3], [h; 3], g)?, &mut rng);
+    poses_are_each_pose(&CartPole::new(T::one(), T::one(), h, g)?, &mut rng);
+    poses_are_each_pose(&acrobot(h, l, g)?, &mut rng);
+    poses_are_each_pose(&Ragdoll::new(RagdollBody::<T>::adult())?, &mut rng);
+    poses_are_each_pose(&RigidBody::disk(T::one(), h, g)?, &mut rng);
+    Ok(())
+}
+
 for_f32_and_f64!(
+    all_poses_at_once,
     energies_agree,
     positions_follow_the_conventions,
     the_ragdoll_agrees,

@@ -184,6 +184,30 @@ fn each_kind_is_itself<T: Real>() -> Result<(), Error> {
         <Kinds<T> as Links<T, N>>::LINKS,
         <Ragdoll<T> as Links<T, RAGDOLL_COORDINATES>>::LINKS
     );
+    // Its poses from one call, and its batched mass solve: the ragdoll's own, the idle
+    // rows as they were.
+    let blank = lagrange_core::links::Pose {
+        origin: [T::zero(); 2],
+        angle: T::zero(),
+    };
+    let (mut wide_poses, mut own_poses) = ([blank; 10], [blank; 10]);
+    body.poses(&wide.q, &mut wide_poses);
+    doll.poses(&own.q, &mut own_poses);
+    assert_eq!(wide_poses, own_poses);
+    let columns = lagrange_core::nalgebra::SMatrix::<T, N, 3>::from_fn(|i, k| {
+        T::from_f64((i * 3 + k) as f64 * 0.25 - 2.0)
+    });
+    let (mut jumps, mut own_jumps) = (
+        columns,
+        columns.fixed_rows::<RAGDOLL_COORDINATES>(0).into_owned(),
+    );
+    body.velocity_jumps(&wide, &mut jumps)?;
+    doll.velocity_jumps(&own, &mut own_jumps)?;
+    assert_eq!(jumps.fixed_rows::<RAGDOLL_COORDINATES>(0), own_jumps);
+    assert_eq!(
+        jumps.fixed_rows::<2>(RAGDOLL_COORDINATES),
+        columns.fixed_rows::<2>(RAGDOLL_COORDINATES)
+    );
     // The second kind, moving on an idle coordinate: pushed there by an extra force.
     let crate_: Kinds<T> = OneOf::Second(box_);
     let mut s: State<T, N> = Kinds::<T>::second_state(&State::new(

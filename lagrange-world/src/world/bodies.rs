@@ -63,6 +63,18 @@ impl<T: Real, M: Mechanism<T, N>, L, const N: usize> Body<T, M, L, N> {
         }
     }
 
+    /// Links `0..poses.len()` posed in the world at coordinates `q` (as [`Body::pose`]
+    /// each, from one [`Links::poses`]).
+    pub(crate) fn poses(&self, q: &SVector<T, N>, poses: &mut [Pose<T>])
+    where
+        M: Links<T, N>,
+    {
+        self.mechanism.poses(q, poses);
+        for pose in poses {
+            pose.origin = add(pose.origin, self.origin);
+        }
+    }
+
     /// Awake, its time at rest started again.
     pub(crate) fn wake(&mut self) {
         self.asleep = false;

@@ -1,25 +1,27 @@
 //! Step 2 of a [`World`]'s step: where its shapes touch or may touch in the step, as contact
 //! rows in the bodies' coordinates; sleeping bodies an awake one touches are woken.
 
-use super::bodies::Attached;
 use super::limits::{Limits, MAX_OWN_ROWS};
+use super::places::{self, Place};
 use super::profile::{Profile, Stopwatch};
 use super::rows::{Contact, Row};
 use super::{World, OWN_ROWS};
 use crate::broad::Proxy;
 use crate::collide::{collide, collide_half_plane};
 use crate::manifold::ContactPoint;
-use crate::vec2::{length, rotate, sub, Vec2};
+use crate::vec2::{rotate, sub, Vec2};
 use heapless::Vec;
 use lagrange_core::links::Links;
 use lagrange_core::nalgebra::{SMatrix, SVector};
 use lagrange_core::{Error, Mechanism, Real};
 
-/// One side of a contact: a shape's key and the body and link it is on (none: static).
+/// One side of a contact: a shape's key, the body and link it is on (none: static), and
+/// where it is.
 #[derive(Debug, Clone, Copy)]
-struct Side {
+struct Side<T> {
     key: u32,
     on: Option<(usize, usize)>,
+    place: Place<T>,
 }
 
 impl<T, M, L, const N: usize, const B: usize, const S: usize, const K: usize>
@@ -64,10 +66,17 @@ where
     fn find(&mut self, dt: T, watch: &mut Stopwatch, profile: &mut Profile) -> Result<u32, Error> {
         self.contacts.clear();
         self.broad.clear();
+        places::place(
+            &mut self.places,
+            &self.shapes,
+            &self.by_body,
+            &self.bodies,
+            dt,
+        );
         let margin = self.settings.margin;
-        for (index, s) in self.shapes.iter().enumerate() {
-            let (lo, hi) = self.placed(s).bounds();
-            let grow = margin + self.reach(s, dt);
+        for (index, (s, place)) in self.shapes.iter().zip(&self.places).enumerate() {
+            let (lo, hi) = place.shape.bounds();
+            let grow = margin + place.reach;
             let body = s.on.map(|(i, _)| i);
             // Each proxy known by its shape's place: unique, and in the order of the shapes'
             // keys (the shapes are sorted by key), so the pairs come in the keys' order, and
@@ -90,12 +99,14 @@ where
         profile.broad += watch.lap();
         let mut woken = 0;
         for &(ia, ib) in &pairs {
-            let at = |i: u32| self.shapes.get(i as usize).copied();
-            let (Some(a), Some(b)) = (at(ia), at(ib)) else {
+            let (Some(a), Some(b)) = (self.side(ia as usize), self.side(ib as usize)) else {
                 continue;
             };
-            let reach = margin + self.reach(&a, dt) + self.reach(&b, dt);
-            let m = collide(&self.placed(&a), &self.placed(&b), reach);
+            let m = collide(
+                &a.place.shape,
+                &b.place.shape,
+                margin + a.place.reach + b.place.reach,
+            );
             if m.points().is_empty() {
                 continue;
             }
@@ -108,7 +119,7 @@ where
                 continue;
             }
             for p in m.points() {
-                self.push(side(&a), side(&b), m.normal, p, dt)?;
+                self.push(a, b, m.normal, p, dt)?;
             }
         }
         for pi in 0..self.planes.len() {
@@ -116,7 +127,7 @@ where
                 continue;
             };
             for si in 0..self.shapes.len() {
-                let Some(s) = self.shapes.get(si).copied() else {
+                let Some(s) = self.side(si) else {
                     continue;
                 };
                 let awake =
@@ -124,18 +135,33 @@ where
                 if !awake {
                     continue;
                 }
-                let reach = margin + self.reach(&s, dt);
-                let m = collide_half_plane(&plane, &self.placed(&s), reach);
+                let m = collide_half_plane(&plane, &s.place.shape, margin + s.place.reach);
+                let wall = Side {
+                    key,
+                    on: None,
+                    place: s.place,
+                };
                 for p in m.points() {
-                    self.push(Side { key, on: None }, side(&s), m.normal, p, dt)?;
+                    self.push(wall, s, m.normal, p, dt)?;
                 }
             }
         }
+        self.mobilities()?;
         for i in 0..self.bodies.len() {
             self.own_rows(i, dt)?;
         }
         profile.narrow += watch.lap();
         Ok(woken)
+    }
+
+    /// Shape `index` as a side of a contact.
+    fn side(&self, index: usize) -> Option<Side<T>> {
+        let (s, place) = (self.shapes.get(index)?, self.places.get(index)?);
+        Some(Side {
+            key: s.key,
+            on: s.on,
+            place: *place,
+        })
     }
 
     /// The rows of awake body `i`'s own (its limits), as contacts with nothing on their
@@ -230,49 +256,26 @@ where
         Ok(n)
     }
 
-    /// How far any point of shape `s` moves in the step at its body's velocity (zero for a
-    /// static or sleeping one): its link's origin's move and its turn times its reach from
-    /// that origin.
-    fn reach(&self, s: &Attached<T>, dt: T) -> T {
-        let Some((body, link)) = s.on.and_then(|(i, link)| Some((self.bodies.get(i)?, link)))
-        else {
-            return T::zero();
-        };
-        if body.asleep {
-            return T::zero();
-        }
-        let now = body.pose(&body.state.q, link);
-        let next = body.pose(&(body.state.q + body.state.qd * dt), link);
-        let extent = s
-            .shape
-            .vertices()
-            .iter()
-            .map(|&v| length(v))
-            .fold(T::zero(), T::max)
-            + s.shape.radius();
-        length(sub(next.origin, now.origin)) + (next.angle - now.angle).abs() * extent
-    }
-
     /// The contact at `p` between `a` and `b` (normal `n` from `a` to `b`): its rows at the
     /// bodies' coordinates, and its lowest speed.
     fn push(
         &mut self,
-        a: Side,
-        b: Side,
+        a: Side<T>,
+        b: Side<T>,
         n: Vec2<T>,
         p: &ContactPoint<T>,
         dt: T,
     ) -> Result<(), Error> {
         let t = [-n[1], n[0]];
         let zero = SVector::<T, N>::zeros();
-        let (mut jn, mut jt, mut bn, mut bt) = ([zero; 2], [zero; 2], [zero; 2], [zero; 2]);
+        let (mut jn, mut jt) = ([zero; 2], [zero; 2]);
         let mut approach = T::zero();
         for (s, (side, sign)) in [(a, -T::one()), (b, T::one())].into_iter().enumerate() {
             let Some((body, link)) = side.on.and_then(|(i, l)| Some((self.bodies.get(i)?, l)))
             else {
                 continue;
             };
-            let pose = body.pose(&body.state.q, link);
+            let pose = side.place.pose;
             let (sin, cos) = pose.angle.sin_cos();
             let local = rotate(sub(p.point, pose.origin), (-sin, cos));
             let j = body.mechanism.point(&body.state.q, link, local).jacobian;
@@ -284,10 +287,6 @@ where
             if let (Some(x), Some(y)) = (jn.get_mut(s), jt.get_mut(s)) {
                 (*x, *y) = (normal, tangent);
             }
-            if let (Some(x), Some(y)) = (bn.get_mut(s), bt.get_mut(s)) {
-                *x = body.mechanism.velocity_jump(&body.state, &normal)?;
-                *y = body.mechanism.velocity_jump(&body.state, &tangent)?;
-            }
         }
         let gap = p.gap;
         let lower = self.lowest(gap, approach, dt);
@@ -295,8 +294,9 @@ where
             .push(Contact {
                 key: (a.key, b.key, p.id),
                 bodies: [a.on.map(|(i, _)| i), b.on.map(|(i, _)| i)],
-                normal: Row::new(jn, bn),
-                tangent: Row::new(jt, bt),
+                // Their mobilities come with the others' of the same bodies.
+                normal: Row::new(jn, [zero; 2]),
+                tangent: Row::new(jt, [zero; 2]),
                 gap,
                 lower,
                 approach,
@@ -314,13 +314,5 @@ fn capacity() -> Error {
     Error::InvalidParameter {
         name: "capacity",
         reason: "more contact points than K",
-    }
-}
-
-/// The side of a contact that shape `s` is.
-fn side<T>(s: &Attached<T>) -> Side {
-    Side {
-        key: s.key,
-        on: s.on,
     }
 }

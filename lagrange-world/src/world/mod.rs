@@ -5,6 +5,8 @@ mod bodies;
 mod detect;
 mod islands;
 mod limits;
+mod mobilities;
+mod places;
 mod profile;
 mod rows;
 mod settings;
@@ -25,6 +27,7 @@ use islands::Islands;
 use lagrange_core::links::Links;
 use lagrange_core::nalgebra::SVector;
 use lagrange_core::{Error, Mechanism, Real, State};
+use places::Place;
 use profile::Stopwatch;
 use rows::{Contact, Kept};
 
@@ -195,6 +198,12 @@ pub struct World<
     by_key: Vec<(u32, usize), B>,
     /// Sorted by key.
     shapes: Vec<Attached<T>, S>,
+    /// The shapes on bodies as `(body, shape)`, their places in `bodies` and `shapes`,
+    /// sorted: a body's shapes placed together from its links posed once.
+    by_body: Vec<(u32, u32), S>,
+    /// Each shape where it is at the step's start and how far it may move (in `shapes`'
+    /// order): kept so that a step makes none.
+    places: Vec<Place<T>, S>,
     /// Sorted by key.
     planes: Vec<(u32, HalfPlane<T>), MAX_PLANES>,
     settings: WorldSettings<T>,
@@ -225,6 +234,8 @@ where
             bodies: Vec::new(),
             by_key: Vec::new(),
             shapes: Vec::new(),
+            by_body: Vec::new(),
+            places: Vec::new(),
             planes: Vec::new(),
             settings,
             contacts: Vec::new(),
@@ -819,7 +830,22 @@ where
             });
         }
         let at = self.shapes.partition_point(|s| s.key < shape.key);
-        self.shapes.insert(at, shape).map_err(|_| full())
+        let index = u32::try_from(at).map_err(|_| full())?;
+        let entry = match shape.on {
+            Some((body, _)) => Some((u32::try_from(body).map_err(|_| full())?, index)),
+            None => None,
+        };
+        self.shapes.insert(at, shape).map_err(|_| full())?;
+        // The shapes after it moved up one; it joins its body's (there is room: by_body
+        // holds fewer than the shapes).
+        for (_, i) in self.by_body.iter_mut().filter(|(_, i)| *i >= index) {
+            *i += 1;
+        }
+        if let Some(entry) = entry {
+            let place = self.by_body.partition_point(|e| *e < entry);
+            let _ = self.by_body.insert(place, entry);
+        }
+        Ok(())
     }
 
     /// Shape `s` where its body's link is now (a static shape where it is).

@@ -43,6 +43,11 @@ impl<T: Real, const N: usize> Row<T, N> {
         }
     }
 
+    /// Its `1 / W` again, from its mobilities as they are now (set after the row was made).
+    pub(crate) fn refresh(&mut self) {
+        self.inverse = Self::new(self.j, self.b).inverse;
+    }
+
     /// The row's velocity `a` at the bodies' velocities `v` (a side of no body: `None`).
     pub(crate) fn speed(&self, v: [Option<&SVector<T, N>>; 2]) -> T {
         v.iter()
