@@ -371,7 +371,12 @@ fn poses_are_each_pose<T: Real, L: Links<T, N>, const N: usize>(l: &L, rng: &mut
             } else {
                 marker
             };
-            assert_eq!(*pose, expected, "{}, link {link}", core::any::type_name::<L>());
+            assert_eq!(
+                *pose,
+                expected,
+                "{}, link {link}",
+                core::any::type_name::<L>()
+            );
         }
     }
 }
