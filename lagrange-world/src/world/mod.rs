@@ -30,6 +30,7 @@ use lagrange_core::{Error, Mechanism, Real, State};
 use places::Place;
 use profile::Stopwatch;
 use rows::{Contact, Kept};
+use solve::Order;
 
 /// The first key of a body's own rows' contacts, `(OWN_ROWS, body, row)`: a key no shape
 /// or half-plane may take.
@@ -585,7 +586,9 @@ where
             ..Profile::default()
         };
         report.woke = self.detect(dt, watch, &mut profile)?;
-        report.guarded = self.solve();
+        let own = self.contacts.partition_point(|c| c.key.0 != OWN_ROWS);
+        let order = Order::of::<T, N, B>(&self.contacts, own);
+        report.guarded = self.solve(&order);
         profile.solve = watch.lap();
         let mut pseudo = [SVector::<T, N>::zeros(); B];
         let velocities: [SVector<T, N>; B] =
@@ -594,15 +597,18 @@ where
             &mut pseudo,
             &velocities,
             &mut self.contacts,
+            &order.all,
             self.settings.slop,
             dt,
             self.settings.sweeps,
         );
         // The bodies' own rows have the last word here too.
-        let own = self.contacts.partition_point(|c| c.key.0 != OWN_ROWS);
-        if let Some(rows) = self.contacts.get_mut(own..) {
-            solve::pseudo(&mut pseudo, rows, OWN_SWEEPS * self.settings.sweeps);
-        }
+        solve::pseudo(
+            &mut pseudo,
+            &mut self.contacts,
+            &order.own,
+            OWN_SWEEPS * self.settings.sweeps,
+        );
         for (body, p) in self
             .bodies
             .iter_mut()
@@ -627,13 +633,13 @@ where
 
     /// Step 3 of the scheme: the impulses, into the awake bodies' velocities. Whether the
     /// guard solved again (see [`WorldReport::guarded`]).
-    fn solve(&mut self) -> bool {
+    fn solve(&mut self, order: &Order<K>) -> bool {
         let free = self.velocities();
         let before = self.kinetic(&free);
         let mut v = free;
         solve::warm_start(&mut v, &self.contacts);
         let (friction, sweeps) = (self.settings.model.friction(), self.settings.sweeps);
-        sweep(&mut v, &mut self.contacts, friction, sweeps);
+        sweep(&mut v, &mut self.contacts, order, friction, sweeps);
         let after = self.kinetic(&v);
         // 16 ulps of the energies: the rounding of sums of a few products.
         let rounding = T::from_f64(16.0) * T::EPSILON * (before.abs() + after.abs());
@@ -645,7 +651,7 @@ where
                 c.tangent.lambda = T::zero();
                 c.lower = c.lower.min(T::zero());
             }
-            sweep(&mut v, &mut self.contacts, friction, sweeps);
+            sweep(&mut v, &mut self.contacts, order, friction, sweeps);
         }
         self.set_velocities(&v);
         guarded
@@ -857,21 +863,19 @@ where
     }
 }
 
-/// The impulse solve over `contacts` (sorted by key, the bodies' own rows last), then as
-/// many sweeps over the own rows alone: a joint's limit has the last word over the contacts
+/// The impulse solve over `contacts` in `order`, then [`OWN_SWEEPS`] times as many sweeps
+/// over the bodies' own rows alone: a joint's limit has the last word over the contacts
 /// that strike its limb (their leftover depth is the drift's to remove; a limit passed is
 /// what a viewer sees).
-fn sweep<T: Real, const N: usize>(
+fn sweep<T: Real, const N: usize, const K: usize>(
     v: &mut [SVector<T, N>],
     contacts: &mut [Contact<T, N>],
+    order: &Order<K>,
     friction: T,
     sweeps: u32,
 ) {
-    solve::velocities(v, contacts, friction, sweeps);
-    let own = contacts.partition_point(|c| c.key.0 != OWN_ROWS);
-    if let Some(rows) = contacts.get_mut(own..) {
-        solve::velocities(v, rows, friction, OWN_SWEEPS * sweeps);
-    }
+    solve::velocities(v, contacts, &order.all, friction, sweeps);
+    solve::velocities(v, contacts, &order.own, friction, OWN_SWEEPS * sweeps);
 }
 
 /// A count as the report's `u32`.

@@ -1,8 +1,10 @@
 //! The impulse solve of a [`World`](super::World)'s step: projected Gauss-Seidel over the
-//! contact rows in their keys' order (sequential impulses), in the bodies' generalized
-//! velocities, and the same over pseudo-velocities for the drift.
+//! contact rows (sequential impulses) in an order of rounds fixed by their keys
+//! ([`Order`]), in the bodies' generalized velocities, and the same over pseudo-velocities
+//! for the drift.
 
 use super::rows::{Contact, Row};
+use heapless::Vec;
 use lagrange_core::nalgebra::SVector;
 use lagrange_core::Real;
 
@@ -43,19 +45,23 @@ pub(crate) fn warm_start<T: Real, const N: usize>(
     }
 }
 
-/// `sweeps` sweeps over the contacts: each tangent within `friction` times its normal
-/// impulse (Coulomb's cone), then each normal row to no less than its `lower` speed with a
-/// push that never pulls (its accumulated impulse stays `>= 0`). Each change lowers the
-/// program whose minimum the impulses are, so that with `lower <= 0` (no rebound) the
-/// kinetic energy never rises.
+/// `sweeps` sweeps over the contacts `order` names: each tangent within `friction` times
+/// its normal impulse (Coulomb's cone), then each normal row to no less than its `lower`
+/// speed with a push that never pulls (its accumulated impulse stays `>= 0`). Each change
+/// lowers the program whose minimum the impulses are, so that with `lower <= 0` (no
+/// rebound) the kinetic energy never rises.
 pub(crate) fn velocities<T: Real, const N: usize>(
     v: Velocities<'_, T, N>,
     contacts: &mut [Contact<T, N>],
+    order: &[u32],
     friction: T,
     sweeps: u32,
 ) {
     for _ in 0..sweeps {
-        for c in contacts.iter_mut() {
+        for &i in order {
+            let Some(c) = contacts.get_mut(i as usize) else {
+                continue;
+            };
             if friction > T::zero() {
                 let bound = friction * c.normal.lambda;
                 let a = speed(v, c.bodies, &c.tangent);
@@ -86,6 +92,7 @@ pub(crate) fn drift<T: Real, const N: usize>(
     p: Velocities<'_, T, N>,
     v: &[SVector<T, N>],
     contacts: &mut [Contact<T, N>],
+    order: &[u32],
     slop: T,
     dt: T,
     sweeps: u32,
@@ -99,22 +106,203 @@ pub(crate) fn drift<T: Real, const N: usize>(
     if contacts.iter().all(|c| c.reach <= T::zero()) {
         return;
     }
-    pseudo(p, contacts, sweeps);
+    pseudo(p, contacts, order, sweeps);
 }
 
-/// `sweeps` sweeps of the drift's rows (see [`drift`]).
+/// `sweeps` sweeps of the drift's rows `order` names (see [`drift`]).
 pub(crate) fn pseudo<T: Real, const N: usize>(
     p: Velocities<'_, T, N>,
     contacts: &mut [Contact<T, N>],
+    order: &[u32],
     sweeps: u32,
 ) {
     for _ in 0..sweeps {
-        for c in contacts.iter_mut() {
+        for &i in order {
+            let Some(c) = contacts.get_mut(i as usize) else {
+                continue;
+            };
             let a = speed(p, c.bodies, &c.normal);
             let lambda = (c.drift + (c.reach - a) * c.normal.inverse).max(T::zero());
             let d = lambda - c.drift;
             c.drift = lambda;
             apply(p, c.bodies, &c.normal, d);
+        }
+    }
+}
+
+/// How many contacts ahead of the keys' order the solve may take one.
+const AHEAD: usize = 16;
+
+/// How many of the contacts just taken the next one should share no body with.
+const APART: usize = 2;
+
+/// No contact.
+const NONE: u32 = u32::MAX;
+
+/// The order the sweeps take the contacts in: the keys' order, but each next contact the
+/// first of the next [`AHEAD`] not yet taken that is ready (every contact before it that
+/// shares a body with it taken) and shares no body with the [`APART`] taken last (else the
+/// first not yet taken, always ready). A row's impulse waits on its speed, and the next
+/// row's speed on that impulse where they share a body: rows of other bodies one after
+/// another let a processor work on several at once (a pyramid of 55 boxes: 78 -> 70 us a
+/// step; ten ragdolls in a pile: 0.137 -> 0.114 ms). Rows of bodies apart commute, so this
+/// order gives the keys' order's bits: a sweep is the same Gauss-Seidel sweep, only faster.
+/// (Orders that do not keep each body's rows in the keys' order go faster still, 59 us,
+/// but change the solve: by rounds of disjoint contacts, or pairs taken ahead, a pyramid's
+/// top crept twice as far in 10 s and a ragdoll pile sank 64 mm where it sinks 31.)
+#[derive(Debug, Clone)]
+pub(crate) struct Order<const K: usize> {
+    /// Every contact.
+    pub(crate) all: Vec<u32, K>,
+    /// The bodies' own rows alone (solved again after the others: see `World::sweep`).
+    pub(crate) own: Vec<u32, K>,
+}
+
+impl<const K: usize> Order<K> {
+    /// The order of `contacts` (sorted by key, the bodies' own rows, from `own` on, last)
+    /// of a world of `B` bodies.
+    pub(crate) fn of<T: Real, const N: usize, const B: usize>(
+        contacts: &[Contact<T, N>],
+        own: usize,
+    ) -> Self {
+        Self {
+            all: interleaved::<T, N, B, K>(contacts, 0),
+            own: interleaved::<T, N, B, K>(contacts, own),
+        }
+    }
+}
+
+/// The contacts from `first` on, interleaved (see [`Order`]).
+fn interleaved<T: Real, const N: usize, const B: usize, const K: usize>(
+    contacts: &[Contact<T, N>],
+    first: usize,
+) -> Vec<u32, K> {
+    // Each body's contacts as a list: `front[body]` its first not yet taken, then
+    // `after[side][c]` after contact `c` on that side (built from the last back).
+    let mut front = [NONE; B];
+    let mut after = [[NONE; K]; 2];
+    for (c, contact) in contacts.iter().enumerate().skip(first).rev() {
+        for (side, body) in contact.bodies.iter().enumerate() {
+            let (Some(head), Some(next)) = (
+                body.and_then(|b| front.get_mut(b)),
+                after.get_mut(side).and_then(|a| a.get_mut(c)),
+            ) else {
+                continue;
+            };
+            *next = *head;
+            *head = u32::try_from(c).unwrap_or(NONE);
+        }
+    }
+    let bodies = |c: usize| contacts.get(c).map_or([None; 2], |c| c.bodies);
+    let mut order = Vec::new();
+    let mut window: Vec<usize, AHEAD> = Vec::new();
+    let mut next = first;
+    let mut last = [[None; 2]; APART];
+    loop {
+        while !window.is_full() && next < contacts.len() {
+            let _ = window.push(next);
+            next += 1;
+        }
+        let ready = |c: usize| {
+            bodies(c)
+                .iter()
+                .flatten()
+                .all(|&b| front.get(b).is_some_and(|&f| f as usize == c))
+        };
+        let apart = |c: usize| {
+            bodies(c)
+                .iter()
+                .flatten()
+                .all(|b| !last.iter().flatten().flatten().any(|l| l == b))
+        };
+        let Some(pick) = window
+            .iter()
+            .position(|&c| ready(c) && apart(c))
+            .or((!window.is_empty()).then_some(0))
+        else {
+            break;
+        };
+        let c = window.remove(pick);
+        let _ = order.push(u32::try_from(c).unwrap_or(NONE));
+        for (side, body) in bodies(c).iter().enumerate() {
+            let (Some(head), Some(&next)) = (
+                body.and_then(|b| front.get_mut(b)),
+                after.get(side).and_then(|a| a.get(c)),
+            ) else {
+                continue;
+            };
+            *head = next;
+        }
+        last.rotate_right(1);
+        last[0] = bodies(c);
+    }
+    order
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{velocities, Order};
+    use crate::world::rows::{Contact, Row};
+    use lagrange_core::nalgebra::SVector;
+
+    /// A contact between `bodies` (of 2 coordinates), its rows drawn from `draw`.
+    fn contact(bodies: [Option<usize>; 2], draw: &mut impl FnMut() -> f64) -> Contact<f64, 2> {
+        let mut row = || {
+            let j = [0, 1].map(|_| SVector::<f64, 2>::new(draw(), draw()));
+            Row::new(j, j.map(|j| j * 0.5))
+        };
+        Contact {
+            key: (0, 0, 0),
+            bodies,
+            normal: row(),
+            tangent: row(),
+            gap: 0.0,
+            lower: draw(),
+            approach: 0.0,
+            drift: 0.0,
+            reach: 0.0,
+            point: [0.0; 2],
+            direction: [0.0; 2],
+        }
+    }
+
+    /// Over 200 random sets of contacts among 6 bodies (some on static geometry), the
+    /// interleaved order takes every contact once, from `first` on, and its sweeps give the
+    /// keys' order's bits.
+    #[test]
+    fn the_interleaved_order_is_the_keys_bits() {
+        let mut seed = 0x2545_f491_4f6c_dd1d_u64;
+        let mut draw = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        };
+        for round in 0..200 {
+            let count = 1 + round % 40;
+            let mut contacts: heapless::Vec<Contact<f64, 2>, 64> = heapless::Vec::new();
+            for _ in 0..count {
+                let body = |x: f64| ((x + 0.5) * 6.0) as usize;
+                let (a, b) = (body(draw()), body(draw()));
+                let first = (draw() > -0.3).then_some(a);
+                let second = if b == a { None } else { Some(b) };
+                assert!(contacts.push(contact([first, second], &mut draw)).is_ok());
+            }
+            let own = round % (count + 1);
+            let order = Order::<64>::of::<f64, 2, 6>(&contacts, own);
+            let mut all = order.all.clone();
+            all.sort_unstable();
+            assert!(all.iter().copied().eq(0..count as u32), "{all:?}");
+            let mut rest = order.own.clone();
+            rest.sort_unstable();
+            assert!(rest.iter().copied().eq(own as u32..count as u32));
+            let keys: heapless::Vec<u32, 64> = (0..count as u32).collect();
+            let start = [0; 6].map(|_| SVector::<f64, 2>::new(draw(), draw()));
+            let (mut v, mut w) = (start, start);
+            let mut other = contacts.clone();
+            velocities(&mut v, &mut contacts, &keys, 0.5, 3);
+            velocities(&mut w, &mut other, &order.all, 0.5, 3);
+            assert_eq!(v, w, "round {round}");
         }
     }
 }
