@@ -131,7 +131,7 @@ pub(crate) fn pseudo<T: Real, const N: usize>(
 }
 
 /// How many contacts ahead of the keys' order the solve may take one.
-const AHEAD: usize = 16;
+const AHEAD: usize = 8;
 
 /// How many of the contacts just taken the next one should share no body with.
 const APART: usize = 2;
@@ -177,6 +177,9 @@ fn interleaved<T: Real, const N: usize, const B: usize, const K: usize>(
     contacts: &[Contact<T, N>],
     first: usize,
 ) -> Vec<u32, K> {
+    if first >= contacts.len() {
+        return Vec::new();
+    }
     // Each body's contacts as a list: `front[body]` its first not yet taken, then
     // `after[side][c]` after contact `c` on that side (built from the last back).
     let mut front = [NONE; B];
