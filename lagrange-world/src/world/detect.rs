@@ -66,6 +66,12 @@ where
     fn find(&mut self, dt: T, watch: &mut Stopwatch, profile: &mut Profile) -> Result<u32, Error> {
         self.contacts.clear();
         self.broad.clear();
+        // Every pair and every half-plane needs a body awake: a world asleep finds nothing
+        // (and costs nothing here).
+        if self.bodies.iter().all(|b| b.asleep) {
+            profile.broad += watch.lap();
+            return Ok(0);
+        }
         places::place(
             &mut self.places,
             &self.shapes,
@@ -127,14 +133,14 @@ where
                 continue;
             };
             for si in 0..self.shapes.len() {
-                let Some(s) = self.side(si) else {
+                let awake = self
+                    .shapes
+                    .get(si)
+                    .and_then(|s| s.on)
+                    .is_some_and(|(i, _)| self.bodies.get(i).is_some_and(|b| !b.asleep));
+                let Some(s) = self.side(si).filter(|_| awake) else {
                     continue;
                 };
-                let awake =
-                    s.on.is_some_and(|(i, _)| self.bodies.get(i).is_some_and(|b| !b.asleep));
-                if !awake {
-                    continue;
-                }
                 let m = collide_half_plane(&plane, &s.place.shape, margin + s.place.reach);
                 let wall = Side {
                     key,

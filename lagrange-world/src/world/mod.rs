@@ -147,11 +147,15 @@ pub struct WorldHit<T> {
 /// a contact that let go), it is done again from zero impulses without rebounds
 /// ([`WorldReport::guarded`]).
 ///
-/// **Cost.** Detection: the broad phase's sweep and prune over the shapes, one narrow phase
-/// a pair that may touch; then per contact point two mass solves per body it joins (a
-/// constant mass matrix: a multiply). The solve: `sweeps` passes over the contacts, `8 N`
-/// multiply-adds a contact a pass. Asleep bodies cost nothing but their shapes' place in
-/// the broad phase.
+/// **Cost.** Detection: each awake body's links posed twice (where they are and where the
+/// step takes them: [`Links::poses`]), the broad phase's sweep and prune over the shapes, one
+/// narrow phase a pair that may touch; then per contact point its rows' Jacobians, and
+/// their mobilities from each body's mass solve, eight contact points of a body to a call
+/// of [`Mechanism::velocity_jumps`] (one factorisation of a ragdoll's mass matrix for
+/// them; a constant mass matrix: a multiply a row). The solve: `sweeps` passes over the
+/// contacts, `8 N` multiply-adds a contact a pass, in an order that lets rows of bodies
+/// apart go at once. Asleep bodies cost nothing but their shapes' place in the broad
+/// phase.
 ///
 /// **Determinism.** Contacts are solved in the order of their keys (the shapes' keys and
 /// the features that meet), islands are named by their least body key, and each body's free
