@@ -838,6 +838,8 @@ const AREAS: [Area; 29] = [
             "lagrange-world/src/world/detect.rs",
             "lagrange-world/src/world/islands.rs",
             "lagrange-world/src/world/limits.rs",
+            "lagrange-world/src/world/mobilities.rs",
+            "lagrange-world/src/world/places.rs",
             "lagrange-world/src/world/profile.rs",
             "lagrange-world/src/world/rows.rs",
             "lagrange-world/src/world/settings.rs",
