@@ -98,5 +98,5 @@ pub use lagrangian::{EulerLagrange, Lagrangian};
 pub use lanes::{divergences, Lanes, VECTOR_UNIT};
 pub use mechanism::{jacobian_by_differences, Mechanism};
 pub use nalgebra;
-pub use scalar::{all_finite, check_finite, Real, Scalar};
+pub use scalar::{all_finite, check_finite, split_dot, Real, Scalar};
 pub use state::State;

@@ -178,6 +178,28 @@ pub fn all_finite<T: Real>(values: &[T]) -> bool {
     values.iter().fold(true, |all, x| all & x.is_finite())
 }
 
+/// `a . b` over the shorter of the two, summed in four partial sums (terms `0, 4, 8, ...`
+/// in the first, `1, 5, ...` in the second; then the first two and the last two added, and
+/// the two sums): a chain of additions a quarter as long as one running sum's. What a sweep
+/// of Gauss-Seidel wants, where each row's speed waits on the last row's impulse (the
+/// impulse stepper's friction sweeps: a landing ragdoll's slowest step 6.5 -> 4.6 us). Not
+/// the bits of a running sum (nalgebra's `dot`).
+///
+/// ```
+/// use lagrange_core::split_dot;
+/// assert_eq!(split_dot(&[1.0f64, 2.0, 3.0], &[4.0, 5.0, 6.0]), 32.0);
+/// assert_eq!(split_dot::<f32>(&[], &[]), 0.0);
+/// ```
+#[inline]
+#[must_use]
+pub fn split_dot<T: Real>(a: &[T], b: &[T]) -> T {
+    let mut sums = [T::zero(); 4];
+    for (k, (x, y)) in a.iter().zip(b).enumerate() {
+        sums[k % 4] += *x * *y;
+    }
+    (sums[0] + sums[1]) + (sums[2] + sums[3])
+}
+
 /// `Ok(())` when every value is finite, else `Err(error)`: the test of a result before it is
 /// returned.
 ///

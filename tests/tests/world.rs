@@ -276,7 +276,8 @@ fn ticks() -> u64 {
 /// step and once after each part, the narrow phase twice (after the pairs' manifolds, and
 /// after their warm start), so that with a clock ticking once a read every step's profile is
 /// exactly one tick a part and two for the narrow phase (no body asleep: one pass of
-/// detection); the world without reads none (every part zero).
+/// detection); the world without reads none (every part zero). A pyramid of 6 asleep: one
+/// tick for the narrow phase too (it looks for no contacts).
 fn a_clock_changes_no_bits<T: Real>() -> Result<(), Error> {
     let (mut timed, count) = pyramid(stacking::<T>()?, 6, false)?;
     let (mut plain, _) = pyramid(stacking::<T>()?, 6, false)?;
@@ -303,6 +304,23 @@ fn a_clock_changes_no_bits<T: Real>() -> Result<(), Error> {
         timed.step(T::from_f64(1.0 / 60.0))?.profile,
         Profile::default()
     );
+    // Asleep, a world looks for no contacts: one read after the broad phase, none of its
+    // own in the narrow phase (one read after it, for the warm start).
+    let (mut resting, _) = pyramid(
+        stacking::<T>()?.with_sleep(T::from_f64(0.05), T::HALF)?,
+        3,
+        false,
+    )?;
+    resting.set_clock(Some(ticks));
+    let mut asleep = 0;
+    for _ in 0..600 {
+        let report = resting.step(T::from_f64(1.0 / 60.0))?;
+        if report.awake == 0 {
+            asleep += 1;
+            assert_eq!(report.profile, Profile { narrow: 1, ..each }, "{report:?}");
+        }
+    }
+    assert!(asleep > 100, "asleep for {asleep} steps");
     Ok(())
 }
 

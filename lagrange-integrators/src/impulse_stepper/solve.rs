@@ -5,7 +5,7 @@
 use super::rows::{within, Direction};
 use lagrange_core::constraints::contact::{Delassus, Row};
 use lagrange_core::nalgebra::SVector;
-use lagrange_core::{Error, Real};
+use lagrange_core::{split_dot, Error, Real};
 
 /// The impulses of one step per row of the contact set: along each row's normal and its
 /// tangent (zero where a row took no part).
@@ -142,7 +142,8 @@ impl<T: Real, const N: usize, const C: usize> Problem<'_, T, N, C> {
                     // through an array, and a bounds check is a panic path.
                     let i = within::<C>(i);
                     let Some(t) = &self.tangent[i] else { continue };
-                    let u = t.j.dot(&v);
+                    // In partial sums: the next tangent's speed waits on this one.
+                    let u = split_dot(t.j.as_slice(), v.as_slice());
                     let bound = self.friction * p.normal[i];
                     let tangent = &mut p.tangent[i];
                     let next = (*tangent - u * t.inverse).max(-bound).min(bound);
