@@ -76,8 +76,10 @@ pub(crate) fn place<T, M, L, const N: usize, const B: usize, const S: usize>(
                 continue;
             };
             let link = s.on.map_or(0, |(_, link)| link);
+            // Every link below `posed` is posed (a shape's link is below LINKS), and the
+            // arrays hold no more: a link past them is posed on its own.
             let (pose, then) = match (now.get(link), next.get(link)) {
-                (Some(&p), Some(&n)) if link < posed => (p, n),
+                (Some(&p), Some(&n)) => (p, n),
                 _ => (body.pose(&q, link), body.pose(&ahead, link)),
             };
             let reach = if body.asleep {

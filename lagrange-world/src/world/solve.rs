@@ -269,6 +269,24 @@ mod tests {
         }
     }
 
+    /// Rows of bodies apart go one after another: of contacts between bodies (0, 1), (0, 2)
+    /// and (3, 4), the third (ready: no contact before it shares a body with it) goes before
+    /// the second (which shares body 0 with the first); a contact with no body before it
+    /// that shares one goes in its keys' place; the own rows alone from their first.
+    #[test]
+    fn rows_of_bodies_apart_take_turns() {
+        let mut draw = || 0.25;
+        let contacts = [
+            contact([Some(0), Some(1)], &mut draw),
+            contact([Some(0), Some(2)], &mut draw),
+            contact([Some(3), Some(4)], &mut draw),
+            contact([Some(2), None], &mut draw),
+        ];
+        let order = Order::<8>::of::<f64, 2, 6>(&contacts, 2);
+        assert_eq!(order.all.as_slice(), &[0, 2, 1, 3]);
+        assert_eq!(order.own.as_slice(), &[2, 3]);
+    }
+
     /// Over 200 random sets of contacts among 6 bodies (some on static geometry), the
     /// interleaved order takes every contact once, from `first` on, and its sweeps give the
     /// keys' order's bits.

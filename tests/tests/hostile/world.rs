@@ -14,12 +14,12 @@ use crate::harness::{lit, lits, ty, Ctx, Entry, Family, Verdict};
 use crate::values::Kind;
 use crate::{entries, say};
 use lagrange_core::constraints::contact::ContactModel;
-use lagrange_core::{Real, State};
-use lagrange_systems::RigidBody;
-use lagrange_world::{HalfPlane, Shape, World, WorldSettings};
-
-/// Up to 4 bodies, 6 shapes, 24 contact points: full now and then.
-type Bodies<T> = World<T, RigidBody<T>, 3, 4, 6, 24>;
+use lagrange_core::links::Links;
+use lagrange_core::{Mechanism, Real, State};
+use lagrange_systems::{
+    Ragdoll, RagdollBody, RigidBody, ADULT_JOINT_LIMITS, RAGDOLL_COORDINATES, RAGDOLL_LINKS,
+};
+use lagrange_world::{CoordinateLimits, HalfPlane, Limits, NoLimits, Shape, World, WorldSettings};
 
 /// Drawn settings, or the verdict of the error that refused them.
 fn settings<T: Real>(ctx: &mut Ctx) -> Result<WorldSettings<T>, Verdict> {
@@ -134,64 +134,146 @@ fn shape<T: Real>(ctx: &mut Ctx) -> Result<Shape<T>, Verdict> {
     Ok(s)
 }
 
+/// A world of `M` with `N` coordinates and own rows `L`, up to 4 bodies, 6 shapes and 24
+/// contact points.
+type Drawn<T, M, L, const N: usize> = World<T, M, N, 4, 6, 24, L>;
+
 /// Every body's state, by key `0..8` (those that exist).
-fn states<T: Real>(w: &Bodies<T>) -> Vec<Option<State<T, 3>>> {
+fn states<T: Real, M, L, const N: usize>(w: &Drawn<T, M, L, N>) -> Vec<Option<State<T, N>>>
+where
+    M: Mechanism<T, N> + Links<T, N> + Clone,
+    L: Limits<T, N>,
+{
     (0..8).map(|k| w.state(k)).collect()
 }
 
-/// A world built from drawn parts, then a drawn sequence of calls.
+/// A world of rigid bodies built from drawn parts, then a drawn sequence of calls.
 fn rigid_bodies<T: Real>(ctx: &mut Ctx) -> Verdict {
+    drawn_world::<T, RigidBody<T>, NoLimits, 3>(ctx, "RigidBody", 1, rigid_body)
+}
+
+/// A world of ragdolls (the adult, with drawn joint limits now and then) built from drawn
+/// parts, then a drawn sequence of calls: the world's paths for a mechanism of many links
+/// (their poses from one call, contact mobilities batched per body) and for own rows.
+fn ragdolls<T: Real>(ctx: &mut Ctx) -> Verdict {
+    drawn_world::<T, Ragdoll<T>, CoordinateLimits<9>, RAGDOLL_COORDINATES>(
+        ctx,
+        "Ragdoll",
+        RAGDOLL_LINKS,
+        ragdoll,
+    )
+}
+
+/// A drawn rigid body added as `key`: the verdict.
+fn rigid_body<T: Real>(
+    ctx: &mut Ctx,
+    w: &mut Drawn<T, RigidBody<T>, NoLimits, 3>,
+    key: u32,
+) -> Verdict {
+    let [m, a, b] = ctx.values::<T, 3>(Kind::Param);
+    let g = ctx.value::<T>(Kind::Param);
+    let (body, params): (Result<RigidBody<T>, _>, &[&str]) = if ctx.pick(2) == 0 {
+        say!(
+            ctx,
+            "let body = RigidBody::rectangle({}, {}, {}, {})?;",
+            lit(m),
+            lit(a),
+            lit(b),
+            lit(g)
+        );
+        (
+            RigidBody::rectangle(m, a, b, g),
+            &["mass", "width", "height", "gravity"],
+        )
+    } else {
+        say!(
+            ctx,
+            "let body = RigidBody::disk({}, {}, {})?;",
+            lit(m),
+            lit(a),
+            lit(g)
+        );
+        (RigidBody::disk(m, a, g), &["mass", "radius", "gravity"])
+    };
+    let body = match body {
+        Ok(b) => b,
+        Err(e) => return refused(e, params),
+    };
+    let s = state::<T, 3>(ctx, "s");
+    say!(ctx, "w.add_body({key}, body, s)?;");
+    verdict(&w.add_body(key, body, s), &["key", "capacity"])
+}
+
+/// The adult ragdoll added as `key`, its joint limits the adult's or (now and then) drawn,
+/// its origin drawn: the verdict.
+fn ragdoll<T: Real>(
+    ctx: &mut Ctx,
+    w: &mut Drawn<T, Ragdoll<T>, CoordinateLimits<9>, RAGDOLL_COORDINATES>,
+    key: u32,
+) -> Verdict {
+    let doll = match Ragdoll::new(RagdollBody::<T>::adult()) {
+        Ok(d) => d,
+        Err(e) => return refused(e, &[]),
+    };
+    say!(
+        ctx,
+        "let doll = Ragdoll::new(RagdollBody::<{}>::adult())?;",
+        ty::<T>()
+    );
+    let bounds = if ctx.pick(3) == 0 {
+        let drawn = ctx.values::<f64, 18>(Kind::State);
+        core::array::from_fn(|k| [drawn[2 * k], drawn[2 * k + 1]])
+    } else {
+        ADULT_JOINT_LIMITS
+    };
+    say!(
+        ctx,
+        "let limits = CoordinateLimits::new(core::array::from_fn(|j| j + 3), {bounds:?})?;"
+    );
+    let limits = match CoordinateLimits::new(core::array::from_fn(|j| j + 3), bounds) {
+        Ok(l) => l,
+        Err(e) => return refused(e, &["bounds"]),
+    };
+    let s = state::<T, RAGDOLL_COORDINATES>(ctx, "s");
+    let origin = ctx.values::<T, 2>(Kind::State);
+    say!(
+        ctx,
+        "w.add_body_with({key}, doll, limits, s, {})?;",
+        lits(&origin)
+    );
+    verdict(
+        &w.add_body_with(key, doll, limits, s, origin),
+        &["key", "capacity", "origin"],
+    )
+}
+
+/// A world of `M` (named `name`, of `links` links) built from drawn parts, its bodies drawn
+/// and added by `add`, then a drawn sequence of calls.
+fn drawn_world<T, M, L, const N: usize>(
+    ctx: &mut Ctx,
+    name: &str,
+    links: usize,
+    add: fn(&mut Ctx, &mut Drawn<T, M, L, N>, u32) -> Verdict,
+) -> Verdict
+where
+    T: Real,
+    M: Mechanism<T, N> + Links<T, N> + Clone,
+    L: Limits<T, N>,
+{
     let settings = match settings::<T>(ctx) {
         Ok(s) => s,
         Err(v) => return v,
     };
-    let mut w = Box::new(Bodies::<T>::new(settings));
+    let mut w = Box::new(Drawn::<T, M, L, N>::new(settings));
     say!(
         ctx,
-        "let mut w = World::<{}, RigidBody<{}>, 3, 4, 6, 24>::new(settings);",
+        "let mut w = World::<{}, {name}<{}>, {N}, 4, 6, 24, _>::new(settings);",
         ty::<T>(),
         ty::<T>()
     );
     for _ in 0..=ctx.pick(5) {
         let key = ctx.pick(8) as u32;
-        let [m, a, b] = ctx.values::<T, 3>(Kind::Param);
-        let g = ctx.value::<T>(Kind::Param);
-        let (body, params): (Result<RigidBody<T>, _>, &[&str]) = if ctx.pick(2) == 0 {
-            say!(
-                ctx,
-                "let body = RigidBody::rectangle({}, {}, {}, {})?;",
-                lit(m),
-                lit(a),
-                lit(b),
-                lit(g)
-            );
-            (
-                RigidBody::rectangle(m, a, b, g),
-                &["mass", "width", "height", "gravity"],
-            )
-        } else {
-            say!(
-                ctx,
-                "let body = RigidBody::disk({}, {}, {})?;",
-                lit(m),
-                lit(a),
-                lit(g)
-            );
-            (RigidBody::disk(m, a, g), &["mass", "radius", "gravity"])
-        };
-        let body = match body {
-            Ok(b) => b,
-            Err(e) => {
-                let v = refused(e, params);
-                if v.class().is_finding() {
-                    return v;
-                }
-                continue;
-            }
-        };
-        let s = state::<T, 3>(ctx, "s");
-        say!(ctx, "w.add_body({key}, body, s)?;");
-        let v = verdict(&w.add_body(key, body, s), &["key", "capacity"]);
+        let v = add(ctx, &mut w, key);
         if v.class().is_finding() {
             return v;
         }
@@ -228,7 +310,13 @@ fn rigid_bodies<T: Real>(ctx: &mut Ctx) -> Verdict {
                     Err(v) if v.class().is_finding() => return v,
                     Err(_) => continue,
                 };
-                let (body, link) = (ctx.pick(8) as u32, ctx.pick(3) / 2);
+                // A link of the mechanism's, or one past them now and then.
+                let body = ctx.pick(8) as u32;
+                let link = if ctx.pick(3) == 0 {
+                    links + ctx.pick(2)
+                } else {
+                    ctx.pick(links)
+                };
                 say!(ctx, "w.add_shape({key}, {body}, {link}, shape)?;");
                 w.add_shape(key, body, link, s)
             }
@@ -254,7 +342,7 @@ fn rigid_bodies<T: Real>(ctx: &mut Ctx) -> Verdict {
             }
             1 => {
                 let key = ctx.pick(8) as u32;
-                let s = state::<T, 3>(ctx, "s");
+                let s = state::<T, N>(ctx, "s");
                 say!(ctx, "w.set_state({key}, s)?;");
                 verdict(&w.set_state(key, s), &["body"])
             }
@@ -335,6 +423,12 @@ pub fn family() -> Family {
         1.0,
         "World<RigidBody>: settings, bodies, shapes, planes, steps, queries",
         rigid_bodies
+    );
+    entries!(
+        v,
+        0.5,
+        "World<Ragdoll> with joint limits: settings, bodies, shapes, planes, steps, queries",
+        ragdolls
     );
     Family {
         name: "world",
