@@ -345,3 +345,44 @@ where
         None => Err(Error::NonFiniteState),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use crate::{EulerLagrange, Lagrangian, Mechanism, Scalar, State};
+    use nalgebra::{SMatrix, SVector};
+
+    /// Two coupled coordinates: `M = [[2, 0.5], [0.5, 1]]`, no potential.
+    struct Coupled;
+
+    impl Lagrangian<f64, 2> for Coupled {
+        fn kinetic<S: Scalar<Real = f64>>(&self, _: S, _: &SVector<S, 2>, qd: &SVector<S, 2>) -> S {
+            (qd[0] * qd[0] * S::from_f64(2.0) + qd[0] * qd[1] + qd[1] * qd[1]) * S::from_f64(0.5)
+        }
+        fn potential<S: Scalar<Real = f64>>(&self, _: S, _: &SVector<S, 2>) -> S {
+            S::zero()
+        }
+    }
+
+    /// The default `velocity_jumps` replaces each column by its `velocity_jump`, bit for bit,
+    /// leaves a zero column zero, and refuses a column that is not finite.
+    #[test]
+    fn jumps_are_each_columns_jump() -> Result<(), crate::Error> {
+        let m = EulerLagrange::new(Coupled);
+        let s = State::new(0.0, [0.3, -0.2], [1.0, 0.5]);
+        let columns = SMatrix::<f64, 2, 3>::from_column_slice(&[1.0, -2.0, 0.0, 0.0, 0.25, 3.0]);
+        let mut jumps = columns;
+        m.velocity_jumps(&s, &mut jumps)?;
+        for k in [0, 2] {
+            let one = m.velocity_jump(&s, &columns.column(k).into_owned())?;
+            assert_eq!(jumps.column(k), one.column(0), "column {k}");
+        }
+        assert_eq!(jumps.column(1), SVector::<f64, 2>::zeros().column(0));
+        // M times the jump is the column again, to rounding.
+        let back = m.mass_matrix(&s) * jumps.column(0);
+        assert!((back[0] - 1.0).abs() < 1e-15 && (back[1] + 2.0).abs() < 1e-15);
+        let mut bad = columns;
+        bad[(1, 2)] = f64::NAN;
+        assert!(m.velocity_jumps(&s, &mut bad).is_err());
+        Ok(())
+    }
+}

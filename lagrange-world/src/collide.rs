@@ -12,9 +12,9 @@
 //!                  along the line of the closest points (a corner, a circle)
 //! cores overlap    the separating axis of the least penetration among the cores' edge
 //!                  normals (Gottschalk's theorem: in the plane, the edge normals suffice),
-//!                  and the same clipping; two cores with edges are known to overlap by
-//!                  their axes alone (each edge normal's separation negative), before any
-//!                  closest points are looked for
+//!                  and the same clipping; cores are known to overlap by their axes alone
+//!                  (each edge normal's separation negative), before any closest points
+//!                  are looked for
 //! ```
 //!
 //! A margin above zero keeps the points of shapes still apart but closing (speculative
@@ -54,11 +54,10 @@ struct Axis<T> {
 pub fn collide<T: Real>(a: &Shape<T>, b: &Shape<T>, margin: T) -> Manifold<T> {
     let radii = a.radius() + b.radius();
     let axis = best_axis(a, b);
-    // Two cores with edges (polygons, segments) that overlap along every edge normal
-    // overlap (the separating axis theorem): no closest points to look for. A circle's
-    // core has no edge, and a polygon's normals alone do not separate it.
-    let edged = a.vertices().len() >= 2 && b.vertices().len() >= 2;
-    if let Some(axis) = axis.filter(|x| edged && x.separation < T::zero()) {
+    // Cores that overlap along every edge normal overlap (the separating axis theorem; a
+    // circle's core, a point, is inside a polygon exactly when it is inside along each of
+    // the polygon's normals): no closest points to look for. Two circles have no axis.
+    if let Some(axis) = axis.filter(|x| x.separation < T::zero()) {
         return clip(a, b, axis, margin);
     }
     let Some((pa, pb, d)) = core_distance(a, b) else {

@@ -770,7 +770,7 @@ const AREAS: [Area; 29] = [
         test_package: "lagrange-tests",
         files: &["lagrange-core/src/links.rs"],
         only: None,
-        tests: &["--test", "rigid_body"],
+        tests: &["--test", "rigid_body", "--test", "links"],
         unit_tests: false,
         optimised: false,
     },
