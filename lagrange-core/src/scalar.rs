@@ -461,3 +461,23 @@ impl_real!(
     scalar_trig::cos_lanesf,
     4.921_566_4e-3 // 2^(-23/3)
 );
+
+#[cfg(test)]
+mod tests {
+    use super::split_dot;
+
+    /// The partial sums are the documented ones: terms `0, 4, ...` in the first, and so on,
+    /// then `(first + second) + (third + fourth)`. With `1e16` against `-1e16` four terms
+    /// apart, the ones beside them survive (a running sum, or sums of neighbours, lose them
+    /// to rounding); twenty terms and none give their exact sums.
+    #[test]
+    fn partial_sums_as_documented() {
+        let a = [1e16, 1.0, 1.0, 1.0, -1e16, 1.0, 1.0, 1.0];
+        assert_eq!(split_dot(&a, &[1.0; 8]), 6.0);
+        let twenty: [f64; 20] = core::array::from_fn(|k| k as f64);
+        assert_eq!(split_dot(&twenty, &[2.0; 20]), 380.0);
+        assert_eq!(split_dot::<f32>(&[], &[]), 0.0);
+        // Over the shorter.
+        assert_eq!(split_dot(&[1.0, 2.0, 3.0], &[1.0, 1.0]), 3.0);
+    }
+}
