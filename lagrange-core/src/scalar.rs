@@ -183,7 +183,9 @@ pub fn all_finite<T: Real>(values: &[T]) -> bool {
 /// the two sums): a chain of additions a quarter as long as one running sum's. What a sweep
 /// of Gauss-Seidel wants, where each row's speed waits on the last row's impulse (the
 /// impulse stepper's friction sweeps: a landing ragdoll's slowest step 6.5 -> 4.6 us). Not
-/// the bits of a running sum (nalgebra's `dot`).
+/// the bits of a running sum (nalgebra's `dot`), but for four terms or fewer, which are one
+/// running sum (no shorter chain exists; the empty partial sums would only add zeros to a
+/// double pendulum's two terms).
 ///
 /// ```
 /// use lagrange_core::split_dot;
@@ -193,6 +195,11 @@ pub fn all_finite<T: Real>(values: &[T]) -> bool {
 #[inline]
 #[must_use]
 pub fn split_dot<T: Real>(a: &[T], b: &[T]) -> T {
+    if a.len().min(b.len()) <= 4 {
+        let mut terms = a.iter().zip(b).map(|(x, y)| *x * *y);
+        let first = terms.next().unwrap_or_else(T::zero);
+        return terms.fold(first, |s, t| s + t);
+    }
     let mut sums = [T::zero(); 4];
     for (k, (x, y)) in a.iter().zip(b).enumerate() {
         sums[k % 4] += *x * *y;
@@ -477,7 +484,9 @@ mod tests {
         let twenty: [f64; 20] = core::array::from_fn(|k| k as f64);
         assert_eq!(split_dot(&twenty, &[2.0; 20]), 380.0);
         assert_eq!(split_dot::<f32>(&[], &[]), 0.0);
-        // Over the shorter.
+        // Over the shorter; four terms or fewer one running sum (1e16 + 1 is 1e16).
         assert_eq!(split_dot(&[1.0, 2.0, 3.0], &[1.0, 1.0]), 3.0);
+        assert_eq!(split_dot(&[1e16, 1.0, -1e16, 1.0], &[1.0; 4]), 1.0);
+        assert_eq!(split_dot(&[-0.0f64], &[1.0]).to_bits(), (-0.0f64).to_bits());
     }
 }
