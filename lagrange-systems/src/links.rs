@@ -7,7 +7,7 @@
 //! torso), from one pose: a world's narrow phase asks for one per contact point, and the
 //! dual-number default ([`Links::point`]) carried twelve derivatives through ten sines.
 
-use crate::ragdoll::{PARENT, TORSO};
+use crate::ragdoll::{self, PARENT, TORSO};
 use crate::{
     Acrobot, CartPole, DoublePendulum, NLinkPendulum, Ragdoll, SimplePendulum, RAGDOLL_COORDINATES,
     RAGDOLL_LINKS,
@@ -167,6 +167,19 @@ impl<T: Real> Links<T, 2> for CartPole<T> {
     }
 }
 
+/// Link `link` (clamped to the links) of a ragdoll at `q` in the world, from the ragdoll's
+/// pose of every link relative to its torso and their absolute angles.
+fn ragdoll_link<S: Scalar>(
+    q: &SVector<S, RAGDOLL_COORDINATES>,
+    pose: &ragdoll::Pose<S>,
+    angle: &[S; RAGDOLL_LINKS],
+    link: usize,
+) -> Pose<S> {
+    let link = link.min(RAGDOLL_LINKS - 1);
+    let origin = pose.origin[link];
+    at([q[0] + origin[0], q[1] + origin[1]], angle[link])
+}
+
 impl<T: Real> Links<T, RAGDOLL_COORDINATES> for Ragdoll<T> {
     /// In the order of `q` and [`Ragdoll::segments`]: the torso (its frame at its centre of
     /// mass, the neck at `(0, L/2)`, the pelvis at `(0, -L/2)`), the head and the limbs (each
@@ -177,18 +190,15 @@ impl<T: Real> Links<T, RAGDOLL_COORDINATES> for Ragdoll<T> {
         q: &SVector<S, RAGDOLL_COORDINATES>,
         link: usize,
     ) -> Pose<S> {
-        let link = link.min(RAGDOLL_LINKS - 1);
         // The ragdoll's own pose of every link (its inherent method, not this one).
-        let origin = self.pose(q).origin[link];
-        at([q[0] + origin[0], q[1] + origin[1]], self.angles(q)[link])
+        ragdoll_link(q, &self.pose(q), &self.angles(q), link)
     }
 
     /// Every link from one pose.
     fn poses(&self, q: &SVector<T, RAGDOLL_COORDINATES>, poses: &mut [Pose<T>]) {
         let (pose, angle) = (self.pose(q), self.angles(q));
         for (link, out) in poses.iter_mut().enumerate().take(RAGDOLL_LINKS) {
-            let origin = pose.origin[link];
-            *out = at([q[0] + origin[0], q[1] + origin[1]], angle[link]);
+            *out = ragdoll_link(q, &pose, &angle, link);
         }
     }
 

@@ -338,20 +338,34 @@ fn hand_points_agree_with_duals<T: Real>() -> Result<(), Error> {
     Ok(())
 }
 
-/// Every standard mechanism with links, asked for a link it does not have.
-fn out_of_range_links<T: Real>() -> Result<(), Error> {
-    let mut rng = Rng::new(346);
+/// A check of one mechanism with links, whatever its coordinates.
+trait Check<T: Real> {
+    fn check<L: Links<T, N>, const N: usize>(&mut self, l: &L);
+}
+
+/// `check` of every standard mechanism with links.
+fn every_mechanism<T: Real>(check: &mut impl Check<T>) -> Result<(), Error> {
     let g = T::from_f64(G);
     let (h, l) = (T::from_f64(0.7), T::from_f64(1.1));
-    out_of_range_is_no_panic(&SimplePendulum::new(T::one(), h, g, T::zero())?, &mut rng);
-    out_of_range_is_no_panic(&DoublePendulum::new(T::one(), T::one(), h, l, g)?, &mut rng);
-    out_of_range_is_no_panic(&NLinkPendulum::new([T::one(); 3], [h; 3], g)?, &mut rng);
-    out_of_range_is_no_panic(&CartPole::new(T::one(), T::one(), h, g)?, &mut rng);
-    let acrobot = acrobot(h, l, g)?;
-    out_of_range_is_no_panic(&acrobot, &mut rng);
-    out_of_range_is_no_panic(&Ragdoll::new(RagdollBody::<T>::adult())?, &mut rng);
-    out_of_range_is_no_panic(&RigidBody::disk(T::one(), h, g)?, &mut rng);
+    check.check(&SimplePendulum::new(T::one(), h, g, T::zero())?);
+    check.check(&DoublePendulum::new(T::one(), T::one(), h, l, g)?);
+    check.check(&NLinkPendulum::new([T::one(); 3], [h; 3], g)?);
+    check.check(&CartPole::new(T::one(), T::one(), h, g)?);
+    check.check(&acrobot(h, l, g)?);
+    check.check(&Ragdoll::new(RagdollBody::<T>::adult())?);
+    check.check(&RigidBody::disk(T::one(), h, g)?);
     Ok(())
+}
+
+/// Every standard mechanism with links, asked for a link it does not have.
+fn out_of_range_links<T: Real>() -> Result<(), Error> {
+    struct OutOfRange(Rng);
+    impl<T: Real> Check<T> for OutOfRange {
+        fn check<L: Links<T, N>, const N: usize>(&mut self, l: &L) {
+            out_of_range_is_no_panic(l, &mut self.0);
+        }
+    }
+    every_mechanism::<T>(&mut OutOfRange(Rng::new(346)))
 }
 
 /// `Links::poses` gives each link's `Links::pose`, bit for bit, at 20 random states, and
@@ -383,17 +397,13 @@ fn poses_are_each_pose<T: Real, L: Links<T, N>, const N: usize>(l: &L, rng: &mut
 
 /// Every standard mechanism's poses from one call.
 fn all_poses_at_once<T: Real>() -> Result<(), Error> {
-    let mut rng = Rng::new(347);
-    let g = T::from_f64(G);
-    let (h, l) = (T::from_f64(0.7), T::from_f64(1.1));
-    poses_are_each_pose(&SimplePendulum::new(T::one(), h, g, T::zero())?, &mut rng);
-    poses_are_each_pose(&DoublePendulum::new(T::one(), T::one(), h, l, g)?, &mut rng);
-    poses_are_each_pose(&NLinkPendulum::new([T::one(); 3], [h; 3], g)?, &mut rng);
-    poses_are_each_pose(&CartPole::new(T::one(), T::one(), h, g)?, &mut rng);
-    poses_are_each_pose(&acrobot(h, l, g)?, &mut rng);
-    poses_are_each_pose(&Ragdoll::new(RagdollBody::<T>::adult())?, &mut rng);
-    poses_are_each_pose(&RigidBody::disk(T::one(), h, g)?, &mut rng);
-    Ok(())
+    struct AtOnce(Rng);
+    impl<T: Real> Check<T> for AtOnce {
+        fn check<L: Links<T, N>, const N: usize>(&mut self, l: &L) {
+            poses_are_each_pose(l, &mut self.0);
+        }
+    }
+    every_mechanism::<T>(&mut AtOnce(Rng::new(347)))
 }
 
 for_f32_and_f64!(

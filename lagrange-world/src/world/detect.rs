@@ -142,6 +142,7 @@ where
                     continue;
                 };
                 let m = collide_half_plane(&plane, &s.place.shape, margin + s.place.reach);
+                // A half-plane has no shape to place; a static side's place is never read.
                 let wall = Side {
                     key,
                     on: None,
@@ -300,9 +301,9 @@ where
             .push(Contact {
                 key: (a.key, b.key, p.id),
                 bodies: [a.on.map(|(i, _)| i), b.on.map(|(i, _)| i)],
-                // Their mobilities come with the others' of the same bodies.
-                normal: Row::new(jn, [zero; 2]),
-                tangent: Row::new(jt, [zero; 2]),
+                // Their mobilities come with the others' of the same bodies (`mobilities`).
+                normal: Row::unsolved(jn),
+                tangent: Row::unsolved(jt),
                 gap,
                 lower,
                 approach,

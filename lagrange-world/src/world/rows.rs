@@ -30,25 +30,33 @@ pub(crate) struct Row<T: Real, const N: usize> {
 impl<T: Real, const N: usize> Row<T, N> {
     /// A row of Jacobians `j` and mobilities `b`, no impulse yet.
     pub(crate) fn new(j: [SVector<T, N>; 2], b: [SVector<T, N>; 2]) -> Self {
-        let w = j[0].dot(&b[0]) + j[1].dot(&b[1]);
-        // A row no impulse moves (both sides static, or a point that no coordinate moves
-        // along it) takes none.
-        let inverse = if w > T::EPSILON && (T::one() / w).is_finite() {
-            T::one() / w
-        } else {
-            T::zero()
-        };
+        let mut row = Self::unsolved(j);
+        row.b = b;
+        row.refresh();
+        row
+    }
+
+    /// A row of Jacobians `j` whose mobilities are still to come (zero, as its `1 / W`):
+    /// set with its body's others, then [`Row::refresh`].
+    pub(crate) fn unsolved(j: [SVector<T, N>; 2]) -> Self {
         Self {
             j,
-            b,
-            inverse,
+            b: [SVector::zeros(); 2],
+            inverse: T::zero(),
             lambda: T::zero(),
         }
     }
 
-    /// Its `1 / W` again, from its mobilities as they are now (set after the row was made).
+    /// Its `1 / W` from its mobilities as they are now.
     pub(crate) fn refresh(&mut self) {
-        self.inverse = Self::new(self.j, self.b).inverse;
+        let w = self.j[0].dot(&self.b[0]) + self.j[1].dot(&self.b[1]);
+        // A row no impulse moves (both sides static, or a point that no coordinate moves
+        // along it) takes none.
+        self.inverse = if w > T::EPSILON && (T::one() / w).is_finite() {
+            T::one() / w
+        } else {
+            T::zero()
+        };
     }
 
     /// The row's velocity `a` at the bodies' velocities `v` (a side of no body: `None`).
