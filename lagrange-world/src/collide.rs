@@ -158,23 +158,39 @@ pub fn collide_half_plane<T: Real>(
     shape: &Shape<T>,
     margin: T,
 ) -> Manifold<T> {
+    collide_half_plane_moving(plane, shape, shape, margin)
+}
+
+/// As [`collide_half_plane`] for `shape` moving to `end` (the same shape placed where the
+/// step may take it): of the vertices within the margin at the start, the two that come
+/// deepest at either end (their points and gaps the start's). A shape turning fast brings a
+/// vertex that is not among the deepest at the start into the plane: a plank spun about one
+/// end sweeps its far corner 20 cm down in a step while its near corners barely move.
+pub(crate) fn collide_half_plane_moving<T: Real>(
+    plane: &HalfPlane<T>,
+    shape: &Shape<T>,
+    end: &Shape<T>,
+    margin: T,
+) -> Manifold<T> {
     let n = plane.normal;
     let gap_of = |v: Vec2<T>| dot(v, n) - plane.offset - shape.radius();
     let mut deepest: [Option<(T, usize)>; 2] = [None, None];
-    for (i, &v) in shape.vertices().iter().enumerate() {
+    for (i, (&v, &w)) in shape.vertices().iter().zip(end.vertices()).enumerate() {
         let g = gap_of(v);
         if g > margin {
             continue;
         }
-        if deepest[0].is_none_or(|(d, _)| g < d) {
-            deepest = [Some((g, i)), deepest[0]];
-        } else if deepest[1].is_none_or(|(d, _)| g < d) {
-            deepest[1] = Some((g, i));
+        let d = g.min(gap_of(w));
+        if deepest[0].is_none_or(|(e, _)| d < e) {
+            deepest = [Some((d, i)), deepest[0]];
+        } else if deepest[1].is_none_or(|(e, _)| d < e) {
+            deepest[1] = Some((d, i));
         }
     }
     let mut m = Manifold::along(n);
-    for (gap, i) in deepest.into_iter().flatten() {
+    for (_, i) in deepest.into_iter().flatten() {
         let v = shape.vertices()[i];
+        let gap = gap_of(v);
         // Midway between the shape's surface and the plane's boundary, below the vertex.
         let on_shape = sub(v, scale(n, shape.radius()));
         let point = sub(on_shape, scale(n, gap * T::HALF));
