@@ -22,7 +22,7 @@
 //! positive.
 
 use crate::manifold::{ContactPoint, Manifold};
-use crate::shape::Shape;
+use crate::shape::{Shape, MAX_VERTICES};
 use crate::vec2::{add, closest_on_segments, dot, length, scale, sub, Vec2};
 use lagrange_core::{Error, Real};
 
@@ -158,49 +158,54 @@ pub fn collide_half_plane<T: Real>(
     shape: &Shape<T>,
     margin: T,
 ) -> Manifold<T> {
-    collide_half_plane_moving(plane, shape, shape, margin)
+    let mut deepest: [Option<&(T, ContactPoint<T>)>; 2] = [None, None];
+    let points = half_plane_points(plane, shape, shape, margin);
+    for p in &points {
+        if deepest[0].is_none_or(|d| p.0 < d.0) {
+            deepest = [Some(p), deepest[0]];
+        } else if deepest[1].is_none_or(|d| p.0 < d.0) {
+            deepest[1] = Some(p);
+        }
+    }
+    let mut m = Manifold::along(plane.normal);
+    for (_, p) in deepest.into_iter().flatten() {
+        m.push(*p);
+    }
+    m
 }
 
-/// As [`collide_half_plane`] for `shape` moving to `end` (the same shape placed where the
-/// step may take it): of the vertices within the margin at the start, the two that come
-/// deepest at either end (their points and gaps the start's). A shape turning fast brings a
-/// vertex that is not among the deepest at the start into the plane: a plank spun about one
-/// end sweeps its far corner 20 cm down in a step while its near corners barely move.
-pub(crate) fn collide_half_plane_moving<T: Real>(
+/// Every vertex of `shape`'s core within `margin` of the half-plane `plane` as a contact
+/// point (its id the vertex, its gap and point at the start; see [`collide_half_plane`]),
+/// each with how deep it comes at either end of a move to `end` (the same shape placed
+/// where the step may take it). A world keeps them all, not the two deepest: a shape turning
+/// fast brings a vertex that is not among the deepest at the start into the plane (a plank
+/// spun about one end sweeps its far corner 20 cm down in a step), and the impulses may turn
+/// it the other way than its velocities at the start (a box struck on a corner).
+pub(crate) fn half_plane_points<T: Real>(
     plane: &HalfPlane<T>,
     shape: &Shape<T>,
     end: &Shape<T>,
     margin: T,
-) -> Manifold<T> {
+) -> heapless::Vec<(T, ContactPoint<T>), MAX_VERTICES> {
     let n = plane.normal;
     let gap_of = |v: Vec2<T>| dot(v, n) - plane.offset - shape.radius();
-    let mut deepest: [Option<(T, usize)>; 2] = [None, None];
+    let mut points = heapless::Vec::new();
     for (i, (&v, &w)) in shape.vertices().iter().zip(end.vertices()).enumerate() {
-        let g = gap_of(v);
-        if g > margin {
+        let gap = gap_of(v);
+        if gap > margin {
             continue;
         }
-        let d = g.min(gap_of(w));
-        if deepest[0].is_none_or(|(e, _)| d < e) {
-            deepest = [Some((d, i)), deepest[0]];
-        } else if deepest[1].is_none_or(|(e, _)| d < e) {
-            deepest[1] = Some((d, i));
-        }
-    }
-    let mut m = Manifold::along(n);
-    for (_, i) in deepest.into_iter().flatten() {
-        let v = shape.vertices()[i];
-        let gap = gap_of(v);
         // Midway between the shape's surface and the plane's boundary, below the vertex.
         let on_shape = sub(v, scale(n, shape.radius()));
-        let point = sub(on_shape, scale(n, gap * T::HALF));
-        m.push(ContactPoint {
-            point,
+        let point = ContactPoint {
+            point: sub(on_shape, scale(n, gap * T::HALF)),
             gap,
             id: u32::try_from(i).unwrap_or(0),
-        });
+        };
+        // A core has at most MAX_VERTICES vertices.
+        let _ = points.push((gap.min(gap_of(w)), point));
     }
-    m
+    points
 }
 
 /// The single vertex of a circle (any vertex of another core).

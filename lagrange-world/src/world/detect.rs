@@ -7,7 +7,7 @@ use super::profile::{Profile, Stopwatch};
 use super::rows::{Contact, Row};
 use super::{World, OWN_ROWS};
 use crate::broad::Proxy;
-use crate::collide::{collide, collide_half_plane_moving};
+use crate::collide::{collide, half_plane_points};
 use crate::manifold::ContactPoint;
 use crate::vec2::{rotate, sub, Vec2};
 use heapless::Vec;
@@ -141,22 +141,22 @@ where
                 let Some(s) = self.side(si).filter(|_| awake) else {
                     continue;
                 };
-                // Where the step may take it, for a shape that moves: a vertex that is not
-                // among the deepest at the start may come deepest by the end.
+                // Where the step may take it, for a shape that moves: every vertex that may
+                // touch (see `half_plane_points`).
                 let end = match self.shapes.get(si) {
                     Some(a) if s.place.reach > T::zero() => a.shape.placed(&s.place.then),
                     _ => s.place.shape,
                 };
-                let m =
-                    collide_half_plane_moving(&plane, &s.place.shape, &end, margin + s.place.reach);
+                let points =
+                    half_plane_points(&plane, &s.place.shape, &end, margin + s.place.reach);
                 // A half-plane has no shape to place; a static side's place is never read.
                 let wall = Side {
                     key,
                     on: None,
                     place: s.place,
                 };
-                for p in m.points() {
-                    self.push(wall, s, m.normal, p, dt)?;
+                for (_, p) in &points {
+                    self.push(wall, s, plane.normal(), p, dt)?;
                 }
             }
         }

@@ -80,12 +80,10 @@ pub(crate) fn place<T, M, L, const N: usize, const B: usize, const S: usize>(
                 continue;
             };
             let link = s.on.map_or(0, |(_, link)| link);
-            // Every link below `posed` is posed (a shape's link is below LINKS), and the
-            // arrays hold no more: a link past them is posed on its own.
-            let (pose, then) = match (now.get(link), next.get(link)) {
-                (Some(&p), Some(&n)) => (p, n),
-                _ => (body.pose(&q, link), body.pose(&ahead, link)),
-            };
+            let (pose, then) = (
+                posed_link(&now, body, &q, link),
+                posed_link(&next, body, &ahead, link),
+            );
             let reach = if body.asleep {
                 T::zero()
             } else {
@@ -105,5 +103,23 @@ pub(crate) fn place<T, M, L, const N: usize, const B: usize, const S: usize>(
                 reach,
             };
         }
+    }
+}
+
+/// Link `link` of `body` at `q` from its links posed there (`posed`), or posed on its own
+/// past them (every link below [`POSED`] is posed, and the arrays hold no more).
+fn posed_link<T, M, L, const N: usize>(
+    posed: &[Pose<T>],
+    body: &Body<T, M, L, N>,
+    q: &lagrange_core::nalgebra::SVector<T, N>,
+    link: usize,
+) -> Pose<T>
+where
+    T: Real,
+    M: Mechanism<T, N> + Links<T, N>,
+{
+    match posed.get(link) {
+        Some(&p) if link < M::LINKS.min(POSED) => p,
+        _ => body.pose(q, link),
     }
 }
