@@ -76,7 +76,7 @@ pub struct Delassus<T: Real, const N: usize, const C: usize> {
     jacobian: SMatrix<T, C, N>,
     mobility: SMatrix<T, N, C>,
     w: SMatrix<T, C, C>,
-    /// The Cholesky factor of the active rows, `factor[(p, q)]` for positions `q <= p` in
+    /// The Cholesky factor of the active rows, transposed: `factor[(q, p)]` for positions `q <= p` in
     /// the active set (scratch, kept so that a solve does not clear `C^2` numbers a pass).
     factor: SMatrix<T, C, C>,
     /// The rows the factor holds, in its order: `factored[..factored_n]` (cleared whenever
@@ -653,34 +653,36 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
             *f = o;
         }
         self.factored_n = kept;
-        let l = &mut self.factor;
+        // Stored transposed, `lt[(q, p)] = L[p][q]`: row `p` of `L`, which the factor's
+        // inner products and the forward substitution walk, is a column (in storage order).
+        let lt = &mut self.factor;
         let row = |p: usize| within::<C>(order[p]);
         for p in kept..n {
             let row_p = row(p);
             for q in 0..p {
-                let x = (0..q).fold(self.w[(row_p, row(q))], |x, k| x - l[(p, k)] * l[(q, k)]);
-                l[(p, q)] = x / l[(q, q)];
+                let x = (0..q).fold(self.w[(row(q), row_p)], |x, k| x - lt[(k, p)] * lt[(k, q)]);
+                lt[(q, p)] = x / lt[(q, q)];
             }
             let wpp = self.w[(row_p, row_p)];
-            let d = (0..p).fold(wpp, |d, k| d - l[(p, k)] * l[(p, k)]);
+            let d = (0..p).fold(wpp, |d, k| d - lt[(k, p)] * lt[(k, p)]);
             if !d.is_finite() {
                 return Err(Error::NonFiniteState);
             }
             if d <= wpp.abs() * threshold {
                 return Err(Error::RedundantConstraints { row: row_p });
             }
-            l[(p, p)] = d.sqrt();
+            lt[(p, p)] = d.sqrt();
             self.factored[p] = order[p];
             self.factored_n = p + 1;
         }
         let mut y = [T::zero(); C];
         for p in 0..n {
-            y[p] = (0..p).fold(r[row(p)], |s, k| s - l[(p, k)] * y[k]) / l[(p, p)];
+            y[p] = (0..p).fold(r[row(p)], |s, k| s - lt[(k, p)] * y[k]) / lt[(p, p)];
         }
         let mut x = SVector::<T, C>::zeros();
         for p in (0..n).rev() {
-            let s = (p + 1..n).fold(y[p], |s, k| s - l[(k, p)] * x[row(k)]);
-            x[row(p)] = s / l[(p, p)];
+            let s = (p + 1..n).fold(y[p], |s, k| s - lt[(p, k)] * x[row(k)]);
+            x[row(p)] = s / lt[(p, p)];
         }
         Ok(x)
     }
