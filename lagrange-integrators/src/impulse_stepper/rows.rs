@@ -152,7 +152,10 @@ impl<T: Real, const N: usize, const C: usize> Workspace<T, N, C> {
             },
             touching,
         )?;
-        self.tangent = [None; C];
+        // Each cleared in place (a new array of them is kilobytes written and copied).
+        for t in &mut self.tangent {
+            *t = None;
+        }
         let Some(t) = tangents else {
             return Ok(());
         };

@@ -647,7 +647,8 @@ where
         let after = self.kinetic(&v);
         // 16 ulps of the energies: the rounding of sums of a few products.
         let rounding = T::from_f64(16.0) * T::EPSILON * (before.abs() + after.abs());
-        let guarded = after > before + rounding;
+        // As a difference: `before + rounding` rounds too (by half an ulp of the energy).
+        let guarded = after - before > rounding;
         if guarded {
             v = free;
             for c in self.contacts.iter_mut() {

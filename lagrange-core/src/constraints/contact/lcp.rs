@@ -4,7 +4,7 @@
 //! level), a projection's displacements (at the position level).
 
 use crate::nalgebra::{SMatrix, SVector};
-use crate::{all_finite, Error, Real};
+use crate::{all_finite, split_dot, Error, Real};
 
 mod relaxed;
 
@@ -73,7 +73,10 @@ pub struct Complementary<T: Real, const C: usize> {
 /// of the active rows (at most `R^3 / 6`).
 #[derive(Debug, Clone, Copy)]
 pub struct Delassus<T: Real, const N: usize, const C: usize> {
-    jacobian: SMatrix<T, C, N>,
+    /// The candidates' rows of the Jacobian as columns (`J^T`; zero off the candidates):
+    /// each row's entries side by side, for its products with the velocities and the
+    /// mobilities.
+    rows: SMatrix<T, N, C>,
     mobility: SMatrix<T, N, C>,
     w: SMatrix<T, C, C>,
     /// The Cholesky factor of the active rows, transposed: `factor[(q, p)]` for positions `q <= p` in
@@ -114,7 +117,7 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
     #[must_use]
     pub fn empty() -> Self {
         Self {
-            jacobian: SMatrix::zeros(),
+            rows: SMatrix::zeros(),
             mobility: SMatrix::zeros(),
             w: SMatrix::zeros(),
             factor: SMatrix::zeros(),
@@ -146,17 +149,16 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
             clear(&mut self.w, &leaving);
         }
         self.candidate = [false; C];
-        // In storage order (nalgebra's row and column fills walk a strided iterator an
-        // entry at a time): the candidates' rows of the Jacobian, zero elsewhere, and their
-        // transposes as the mobilities' columns before the mass solve.
-        let rows = jacobian.as_slice().chunks_exact(C);
-        for (to, from) in self.jacobian.as_mut_slice().chunks_exact_mut(C).zip(rows) {
-            for ((x, &y), &on) in to.iter_mut().zip(from).zip(candidate) {
-                *x = if on { y } else { T::zero() };
-            }
-        }
-        let columns = self.mobility.as_mut_slice().chunks_exact_mut(N);
-        for ((i, column), &on) in columns.enumerate().zip(candidate) {
+        // The candidates' rows as columns, zero elsewhere (nalgebra's row and column fills
+        // walk a strided iterator an entry at a time); the mobilities start as them, before
+        // the mass solve.
+        for ((i, column), &on) in self
+            .rows
+            .as_mut_slice()
+            .chunks_exact_mut(N)
+            .enumerate()
+            .zip(candidate)
+        {
             for (c, x) in column.iter_mut().enumerate() {
                 *x = if on {
                     jacobian[(within::<C>(i), c.min(N.saturating_sub(1)))]
@@ -165,24 +167,25 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
                 };
             }
         }
+        self.mobility = self.rows;
         if let Err(e) = mobility_of(&mut self.mobility) {
             self.w.fill(T::zero());
             return Err(e);
         }
+        // W's entries as products of columns, in partial sums (each its own short chain).
+        let mut finite = true;
         for i in (0..C).filter(|&i| candidate[i]).map(within::<C>) {
-            for k in (i..C).filter(|&k| candidate[k]) {
-                let x = self
-                    .jacobian
-                    .row(i)
-                    .transpose()
-                    .dot(&self.mobility.column(within::<C>(k)));
-                if !x.is_finite() {
-                    self.w.fill(T::zero());
-                    return Err(Error::NonFiniteState);
-                }
+            let row = column_of(&self.rows, i);
+            for k in (i..C).filter(|&k| candidate[k]).map(within::<C>) {
+                let x = split_dot(row, column_of(&self.mobility, k));
+                finite &= x.is_finite();
                 self.w[(i, k)] = x;
                 self.w[(k, i)] = x;
             }
+        }
+        if !finite {
+            self.w.fill(T::zero());
+            return Err(Error::NonFiniteState);
         }
         self.candidate = *candidate;
         Ok(())
@@ -225,11 +228,11 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
             });
         }
         self.factored_n = 0;
-        self.jacobian.set_row(i, &j.transpose());
+        self.rows.set_column(i, j);
         self.mobility.set_column(i, b);
         self.candidate[i] = true;
         for k in (0..C).filter(|&k| self.candidate[k]).map(within::<C>) {
-            let x = self.jacobian.row(k).transpose().dot(b);
+            let x = split_dot(column_of(&self.rows, k), b.as_slice());
             if !x.is_finite() {
                 self.candidate[i] = false;
                 self.w.row_mut(i).fill(T::zero());
@@ -250,8 +253,8 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
 
     /// The Jacobian of the candidate rows (the others are zero).
     #[must_use]
-    pub fn jacobian(&self) -> &SMatrix<T, C, N> {
-        &self.jacobian
+    pub fn jacobian(&self) -> SMatrix<T, C, N> {
+        self.rows.transpose()
     }
 
     /// `W = J M^-1 J^T` over the candidate rows (zero elsewhere).
@@ -280,7 +283,7 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
     pub fn speeds(&self, v: &SVector<T, N>) -> SVector<T, C> {
         let mut out = SVector::<T, C>::zeros();
         for i in (0..C).filter(|&i| self.candidate[i]).map(within::<C>) {
-            out[i] = self.jacobian.row(i).transpose().dot(v);
+            out[i] = split_dot(column_of(&self.rows, i), v.as_slice());
         }
         out
     }
@@ -712,6 +715,11 @@ fn remove<const C: usize>(order: &mut [usize; C], n: &mut usize, row: usize) -> 
     }
     *n = count.saturating_sub(1);
     at
+}
+
+/// Column `k` of `m` as a slice (empty past the last).
+fn column_of<T: Real, const N: usize, const C: usize>(m: &SMatrix<T, N, C>, k: usize) -> &[T] {
+    m.as_slice().chunks_exact(N).nth(k).unwrap_or(&[])
 }
 
 /// `i`, a row of a set of `C` that this module counted or listed (so below `C`), clamped
