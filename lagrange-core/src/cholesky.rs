@@ -42,7 +42,7 @@ const CHECKED_AFTER: usize = 8;
 
 /// `Ok` where `d`, the pivot of column `j` (`m_jj` on `M`'s diagonal), is finite and well above
 /// rounding.
-fn pivot<T: Real>(d: T, m_jj: T, j: usize) -> Result<(), Error> {
+pub(crate) fn pivot<T: Real>(d: T, m_jj: T, j: usize) -> Result<(), Error> {
     if !d.is_finite() {
         return Err(Error::NonFiniteState);
     }
@@ -192,7 +192,7 @@ impl<T: Real, const N: usize> Cholesky<T, N> {
 /// ragdoll's fifteen columns, 900 ns with eight, 750 with sixteen, f32), one where it has none
 /// (a Cortex-M: the lanes would be done one by one, padding and all). The bits are the same
 /// either way: each lane does the operations of a single solve, in their order.
-const LANES: usize = if cfg!(any(
+pub(crate) const LANES: usize = if cfg!(any(
     target_arch = "x86_64",
     target_arch = "aarch64",
     target_feature = "simd128"

@@ -78,6 +78,7 @@ mod scalar;
 mod scalar_trig;
 mod state;
 mod tape;
+mod tree_factor;
 mod trig_memo;
 pub mod validate;
 
@@ -100,3 +101,4 @@ pub use mechanism::{jacobian_by_differences, Mechanism};
 pub use nalgebra;
 pub use scalar::{all_finite, check_finite, split_dot, Real, Scalar};
 pub use state::State;
+pub use tree_factor::TreeFactor;

@@ -5,8 +5,8 @@ use core::cmp::Ordering;
 
 use lagrange_core::nalgebra::{SMatrix, SVector};
 use lagrange_core::{
-    all_finite, free_law_force, validate, Cholesky, Error, GeneralizedForce, Lagrangian, Mechanism,
-    Real, Scalar, State,
+    all_finite, free_law_force, validate, Error, GeneralizedForce, Lagrangian, Mechanism, Real,
+    Scalar, State, TreeFactor,
 };
 
 /// Generalized coordinates of a [`Ragdoll`]: the torso's position and angle, then nine joints.
@@ -58,6 +58,21 @@ const LENGTH_NAMES: [&str; RAGDOLL_LINKS] = [
 
 /// The parent of each link (the torso's entry is unused).
 pub(crate) const PARENT: [usize; RAGDOLL_LINKS] = [0, 0, 0, 2, 0, 4, 0, 6, 0, 8];
+
+/// Each coordinate's parent in the tree the mass matrix has: the torso's `x`, `y`, angle one
+/// after another, then each joint after its parent link's (the torso's angle for a link on
+/// the torso).
+const COORDINATE_PARENT: [Option<usize>; RAGDOLL_COORDINATES] = {
+    let mut parent = [None; RAGDOLL_COORDINATES];
+    parent[1] = Some(0);
+    parent[2] = Some(1);
+    let mut k = 1;
+    while k < RAGDOLL_LINKS {
+        parent[k + 2] = Some(if PARENT[k] == TORSO { 2 } else { PARENT[k] + 2 });
+        k += 1;
+    }
+    parent
+};
 
 /// One rigid link: a uniform rod of `mass` (kg) and `length` (m), its centre of mass at
 /// half its length, its moment of inertia `mass length^2 / 12` about it.
@@ -744,10 +759,14 @@ impl<T: Real> Mechanism<T, RAGDOLL_COORDINATES> for Ragdoll<T> {
         s: &State<T, RAGDOLL_COORDINATES>,
         impulses: &mut SMatrix<T, RAGDOLL_COORDINATES, K>,
     ) -> Result<(), Error> {
-        let factor = Cholesky::factor(&self.mass_matrix(&State {
-            qd: SVector::zeros(),
-            ..*s
-        }))?;
+        // Along the tree: each limb couples with the torso and its own joints, not the others.
+        let factor = TreeFactor::factor(
+            &self.mass_matrix(&State {
+                qd: SVector::zeros(),
+                ..*s
+            }),
+            &COORDINATE_PARENT,
+        )?;
         factor.solve_columns(impulses);
         if all_finite(impulses.as_slice()) {
             Ok(())

@@ -368,28 +368,33 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
         // changes no multiplier); the other candidates are held at a bound, or left out at
         // zero while they depend on the rows solved for (`blocked`).
         let mut free = [false; C];
-        let (mut order, mut n) = ([0usize; C], 0usize);
         for i in listed.clone() {
-            let solved_for = match kinds[i] {
+            free[i] = match kinds[i] {
                 Row::Unilateral => guess[i],
                 Row::Bounded(x) => x > T::zero(),
                 Row::Bilateral | Row::Held => true,
             };
-            if solved_for {
-                free[i] = true;
-                order[within::<C>(n)] = i;
-                n += 1;
-            }
         }
-        // The rows of the factor still valid: those before the first change of `order` (at
-        // first, those the last solve left that this one starts with).
-        let mut kept = self
-            .factored
-            .iter()
-            .zip(&order)
-            .take(n.min(self.factored_n))
-            .take_while(|(a, b)| a == b)
-            .count();
+        // First the rows of the last factor that are solved for again, in its order: the
+        // factor of those still holds (a round of a contact step whose rows pushing did not
+        // change factors none; in the candidates' order, a row that had joined late moved up
+        // and every row after it was factored again). Then the others, by index.
+        let (mut order, mut n) = ([0usize; C], 0usize);
+        let mut placed = [false; C];
+        for &r in self.factored.iter().take(self.factored_n) {
+            let r = within::<C>(r);
+            if !(self.candidate[r] && free[r]) {
+                break;
+            }
+            order[within::<C>(n)] = r;
+            placed[r] = true;
+            n += 1;
+        }
+        let mut kept = n;
+        for i in listed.clone().filter(|&i| free[i] && !placed[i]) {
+            order[within::<C>(n)] = i;
+            n += 1;
+        }
         let mut blocked = [false; C];
         let mut lambda = SVector::<T, C>::zeros();
         // The row that joined last, the way it moves off its bound, and whether its pull was
