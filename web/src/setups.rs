@@ -257,9 +257,10 @@ const CONTACT_SLOP: f64 = 2e-3;
 /// The contact solver's cap on rounds per solve on the page.
 pub const CONTACT_ITERATIONS: u32 = 4;
 
-/// The most rounds a step of the page's contact solver may take: four solves (the plastic
-/// one, two more with speculative rows, the rebound), each capped.
-pub const CONTACT_ROUNDS_CAP: u32 = 4 * CONTACT_ITERATIONS;
+/// The most rounds a step of the page's contact solver may take: the plastic solve's cap,
+/// and one more for each of the three solves that may follow it
+/// (`ImpulseSettings::max_rounds`).
+pub const CONTACT_ROUNDS_CAP: u32 = CONTACT_ITERATIONS + 3;
 
 /// The worst `[rows, rounds]` of an impulse stepper's steps.
 fn peak_work<T: Real, const N: usize, const C: usize, I, K>(

@@ -920,22 +920,23 @@ fn ragdoll_cost(
     let k = u64::from(RAGDOLL_ITERATIONS);
     println!(
         "  its worst work (peak report): R = {rows} rows ({speculative} speculative), F = \
-         {frictional} with friction, {rounds} rounds (cap 4 K = {}, C = {RAGDOLL_ROWS})",
-        4 * k
+         {frictional} with friction, {rounds} rounds (cap K + 3 = {}, C = {RAGDOLL_ROWS})",
+        k + 3
     );
     println!(
         "  bound (ImpulseStepper's docs): the inner step + position_residual + jacobian + \
          tangent_jacobian + 2 velocity_jumps (R and F columns) + a velocity_jump per \
-         speculative row + at most 4 solves x K rounds (an exact solve of the R rows: Cholesky \
-         of at most R rows a pass, at most 4 C + 4 passes; a sweep of the F tangents) + at \
+         speculative row + at most K + 3 rounds in all (an exact solve of the R rows: Cholesky \
+         of at most R rows a pass, at most 4 C + 4 passes; at most K sweeps of the F \
+         tangents) + at \
          most 3 exact solves for the drift + 2 to 4 evaluations of T and V"
     );
     let mut failures = Vec::new();
-    if rows > RAGDOLL_ROWS as u64 || rounds > 4 * k {
+    if rows > RAGDOLL_ROWS as u64 || rounds > k + 3 {
         failures.push(format!(
             "ragdoll landing: {rows} rows and {rounds} rounds in a step, past the caps of \
              {RAGDOLL_ROWS} rows and {} rounds",
-            4 * k
+            k + 3
         ));
     }
     failures

@@ -13,7 +13,7 @@
 //!   dt = 1e-3 s, 5 s (it is at rest well before).
 //!
 //! Steppers: `time_stepping` is `ImpulseStepper` with `SemiImplicitEuler` inside, slop 2 mm
-//! and at most 4 sweeps per solve ([`scenes::SLOP`], [`scenes::MAX_ITERATIONS`]: a game's
+//! and at most 4 rounds for a step's plastic solve ([`scenes::SLOP`], [`scenes::MAX_ITERATIONS`]: a game's
 //! budget; the slop is what a contact may rest below zero, so its depth is that by design);
 //! `event` is `ContactStepper` with `Rk4` inside; `rapier2d` is the peer ([`peer`]), in the
 //! `f32` ragdoll rows only (rapier2d computes in `f32`; its `f64` build is another crate),

@@ -26,8 +26,9 @@ pub const RAGDOLL_DT: f64 = 1.0 / 240.0;
 /// `dt^2 g = 0.17 mm` a resting body sinks in one step at 1/240 s.
 pub const SLOP: f64 = 2e-3;
 
-/// The time-stepping stepper's cap on sweeps per solve: four, a game's usual budget; the
-/// normal rows are solved exactly each sweep, so the cap only bounds the friction sweeps.
+/// The time-stepping stepper's cap on the rounds of a step's plastic solve (and the friction
+/// sweeps of a round): four, a game's usual budget; the normal rows are solved exactly each
+/// round, so the cap only bounds the friction's alternation with them.
 pub const MAX_ITERATIONS: u32 = 4;
 
 /// `for_f32` in f32, `for_f64` in f64.

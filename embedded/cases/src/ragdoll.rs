@@ -36,12 +36,13 @@ fn model() -> Result<ContactModel<f32>, Error> {
 }
 
 /// The slop, 2 mm (and 2 mrad at the joint limits), and at most
-/// [`RAGDOLL_ITERATIONS`] rounds per solve.
+/// [`RAGDOLL_ITERATIONS`] rounds for a step's plastic solve.
 fn settings() -> Result<ImpulseSettings<f32>, Error> {
     ImpulseSettings::new(black_box(2e-3), RAGDOLL_ITERATIONS)
 }
 
-/// The landing's cap on rounds per solve (`ImpulseSettings::max_iterations`).
+/// The landing's cap on the rounds of a step's plastic solve
+/// (`ImpulseSettings::max_iterations`; a step takes at most three more).
 pub const RAGDOLL_ITERATIONS: u32 = 4;
 
 /// The throw of `examples/ragdoll.rs`: the torso 1.6 m up, tilted 0.6 rad, limbs spread,
@@ -103,7 +104,7 @@ fn adult() -> Result<Ragdoll<f32>, Error> {
 
 /// The thrown ragdoll landing on a floor at height 0 and settling: `ImpulseStepper` with
 /// semi-implicit Euler inside and the ragdoll's 31 rows (13 floor points, 18 joint limits),
-/// restitution 0.3, friction 0.8, slop 2 mm, at most [`RAGDOLL_ITERATIONS`] rounds per solve,
+/// restitution 0.3, friction 0.8, slop 2 mm, at most [`RAGDOLL_ITERATIONS`] + 3 rounds a step,
 /// `steps` steps of [`RAGDOLL_DT`] (1000: 4.2 s, down and at rest), each through `watch`.
 ///
 /// The outcome's 9 words: `t`; an FNV-1a digest of the bits of the final `q` and `q'`; the

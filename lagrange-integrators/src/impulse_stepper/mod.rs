@@ -71,12 +71,13 @@ use step::{Memory, Setup};
 ///   1 velocity_jumps of the R + F columns (2 where R + F > C), one velocity_jump per
 ///   speculative row
 /// at most 4 solves of the impulses (plastic, twice more with speculative rows, rebound),
-///   each at most K rounds of: one exact solve of the R normal rows (the active-set method
-///   of Delassus::complementary: per pass, the Cholesky rows of the rows that joined, at most
-///   4 C + 4 passes, one or two from the last step's rows; where they do not end, a
-///   degenerate set that cycles, 4 C sweeps of projected Gauss-Seidel over the R rows
-///   instead, Delassus::relaxed), then sweeps of the F tangents until one changes nothing,
-///   at most K
+///   at most K + 3 rounds in all (the plastic solve at most K; those after it share what it
+///   left, at least one each), each round: one exact solve of the R normal rows (the
+///   active-set method of Delassus::complementary: per pass, the Cholesky rows of the rows
+///   that joined, at most 4 C + 4 passes, one or two from the last step's rows; where they
+///   do not end, a degenerate set that cycles, 4 C sweeps of projected Gauss-Seidel over the
+///   R rows instead, Delassus::relaxed), then sweeps of the F tangents until one changes
+///   nothing, at most K
 /// at most 3 exact solves of the R rows for the drift; 1 position_residual after it, and at
 ///   most 3 more exact solves and position_residuals on the gaps it left (1 more
 ///   position_residual where the coordinates stay the start's)

@@ -13,8 +13,9 @@ pub struct ImpulseReport {
     /// Contacts with a tangent (friction).
     pub frictional: u32,
     /// Exact solves of the normal rows, each followed by friction sweeps: at most the
-    /// settings' `max_iterations` per solve, and at most four solves (the plastic one, two
-    /// more with speculative rows, the rebound).
+    /// settings' `max_iterations` for the plastic solve, and one more for each of the three
+    /// that may follow it (two with speculative rows, the rebound), which share what it left:
+    /// at most `ImpulseSettings::max_rounds`.
     pub rounds: u32,
     /// Whether the friction sweeps settled before the cap (always without friction, and when
     /// no row was in contact). Where they did not, the impulses are those of the last round,

@@ -15,9 +15,11 @@ const MAX_ITERATIONS_CAP: u32 = 1000;
 ///                 it. A little slop keeps a resting contact in touch from step to step
 ///                 (quiet, and warm-started); none makes every resting step lift it. Choose
 ///                 it above a step's free fall, dt^2 g (0.17 mm at 240 Hz, 2.7 mm at 60 Hz)
-/// max_iterations  rounds of each impulse solve, at most (each an exact solve of the normal
-///                 rows, then Gauss-Seidel sweeps of the friction tangents until one changes
-///                 nothing, at most this many): the cap on a step's work
+/// max_iterations  rounds of the plastic impulse solve, at most (each an exact solve of the
+///                 normal rows, then Gauss-Seidel sweeps of the friction tangents until one
+///                 changes nothing, at most this many); the solves after it (speculative
+///                 rows, rebounds) share what it left, at least one round each: at most
+///                 max_iterations + 3 rounds a step (max_rounds), the cap on a step's work
 /// tolerance       a round whose first sweep changes no tangent's speed by more than this
 ///                 (gap units per second, plus the rounding of the speed) ends the solve
 /// max_rows        rows in contact at once, at most (default: every row of the set): the
@@ -89,10 +91,18 @@ impl<T: Real> ImpulseSettings<T> {
         self.slop
     }
 
-    /// The most rounds per solve.
+    /// The most rounds of a step's plastic solve, and the most friction sweeps of a round.
     #[must_use]
     pub fn max_iterations(&self) -> u32 {
         self.max_iterations
+    }
+
+    /// The most rounds a step takes: `max_iterations` for its plastic solve, then at most one
+    /// for each of the three solves that may follow it (twice with speculative rows, once for
+    /// rebounds), which share what the plastic solve left.
+    #[must_use]
+    pub fn max_rounds(&self) -> u32 {
+        self.max_iterations + 3
     }
 
     /// The rounds' early-end tolerance, gap units per second.

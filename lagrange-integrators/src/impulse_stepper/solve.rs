@@ -70,7 +70,7 @@ impl<T: Real, const N: usize, const C: usize> Problem<'_, T, N, C> {
     /// Coulomb friction `|tangent| <= mu normal` stopping the sliding where it can: the
     /// normal rows solved exactly with the tangents' impulses held, then projected
     /// Gauss-Seidel sweeps of the tangents with the normals held until they settle (at most
-    /// `rounds` sweeps), from the tangents' impulses `warm`, at most `rounds` times, ending
+    /// `sweeps` sweeps), from the tangents' impulses `warm`, at most `rounds` times, ending
     /// early once a round's first sweep changes no tangent's speed by more than `tolerance`
     /// (plus the rounding of its speed). The cone holds exactly at
     /// the end. The velocities returned are `v0` plus the response of the final impulses.
@@ -88,6 +88,7 @@ impl<T: Real, const N: usize, const C: usize> Problem<'_, T, N, C> {
         target: &SVector<T, C>,
         warm: &Impulses<T, C>,
         rounds: u32,
+        sweeps: u32,
         tolerance: T,
     ) -> Result<Solved<T, N, C>, Error> {
         let mut p = Impulses::zero();
@@ -112,7 +113,7 @@ impl<T: Real, const N: usize, const C: usize> Problem<'_, T, N, C> {
         let mut guess = *self.pushed;
         while taken < rounds.max(1) && !settled {
             taken += 1;
-            let sliding = self.tangent_response(v0, &p.tangent);
+            let sliding = self.tangent_response(v0, &p.tangent, &with_tangent[..count.min(C)]);
             let b = self.normal.speeds(&sliding) - target;
             let solved = match self.normal.complementary_from(&b, self.kinds, &guess) {
                 Ok(solved) => solved,
@@ -132,10 +133,10 @@ impl<T: Real, const N: usize, const C: usize> Problem<'_, T, N, C> {
                 break;
             }
             // The tangents swept until they settle (each sweep is cheap beside a normal
-            // solve: two dot products a tangent), at most `rounds` sweeps; the round settles
+            // solve: two dot products a tangent), at most `sweeps` sweeps; the round settles
             // when its first sweep changed nothing.
             let mut v = sliding + self.normal.response(&p.normal);
-            for sweep in 0..rounds.max(1) {
+            for sweep in 0..sweeps.max(1) {
                 let (mut change, mut allowed) = (T::zero(), tolerance);
                 for &i in with_tangent.iter().take(count) {
                     // Clamped (a no-op): the optimiser does not follow a row number
@@ -165,7 +166,8 @@ impl<T: Real, const N: usize, const C: usize> Problem<'_, T, N, C> {
         if !frictional {
             p.tangent = [T::zero(); C];
         }
-        let velocity = self.tangent_response(v0, &p.tangent) + self.normal.response(&p.normal);
+        let velocity = self.tangent_response(v0, &p.tangent, &with_tangent[..count.min(C)])
+            + self.normal.response(&p.normal);
         Ok(Solved {
             impulses: p,
             velocity,
@@ -174,12 +176,19 @@ impl<T: Real, const N: usize, const C: usize> Problem<'_, T, N, C> {
         })
     }
 
-    /// `v` plus the velocity change of the tangents' impulses.
-    fn tangent_response(&self, v: &SVector<T, N>, tangent: &[T; C]) -> SVector<T, N> {
+    /// `v` plus the velocity change of the tangents' impulses, over the rows `listed` (those
+    /// with a tangent: the rest are none of the set's kilobytes of directions).
+    fn tangent_response(
+        &self,
+        v: &SVector<T, N>,
+        tangent: &[T; C],
+        listed: &[usize],
+    ) -> SVector<T, N> {
         let mut out = *v;
-        for (t, p) in self.tangent.iter().zip(tangent) {
-            if let Some(t) = t {
-                out += t.b * *p;
+        for &i in listed {
+            let i = within::<C>(i);
+            if let Some(t) = &self.tangent[i] {
+                out += t.b * tangent[i];
             }
         }
         out

@@ -267,22 +267,30 @@ impl<T: Real, const C: usize, K> Setup<T, C, K> {
             settings.tolerance(),
             settings.slop(),
         );
+        // The solves after the plastic one (speculative rows, rebounds) start from its
+        // impulses and share the rounds it left, at least one each: a step takes at most
+        // `max_iterations + 3` rounds (ImpulseSettings::max_rounds), where each solve
+        // capped on its own took four times as many in the landing steps whose friction
+        // does not settle (the rounds shrink its change by a third each).
+        let left = |taken: u32| rounds.saturating_sub(taken).max(1);
         let friction = self.model.friction();
         let w = jacobian * free.qd;
         let jump = |b: &SVector<T, N>| mechanism.velocity_jump(&free, b);
         let mut target = SVector::<T, C>::zeros();
-        let solve =
-            |normal: &mut Delassus<T, N, C>, target: &SVector<T, C>, warm: &Impulses<T, C>| {
-                Problem {
-                    normal,
-                    kinds: &kinds,
-                    tangent,
-                    friction,
-                    pushed: &guess,
-                }
-                .solve(&free.qd, target, warm, rounds, tolerance)
-            };
-        let mut plastic = solve(normal, &target, &warm)?;
+        let solve = |normal: &mut Delassus<T, N, C>,
+                     target: &SVector<T, C>,
+                     warm: &Impulses<T, C>,
+                     cap: u32| {
+            Problem {
+                normal,
+                kinds: &kinds,
+                tangent,
+                friction,
+                pushed: &guess,
+            }
+            .solve(&free.qd, target, warm, cap, rounds, tolerance)
+        };
+        let mut plastic = solve(normal, &target, &warm, rounds)?;
         let (mut taken, mut speculative) = (plastic.rounds, 0u32);
         for _ in 0..SPECULATIVE_ROUNDS {
             let reach = jacobian * ((plastic.velocity - free.qd) * share) + gaps;
@@ -296,13 +304,13 @@ impl<T: Real, const C: usize, K> Setup<T, C, K> {
                 target[i] = w[i] - gaps[i] / share;
                 speculative += 1;
             }
-            plastic = solve(normal, &target, &plastic.impulses)?;
+            plastic = solve(normal, &target, &plastic.impulses, left(taken))?;
             taken += plastic.rounds;
         }
         let rebound = self.rebounds(&gaps, &w);
         let solved = if rebound.iter().any(|&r| r > T::zero()) {
             let bounce = target.zip_map(&rebound, |t, r| t.max(r));
-            let bounced = solve(normal, &bounce, &plastic.impulses)?;
+            let bounced = solve(normal, &bounce, &plastic.impulses, left(taken))?;
             taken += bounced.rounds;
             Solved {
                 settled: plastic.settled && bounced.settled,
