@@ -463,11 +463,14 @@ const AREAS: [Area; 29] = [
         test_package: "lagrange-tests",
         files: &[
             "lagrange-core/src/cholesky.rs",
+            "lagrange-core/src/tree_factor.rs",
             "lagrange-core/src/constraints/automatic.rs",
             "lagrange-core/src/constraints/contact/active_rows.rs",
         ],
         only: None,
         tests: &[
+            "--test",
+            "ragdoll",
             "--test",
             "automatic_euler_lagrange",
             "--test",
