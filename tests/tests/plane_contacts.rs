@@ -63,8 +63,9 @@ fn a_disk_rolls_down_a_slope<T: Real>() -> Result<(), Error> {
 /// (restitution 0.3, friction 0.6, slop 2 mm) at 120 Hz for 4 s: no step in contact ends above
 /// its start's energy (to 16 ulps of the terms), no corner deeper than the slop (to 2^-10 of it
 /// and rounding), and at the end it rests on a face: still (under 1e-3 m/s and rad/s), its
-/// angle a multiple of a quarter turn to 1e-3 rad, its lowest corners on the floor within the
-/// slop.
+/// angle a multiple of a quarter turn to what the slop allows (its two lowest corners rest
+/// anywhere within the slop, at most 0.3 m apart: slop / 0.3 m = 6.7e-3 rad; measured 1.4e-3
+/// rad, standing on its short side), its lowest corners on the floor within the slop.
 fn a_crate_comes_to_rest_flat<T: Real>() -> Result<(), Error> {
     let body = RigidBody::rectangle(T::from_f64(2.0), T::HALF, T::from_f64(0.3), T::from_f64(G))?;
     let shape = Shape::rectangle(T::HALF, T::from_f64(0.3))?;
@@ -108,7 +109,7 @@ fn a_crate_comes_to_rest_flat<T: Real>() -> Result<(), Error> {
     let quarter = core::f64::consts::FRAC_PI_2;
     let angle = s.q[2].to_f64();
     assert!(
-        (angle - quarter * (angle / quarter).round()).abs() < 1e-3,
+        (angle - quarter * (angle / quarter).round()).abs() <= slop / 0.3,
         "angle {angle}"
     );
     let gaps = rows.position_residual(&s.q);
