@@ -120,40 +120,7 @@ impl<T: Real, const N: usize> Cholesky<T, N> {
     /// than a chain of its own per column (a contact step's fifteen mobilities `M^-1 J^T` of
     /// a ragdoll cost about what four single solves do).
     pub fn solve_columns<const K: usize>(&self, b: &mut SMatrix<T, N, K>) {
-        // Columns read as slices in storage order (nalgebra's column iterator walks an entry
-        // at a time through a strided iterator).
-        let mut nonzero = [false; K];
-        for (flag, column) in nonzero.iter_mut().zip(b.as_slice().chunks_exact(N)) {
-            *flag = column.iter().any(|v| *v != T::zero());
-        }
-        let mut columns = (0..K).filter(|&k| nonzero[k]);
-        loop {
-            // Up to LANES columns that are not zero, by coordinate: x[i][c] is coordinate i
-            // of the c-th.
-            let mut which = [None::<usize>; LANES];
-            let mut x = [[T::zero(); LANES]; N];
-            for (slot, k) in which.iter_mut().zip(columns.by_ref()) {
-                *slot = Some(k);
-            }
-            if which[0].is_none() {
-                return;
-            }
-            for (c, &k) in which.iter().enumerate() {
-                if let Some(column) = k.and_then(|k| b.as_slice().chunks_exact(N).nth(k)) {
-                    for (xi, v) in x.iter_mut().zip(column) {
-                        xi[c] = *v;
-                    }
-                }
-            }
-            self.substitute(&mut x);
-            for (c, &k) in which.iter().enumerate() {
-                if let Some(column) = k.and_then(|k| b.as_mut_slice().chunks_exact_mut(N).nth(k)) {
-                    for (v, xi) in column.iter_mut().zip(x.iter()) {
-                        *v = xi[c];
-                    }
-                }
-            }
-        }
+        in_lanes(b, |x| self.substitute(x));
     }
 
     /// `L y = b` forward, `x = D^-1 y`, then `L^T x = ...` backward, in place, on each of
@@ -201,6 +168,50 @@ pub(crate) const LANES: usize = if cfg!(any(
 } else {
     1
 };
+
+/// Each column of `b` that is not zero replaced by what `substitute` makes of it, [`LANES`]
+/// columns side by side (by coordinate: `x[i][c]` is coordinate `i` of the `c`-th), zero
+/// columns left as they are: each step of a substitution is then one operation on the lanes
+/// rather than a chain of its own per column. The columns are read as slices in storage
+/// order (nalgebra's column iterator walks an entry at a time through a strided iterator).
+pub(crate) fn in_lanes<T: Real, const N: usize, const K: usize>(
+    b: &mut SMatrix<T, N, K>,
+    mut substitute: impl FnMut(&mut [[T; LANES]; N]),
+) {
+    if N == 0 {
+        return;
+    }
+    let mut nonzero = [false; K];
+    for (flag, column) in nonzero.iter_mut().zip(b.as_slice().chunks_exact(N)) {
+        *flag = column.iter().any(|v| *v != T::zero());
+    }
+    let mut columns = (0..K).filter(|&k| nonzero[k]);
+    loop {
+        let mut which = [None::<usize>; LANES];
+        let mut x = [[T::zero(); LANES]; N];
+        for (slot, k) in which.iter_mut().zip(columns.by_ref()) {
+            *slot = Some(k);
+        }
+        if which[0].is_none() {
+            return;
+        }
+        for (c, &k) in which.iter().enumerate() {
+            if let Some(column) = k.and_then(|k| b.as_slice().chunks_exact(N).nth(k)) {
+                for (xi, v) in x.iter_mut().zip(column) {
+                    xi[c] = *v;
+                }
+            }
+        }
+        substitute(&mut x);
+        for (c, &k) in which.iter().enumerate() {
+            if let Some(column) = k.and_then(|k| b.as_mut_slice().chunks_exact_mut(N).nth(k)) {
+                for (v, xi) in column.iter_mut().zip(x.iter()) {
+                    *v = xi[c];
+                }
+            }
+        }
+    }
+}
 
 #[cfg(test)]
 mod tests {

@@ -1,6 +1,6 @@
 //! [`TreeFactor`]: the mass matrix of a branched mechanism factored along its tree.
 
-use crate::cholesky::{pivot, LANES};
+use crate::cholesky::{in_lanes, pivot};
 use crate::{Error, Real};
 use nalgebra::SMatrix;
 
@@ -93,39 +93,7 @@ impl<T: Real, const N: usize> TreeFactor<T, N> {
     /// as they are), sixteen side by side where the target has SIMD lanes (as
     /// [`Cholesky::solve_columns`](crate::Cholesky::solve_columns)).
     pub fn solve_columns<const K: usize>(&self, b: &mut SMatrix<T, N, K>) {
-        if N == 0 {
-            return;
-        }
-        let mut nonzero = [false; K];
-        for (flag, column) in nonzero.iter_mut().zip(b.as_slice().chunks_exact(N)) {
-            *flag = column.iter().any(|v| *v != T::zero());
-        }
-        let mut columns = (0..K).filter(|&k| nonzero[k]);
-        loop {
-            let mut which = [None::<usize>; LANES];
-            for (slot, k) in which.iter_mut().zip(columns.by_ref()) {
-                *slot = Some(k);
-            }
-            if which[0].is_none() {
-                return;
-            }
-            let mut x = [[T::zero(); LANES]; N];
-            for (c, &k) in which.iter().enumerate() {
-                if let Some(column) = k.and_then(|k| b.as_slice().chunks_exact(N).nth(k)) {
-                    for (xi, v) in x.iter_mut().zip(column) {
-                        xi[c] = *v;
-                    }
-                }
-            }
-            self.substitute(&mut x);
-            for (c, &k) in which.iter().enumerate() {
-                if let Some(column) = k.and_then(|k| b.as_mut_slice().chunks_exact_mut(N).nth(k)) {
-                    for (v, xi) in column.iter_mut().zip(x.iter()) {
-                        *v = xi[c];
-                    }
-                }
-            }
-        }
+        in_lanes(b, |x| self.substitute(x));
     }
 
     /// `L^T z = b` from the leaves up (each coordinate, once final, taken from its

@@ -148,15 +148,7 @@ fn turning_plank<T: Real>(q: [f64; 3], slab: bool) -> Result<(), Error> {
     let mut deepest: f64 = 0.0;
     for _ in 0..30 {
         world.step(T::from_f64(1.0 / 60.0))?;
-        let s = world
-            .state(1)
-            .unwrap_or(State::new(T::zero(), [T::zero(); 3], [T::zero(); 3]));
-        let placed = plank.placed(&lagrange_core::links::Pose {
-            origin: [s.q[0], s.q[1]],
-            angle: s.q[2],
-        });
-        let m = lagrange_world::collide_half_plane(&HalfPlane::floor(), &placed, T::zero());
-        deepest = deepest.max(-m.gap().map_or(0.0, |g| g.to_f64()));
+        deepest = deepest.max(under_the_floor(&world, 1, &plank));
     }
     assert!(
         deepest <= SLOP * 1.01,
@@ -197,15 +189,7 @@ fn a_box_struck_on_a_corner_does_not_pass_into_the_floor<T: Real>() -> Result<()
         let mut deepest: f64 = 0.0;
         for _ in 0..60 {
             world.step(T::from_f64(1.0 / 60.0))?;
-            let s = world
-                .state(1)
-                .unwrap_or(State::new(T::zero(), [T::zero(); 3], [T::zero(); 3]));
-            let placed = shape.placed(&lagrange_core::links::Pose {
-                origin: [s.q[0], s.q[1]],
-                angle: s.q[2],
-            });
-            let m = lagrange_world::collide_half_plane(&HalfPlane::floor(), &placed, T::zero());
-            deepest = deepest.max(-m.gap().map_or(0.0, |g| g.to_f64()));
+            deepest = deepest.max(under_the_floor(&world, 1, &shape));
         }
         assert!(
             deepest <= SLOP * 1.01,
@@ -213,6 +197,20 @@ fn a_box_struck_on_a_corner_does_not_pass_into_the_floor<T: Real>() -> Result<()
         );
     }
     Ok(())
+}
+
+/// How far `shape` on body `key` (a rigid body: its coordinates its pose) is under the
+/// floor `y = 0` where the world has it now, m (zero above it).
+fn under_the_floor<T: Real>(world: &Bodies<T>, key: u32, shape: &Shape<T>) -> f64 {
+    let s = world
+        .state(key)
+        .unwrap_or(State::new(T::zero(), [T::zero(); 3], [T::zero(); 3]));
+    let placed = shape.placed(&lagrange_core::links::Pose {
+        origin: [s.q[0], s.q[1]],
+        angle: s.q[2],
+    });
+    let m = lagrange_world::collide_half_plane(&HalfPlane::floor(), &placed, T::zero());
+    (-m.gap().map_or(0.0, |g| g.to_f64())).max(0.0)
 }
 
 /// The settings of the stacking tests: no rebound, friction 0.6, a slop of 5 mm, 8 sweeps.
