@@ -837,10 +837,12 @@ const AREAS: [Area; 29] = [
         test_package: "lagrange-tests",
         files: &[
             "lagrange-world/src/world/mod.rs",
+            "lagrange-world/src/world/block.rs",
             "lagrange-world/src/world/bodies.rs",
             "lagrange-world/src/world/detect.rs",
             "lagrange-world/src/world/islands.rs",
             "lagrange-world/src/world/limits.rs",
+            "lagrange-world/src/world/locks.rs",
             "lagrange-world/src/world/mobilities.rs",
             "lagrange-world/src/world/places.rs",
             "lagrange-world/src/world/profile.rs",

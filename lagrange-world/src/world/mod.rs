@@ -1,10 +1,12 @@
 //! [`World`]: instances of a mechanism (bodies) with shapes on their links, static geometry,
 //! and the contacts between them, stepped together.
 
+mod block;
 mod bodies;
 mod detect;
 mod islands;
 mod limits;
+mod locks;
 mod mobilities;
 mod places;
 mod profile;
@@ -27,6 +29,7 @@ use islands::Islands;
 use lagrange_core::links::Links;
 use lagrange_core::nalgebra::SVector;
 use lagrange_core::{Error, Mechanism, Real, State};
+use locks::Locks;
 use places::Place;
 use profile::Stopwatch;
 use rows::{Contact, Kept};
@@ -130,7 +133,9 @@ pub struct WorldHit<T> {
 ///               mu times its normal impulse, each normal row to J v >= lower:
 ///               -gap / dt while open (speculative: it may close, no more), 0 touching,
 ///               -e J v* for a contact that strikes (and would leave at the rest speed
-///               or faster)
+///               or faster); a body's limits that pushed in the last step held still in
+///               the updates of its contacts' rows (a limb at its limit moves with its
+///               body), the bodies' own rows swept last
 /// 4. move       q+ = q + dt v+                                v+ the solved velocities
 /// 5. drift      q+ += dt p, pseudo-velocities p that bring every row the move leaves
 ///               deeper than the slop back to it, and close no other past it (split
@@ -214,6 +219,8 @@ pub struct World<
     settings: WorldSettings<T>,
     /// The last step's contacts, sorted by key.
     contacts: Vec<Contact<T, N>, K>,
+    /// The bodies' own rows locked in the last step's contacts.
+    locks: Locks<T, B>,
     /// The last step's impulses, sorted by key (the next step's warm start).
     kept: Vec<Kept<T>, K>,
     /// The pairs of shapes that pushed on each other in the last step, sorted.
@@ -244,6 +251,7 @@ where
             planes: Vec::new(),
             settings,
             contacts: Vec::new(),
+            locks: Locks::new(),
             kept: Vec::new(),
             touching: Vec::new(),
             events: Vec::new(),
@@ -591,28 +599,31 @@ where
         };
         report.woke = self.detect(dt, watch, &mut profile)?;
         let own = self.contacts.partition_point(|c| c.key.0 != OWN_ROWS);
+        self.locks
+            .lock::<N, K>(&mut self.contacts, own, self.bodies.len());
         let order = Order::of::<T, N, B>(&self.contacts, own);
         report.guarded = self.solve(&order);
         profile.solve = watch.lap();
         let mut pseudo = [SVector::<T, N>::zeros(); B];
         let velocities: [SVector<T, N>; B] =
             core::array::from_fn(|i| self.bodies.get(i).map_or(SVector::zeros(), |b| b.state.qd));
-        solve::drift(
-            &mut pseudo,
-            &velocities,
-            &mut self.contacts,
-            &order.all,
-            self.settings.slop,
-            dt,
-            self.settings.sweeps,
-        );
-        // The bodies' own rows have the last word here too.
-        solve::pseudo(
-            &mut pseudo,
-            &mut self.contacts,
-            &order.own,
-            OWN_SWEEPS * self.settings.sweeps,
-        );
+        if solve::drift(&velocities, &mut self.contacts, self.settings.slop, dt) {
+            // The bodies' own rows have the last word here too.
+            own_last(&order, self.settings.sweeps, |rows, sweeps| {
+                let (contacts, locks, drift) =
+                    (&mut self.contacts, &self.locks, solve::Phase::Drift);
+                solve::sweep(
+                    &mut pseudo,
+                    contacts,
+                    locks,
+                    rows,
+                    T::zero(),
+                    sweeps,
+                    drift,
+                    true,
+                );
+            });
+        }
         for (body, p) in self
             .bodies
             .iter_mut()
@@ -641,9 +652,9 @@ where
         let free = self.velocities();
         let before = self.kinetic(&free);
         let mut v = free;
-        solve::warm_start(&mut v, &self.contacts);
-        let (friction, sweeps) = (self.settings.model.friction(), self.settings.sweeps);
-        sweep(&mut v, &mut self.contacts, order, friction, sweeps);
+        solve::warm_start(&mut v, &mut self.contacts, &self.locks);
+        let solve = (self.settings.model.friction(), self.settings.sweeps);
+        sweep(&mut v, &mut self.contacts, &self.locks, order, solve, true);
         let after = self.kinetic(&v);
         // 16 ulps of the energies: the rounding of sums of a few products.
         let rounding = T::from_f64(16.0) * T::EPSILON * (before.abs() + after.abs());
@@ -656,7 +667,9 @@ where
                 c.tangent.lambda = T::zero();
                 c.lower = c.lower.min(T::zero());
             }
-            sweep(&mut v, &mut self.contacts, order, friction, sweeps);
+            // Plain updates, no rows locked: each lowers the program, whose value from
+            // zero impulses is the kinetic energy's change.
+            sweep(&mut v, &mut self.contacts, &self.locks, order, solve, false);
         }
         self.set_velocities(&v);
         guarded
@@ -868,19 +881,30 @@ where
     }
 }
 
-/// The impulse solve over `contacts` in `order`, then [`OWN_SWEEPS`] times as many sweeps
-/// over the bodies' own rows alone: a joint's limit has the last word over the contacts
-/// that strike its limb (their leftover depth is the drift's to remove; a limit passed is
-/// what a viewer sees).
-fn sweep<T: Real, const N: usize, const K: usize>(
+/// The impulse solve over `contacts` in `order`, the bodies' own rows last ([`own_last`]).
+fn sweep<T: Real, const N: usize, const B: usize, const K: usize>(
     v: &mut [SVector<T, N>],
     contacts: &mut [Contact<T, N>],
+    locks: &Locks<T, B>,
     order: &Order<K>,
-    friction: T,
-    sweeps: u32,
+    (friction, sweeps): (T, u32),
+    locking: bool,
 ) {
-    solve::velocities(v, contacts, &order.all, friction, sweeps);
-    solve::velocities(v, contacts, &order.own, friction, OWN_SWEEPS * sweeps);
+    let velocity = solve::Phase::Velocity;
+    own_last(order, sweeps, |rows, sweeps| {
+        solve::sweep(
+            v, contacts, locks, rows, friction, sweeps, velocity, locking,
+        );
+    });
+}
+
+/// `sweeps` sweeps over every row of `order` by `pass`, then [`OWN_SWEEPS`] times as many
+/// over the bodies' own rows alone: a joint's limit has the last word over the contacts that
+/// strike its limb (their leftover depth is the drift's to remove; a limit passed is what a
+/// viewer sees).
+fn own_last<const K: usize>(order: &Order<K>, sweeps: u32, mut pass: impl FnMut(&[u32], u32)) {
+    pass(&order.all, sweeps);
+    pass(&order.own, OWN_SWEEPS * sweeps);
 }
 
 /// A count as the report's `u32`.

@@ -3,6 +3,7 @@
 //! coordinates, each with its mobilities (`M^-1 j^T`, from each body's own mass solve) and
 //! the impulse it has taken.
 
+use super::locks::LOCKS;
 use crate::vec2::Vec2;
 use lagrange_core::nalgebra::SVector;
 use lagrange_core::Real;
@@ -23,8 +24,16 @@ pub(crate) struct Row<T: Real, const N: usize> {
     pub(crate) b: [SVector<T, N>; 2],
     /// `1 / W`, `W = sum_s j[s] . b[s]`; zero for a row no impulse moves.
     pub(crate) inverse: T,
+    /// `1 / W` of the row's own mobilities, before any rows were locked in them (see
+    /// `locks`; the same as `inverse` where none are).
+    pub(crate) loose: T,
     /// The impulse taken this step (warm-started from the last step's).
     pub(crate) lambda: T,
+    /// On each side, the impulses per unit of this row's that the rows locked on its body
+    /// take (see `locks`; zero where none are).
+    pub(crate) locks: [[T; LOCKS]; 2],
+    /// Whether rows are locked in it on a side.
+    pub(crate) held: bool,
 }
 
 impl<T: Real, const N: usize> Row<T, N> {
@@ -43,20 +52,29 @@ impl<T: Real, const N: usize> Row<T, N> {
             j,
             b: [SVector::zeros(); 2],
             inverse: T::zero(),
+            loose: T::zero(),
             lambda: T::zero(),
+            locks: [[T::zero(); LOCKS]; 2],
+            held: false,
         }
     }
 
-    /// Its `1 / W` from its mobilities as they are now.
+    /// Its `1 / W` from its own mobilities as they are now (no rows locked in them).
     pub(crate) fn refresh(&mut self) {
+        self.inverse = self.inverse_now();
+        self.loose = self.inverse;
+    }
+
+    /// `1 / W` from its mobilities as they are now (zero for a row no impulse moves).
+    pub(crate) fn inverse_now(&self) -> T {
         let w = self.j[0].dot(&self.b[0]) + self.j[1].dot(&self.b[1]);
         // A row no impulse moves (both sides static, or a point that no coordinate moves
         // along it) takes none.
-        self.inverse = if w > T::EPSILON && (T::one() / w).is_finite() {
+        if w > T::EPSILON && (T::one() / w).is_finite() {
             T::one() / w
         } else {
             T::zero()
-        };
+        }
     }
 
     /// The row's velocity `a` at the bodies' velocities `v` (a side of no body: `None`).

@@ -3,6 +3,7 @@
 //! ([`Order`]), in the bodies' generalized velocities, and the same over pseudo-velocities
 //! for the drift.
 
+use super::locks::Locks;
 use super::rows::{Contact, Row};
 use heapless::Vec;
 use lagrange_core::nalgebra::SVector;
@@ -11,14 +12,15 @@ use lagrange_core::Real;
 /// Velocities of the bodies, by index.
 pub(crate) type Velocities<'a, T, const N: usize> = &'a mut [SVector<T, N>];
 
-/// `v[body] += b * d` on each side of `row`.
+/// `v[body] += b * d` on each side (`b` a row's mobilities).
+#[inline(always)]
 fn apply<T: Real, const N: usize>(
     v: &mut [SVector<T, N>],
     bodies: [Option<usize>; 2],
-    row: &Row<T, N>,
+    b: &[SVector<T, N>; 2],
     d: T,
 ) {
-    for (body, b) in bodies.iter().zip(&row.b) {
+    for (body, b) in bodies.iter().zip(b) {
         if let Some(x) = body.and_then(|k| v.get_mut(k)) {
             *x += b * d;
         }
@@ -26,6 +28,7 @@ fn apply<T: Real, const N: usize>(
 }
 
 /// The row's velocity at `v`.
+#[inline(always)]
 fn speed<T: Real, const N: usize>(
     v: &[SVector<T, N>],
     bodies: [Option<usize>; 2],
@@ -34,100 +37,264 @@ fn speed<T: Real, const N: usize>(
     row.speed(bodies.map(|b| b.and_then(|k| v.get(k))))
 }
 
-/// The impulses the contacts took last step, applied again (warm start).
-pub(crate) fn warm_start<T: Real, const N: usize>(
-    v: Velocities<'_, T, N>,
-    contacts: &[Contact<T, N>],
-) {
-    for c in contacts {
-        apply(v, c.bodies, &c.normal, c.normal.lambda);
-        apply(v, c.bodies, &c.tangent, c.tangent.lambda);
-    }
+/// Which impulses a sweep solves for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Phase {
+    /// The velocities': each tangent within the cone, each normal row to its `lower` speed.
+    Velocity,
+    /// The drift's, on pseudo-velocities: each normal row to its `reach`.
+    Drift,
 }
 
-/// `sweeps` sweeps over the contacts `order` names: each tangent within `friction` times
-/// its normal impulse (Coulomb's cone), then each normal row to no less than its `lower`
-/// speed with a push that never pulls (its accumulated impulse stays `>= 0`). Each change
-/// lowers the program whose minimum the impulses are, so that with `lower <= 0` (no
-/// rebound) the kinetic energy never rises.
-pub(crate) fn velocities<T: Real, const N: usize>(
-    v: Velocities<'_, T, N>,
-    contacts: &mut [Contact<T, N>],
-    order: &[u32],
-    friction: T,
-    sweeps: u32,
-) {
-    for _ in 0..sweeps {
-        for &i in order {
-            let Some(c) = contacts.get_mut(i as usize) else {
-                continue;
-            };
-            if friction > T::zero() {
-                let bound = friction * c.normal.lambda;
-                let a = speed(v, c.bodies, &c.tangent);
-                let lambda = (c.tangent.lambda - a * c.tangent.inverse)
-                    .max(-bound)
-                    .min(bound);
-                let d = lambda - c.tangent.lambda;
-                c.tangent.lambda = lambda;
-                apply(v, c.bodies, &c.tangent, d);
-            }
-            let a = speed(v, c.bodies, &c.normal);
-            let lambda = (c.normal.lambda + (c.lower - a) * c.normal.inverse).max(T::zero());
-            let d = lambda - c.normal.lambda;
-            c.normal.lambda = lambda;
-            apply(v, c.bodies, &c.normal, d);
+/// One of a contact's two rows.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Part {
+    /// Along the contact's normal.
+    Normal,
+    /// Across it (friction).
+    Tangent,
+}
+
+impl Phase {
+    /// The impulse of row `part` of `c` that this phase solves for.
+    pub(crate) fn impulse<T: Real, const N: usize>(
+        self,
+        c: &mut Contact<T, N>,
+        part: Part,
+    ) -> &mut T {
+        match (self, part) {
+            (Phase::Drift, _) => &mut c.drift,
+            (Phase::Velocity, Part::Normal) => &mut c.normal.lambda,
+            (Phase::Velocity, Part::Tangent) => &mut c.tangent.lambda,
+        }
+    }
+
+    /// [`Phase::impulse`], read.
+    pub(crate) fn impulse_of<T: Real, const N: usize>(self, c: &Contact<T, N>, part: Part) -> T {
+        match (self, part) {
+            (Phase::Drift, _) => c.drift,
+            (Phase::Velocity, Part::Normal) => c.normal.lambda,
+            (Phase::Velocity, Part::Tangent) => c.tangent.lambda,
+        }
+    }
+
+    /// The speed row `part` of `c` is solved to.
+    pub(crate) fn target<T: Real, const N: usize>(self, c: &Contact<T, N>, part: Part) -> T {
+        match (self, part) {
+            (Phase::Drift, _) => c.reach,
+            (Phase::Velocity, Part::Normal) => c.lower,
+            (Phase::Velocity, Part::Tangent) => T::zero(),
         }
     }
 }
 
-/// Pseudo-velocities `p` (zero at first) that leave no row deeper than `slop` where the
-/// velocities `v` take it over the step `dt`: each row's gap there, linearised (`gap + dt J
-/// v`), and `sweeps` sweeps of the normal rows to `J p >= -(that + slop) / dt` with pushes
-/// only. A row the velocities leave open takes no push but may not be closed past the slop
-/// by the others' (a joint's limit while its limb is pushed out of another body). They move
-/// the coordinates only, never the velocities: the drift is removed without kinetic energy
-/// (split impulses).
+impl Part {
+    fn of<T: Real, const N: usize>(self, c: &Contact<T, N>) -> &Row<T, N> {
+        match self {
+            Part::Normal => &c.normal,
+            Part::Tangent => &c.tangent,
+        }
+    }
+}
+
+/// The impulses the contacts took last step, applied again (warm start): a row locked on a
+/// body (see `locks`) takes with its own mobility what the others' locked mobilities do not
+/// apply for it.
+pub(crate) fn warm_start<T: Real, const N: usize, const B: usize>(
+    v: Velocities<'_, T, N>,
+    contacts: &mut [Contact<T, N>],
+    locks: &Locks<T, B>,
+) {
+    let implied = |contacts: &mut [Contact<T, N>], sign: T| {
+        for i in 0..contacts.len() {
+            let Some(c) = contacts.get(i) else { continue };
+            let (bodies, normal, tangent) = (c.bodies, c.normal, c.tangent);
+            let velocity = Phase::Velocity;
+            locks.hold(
+                contacts,
+                bodies,
+                &normal.locks,
+                sign * normal.lambda,
+                velocity,
+            );
+            locks.hold(
+                contacts,
+                bodies,
+                &tangent.locks,
+                sign * tangent.lambda,
+                velocity,
+            );
+        }
+    };
+    if locks.any() {
+        implied(contacts, -T::one());
+    }
+    for c in contacts.iter() {
+        apply(v, c.bodies, &c.normal.b, c.normal.lambda);
+        apply(v, c.bodies, &c.tangent.b, c.tangent.lambda);
+    }
+    if locks.any() {
+        implied(contacts, T::one());
+    }
+}
+
+/// `sweeps` sweeps over the contacts `order` names, solving for `phase`'s impulses at the
+/// velocities `v` (the bodies' or, for the drift, pseudo-velocities): each tangent within
+/// `friction` times its normal impulse (Coulomb's cone), then each normal row to no less
+/// than its target speed with a push that never pulls (its accumulated impulse stays `>=
+/// 0`). Each update is the program's minimum along it (the program whose minimum the
+/// impulses are), so that with targets `<= 0` (no rebound) the kinetic energy never rises.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn sweep<T: Real, const N: usize, const B: usize>(
+    v: Velocities<'_, T, N>,
+    contacts: &mut [Contact<T, N>],
+    locks: &Locks<T, B>,
+    order: &[u32],
+    friction: T,
+    sweeps: u32,
+    phase: Phase,
+    locking: bool,
+) {
+    let run = Run {
+        order,
+        friction,
+        sweeps,
+        locking,
+    };
+    // Each phase's sweeps compiled on their own: its accessors' matches folded away.
+    match phase {
+        Phase::Velocity => run.sweeps::<N, B, false>(v, contacts, locks),
+        Phase::Drift => run.sweeps::<N, B, true>(v, contacts, locks),
+    }
+}
+
+/// What [`sweep`] was asked for.
+struct Run<'a, T> {
+    order: &'a [u32],
+    friction: T,
+    sweeps: u32,
+    locking: bool,
+}
+
+impl<T: Real> Run<'_, T> {
+    /// [`sweep`] in the drift's phase (`DRIFT`) or the velocities'.
+    fn sweeps<const N: usize, const B: usize, const DRIFT: bool>(
+        &self,
+        v: Velocities<'_, T, N>,
+        contacts: &mut [Contact<T, N>],
+        locks: &Locks<T, B>,
+    ) {
+        let phase = if DRIFT { Phase::Drift } else { Phase::Velocity };
+        let frictional = !DRIFT && self.friction > T::zero();
+        let push = (T::zero(), T::INFINITY);
+        for _ in 0..self.sweeps {
+            for &i in self.order {
+                let i = i as usize;
+                // A row with no tangent (a body's own) has no friction to sweep.
+                let tangent = contacts
+                    .get(i)
+                    .filter(|c| frictional && c.tangent.inverse > T::zero())
+                    .map(|c| self.friction * c.normal.lambda);
+                if let Some(bound) = tangent {
+                    let cone = (-bound, bound);
+                    update(
+                        v,
+                        contacts,
+                        locks,
+                        i,
+                        Part::Tangent,
+                        phase,
+                        cone,
+                        self.locking,
+                    );
+                }
+                update(
+                    v,
+                    contacts,
+                    locks,
+                    i,
+                    Part::Normal,
+                    phase,
+                    push,
+                    self.locking,
+                );
+            }
+        }
+    }
+}
+
+/// Row `part` of contact `i` updated to its target speed in `phase`, its impulse within
+/// `bounds`: along its mobility; or where rows are locked in it (see `locks`) and `locking`,
+/// along its locked mobility where that leaves every locked row pushing, else with those
+/// that would pull let go.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn update<T: Real, const N: usize, const B: usize>(
+    v: &mut [SVector<T, N>],
+    contacts: &mut [Contact<T, N>],
+    locks: &Locks<T, B>,
+    i: usize,
+    part: Part,
+    phase: Phase,
+    (lo, hi): (T, T),
+    locking: bool,
+) {
+    let Some(c) = contacts.get(i) else {
+        return;
+    };
+    let (bodies, row) = (c.bodies, part.of(c));
+    let residual = speed(v, bodies, row) - phase.target(c, part);
+    let lambda = phase.impulse_of(c, part);
+    let next = if !row.held {
+        let next = (lambda - residual * row.inverse).max(lo).min(hi);
+        apply(v, bodies, &row.b, next - lambda);
+        next
+    } else {
+        let locked = (lambda - residual * row.inverse).max(lo).min(hi);
+        let (next, b, mu) =
+            if locking && locks.allows(contacts, bodies, &row.locks, locked - lambda, phase) {
+                (locked, row.b, row.locks)
+            } else {
+                locks.let_go(
+                    contacts,
+                    bodies,
+                    row,
+                    residual,
+                    lambda,
+                    (lo, hi),
+                    phase,
+                    locking,
+                )
+            };
+        apply(v, bodies, &b, next - lambda);
+        locks.hold(contacts, bodies, &mu, next - lambda, phase);
+        next
+    };
+    if let Some(c) = contacts.get_mut(i) {
+        *phase.impulse(c, part) = next;
+    }
+}
+
+/// The drift's targets: each row's gap where the velocities `v` take it over the step `dt`,
+/// linearised (`gap + dt J v`), to be brought back to `-slop` by pseudo-velocities `p`
+/// (zero at first) with pushes only, `J p >= -(that + slop) / dt` (the [`sweep`]s of
+/// [`Phase::Drift`]). A row the velocities leave open takes no push but may not be closed
+/// past the slop by the others' (a joint's limit while its limb is pushed out of another
+/// body). They move the
+/// coordinates only, never the velocities: the drift is removed without kinetic energy
+/// (split impulses). Whether any row is deeper than the slop (else none needs a push).
 pub(crate) fn drift<T: Real, const N: usize>(
-    p: Velocities<'_, T, N>,
     v: &[SVector<T, N>],
     contacts: &mut [Contact<T, N>],
-    order: &[u32],
     slop: T,
     dt: T,
-    sweeps: u32,
-) {
+) -> bool {
     for c in contacts.iter_mut() {
         let reach = c.gap + dt * speed(v, c.bodies, &c.normal);
         c.drift = T::zero();
         c.reach = -(reach + slop) / dt;
     }
-    // Nothing deeper than the slop: no row pushes, and the others only hold.
-    if contacts.iter().all(|c| c.reach <= T::zero()) {
-        return;
-    }
-    pseudo(p, contacts, order, sweeps);
-}
-
-/// `sweeps` sweeps of the drift's rows `order` names (see [`drift`]).
-pub(crate) fn pseudo<T: Real, const N: usize>(
-    p: Velocities<'_, T, N>,
-    contacts: &mut [Contact<T, N>],
-    order: &[u32],
-    sweeps: u32,
-) {
-    for _ in 0..sweeps {
-        for &i in order {
-            let Some(c) = contacts.get_mut(i as usize) else {
-                continue;
-            };
-            let a = speed(p, c.bodies, &c.normal);
-            let lambda = (c.drift + (c.reach - a) * c.normal.inverse).max(T::zero());
-            let d = lambda - c.drift;
-            c.drift = lambda;
-            apply(p, c.bodies, &c.normal, d);
-        }
-    }
+    contacts.iter().any(|c| c.reach > T::zero())
 }
 
 /// How many contacts ahead of the keys' order the solve may take one: far enough to reach
@@ -247,7 +414,8 @@ fn interleaved<T: Real, const N: usize, const B: usize, const K: usize>(
 
 #[cfg(test)]
 mod tests {
-    use super::{velocities, Order};
+    use super::{sweep, Order, Phase};
+    use crate::world::locks::Locks;
     use crate::world::rows::{Contact, Row};
     use lagrange_core::nalgebra::SVector;
 
@@ -324,8 +492,12 @@ mod tests {
             let start = [0; 6].map(|_| SVector::<f64, 2>::new(draw(), draw()));
             let (mut v, mut w) = (start, start);
             let mut other = contacts.clone();
-            velocities(&mut v, &mut contacts, &keys, 0.5, 3);
-            velocities(&mut w, &mut other, &order.all, 0.5, 3);
+            let locks = Locks::<f64, 6>::new();
+            let velocity = Phase::Velocity;
+            sweep(&mut v, &mut contacts, &locks, &keys, 0.5, 3, velocity, true);
+            sweep(
+                &mut w, &mut other, &locks, &order.all, 0.5, 3, velocity, true,
+            );
             assert_eq!(v, w, "round {round}");
         }
     }
