@@ -25,6 +25,11 @@ impl<T: Real> WorldSettings<T> {
     /// sweeps of the impulse solve a step (>= 1). A speculative margin of `4 slop` (bodies
     /// moving faster widen it by how far they move in the step); no sleeping.
     ///
+    /// How many sweeps: a step's work grows with them, and a tall stack needs more, its
+    /// weight carried down one row a sweep. A pyramid of 10 rows of boxes stands with 8
+    /// (its top box 8 mm from its start after a minute); one of 20 rows falls apart with 8
+    /// and stands with 12 (its top box 35 to 38 mm from its start after 10 s).
+    ///
     /// # Errors
     /// [`Error::InvalidParameter`] `slop` unless positive and finite, `sweeps` when zero.
     pub fn new(model: ContactModel<T>, slop: T, sweeps: u32) -> Result<Self, Error> {
