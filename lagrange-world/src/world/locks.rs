@@ -395,9 +395,16 @@ mod tests {
             let tip = v[0][0] + 0.6 * v[0][1];
             if locked {
                 assert!(tip.abs() < 1e-15 && v[0][1].abs() < 1e-15, "{v:?}");
-                // Momentum: 61.2 kg stopped from 1 m/s by the floor's impulse.
+                // Momentum: 61.2 kg stopped from 1 m/s by the floor's impulse; the limit took
+                // what keeps the limb's angle (M's second row of the change: 0.6 * 61.2 - its
+                // impulse = 0.36, the limb's share of the momentum), over its 1e-3.
                 assert!(
                     (contacts[0].normal.lambda - 61.2).abs() < 1e-12,
+                    "{contacts:?}"
+                );
+                let limit = 1e-3 + 0.6 * 61.2 - 0.36;
+                assert!(
+                    (contacts[1].normal.lambda - limit).abs() < 1e-12,
                     "{contacts:?}"
                 );
             } else {
