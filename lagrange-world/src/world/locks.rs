@@ -335,6 +335,30 @@ mod tests {
     use crate::world::solve::{sweep, Phase};
     use lagrange_core::nalgebra::{Matrix2, SVector, Vector2, Vector3};
 
+    /// A contact of body 0 alone (a floor's, or its own row) with the row `normal`, pushing
+    /// with `lambda` from the last step, touching, no tangent.
+    fn on_one_body<const N: usize>(
+        key: (u32, u32, u32),
+        mut normal: Row<f64, N>,
+        lambda: f64,
+    ) -> Contact<f64, N> {
+        normal.lambda = lambda;
+        let zero = SVector::zeros();
+        Contact {
+            key,
+            bodies: [Some(0), None],
+            normal,
+            tangent: Row::new([zero; 2], [zero; 2]),
+            gap: 0.0,
+            lower: 0.0,
+            approach: 0.0,
+            drift: 0.0,
+            reach: 0.0,
+            point: [0.0; 2],
+            direction: [0.0; 2],
+        }
+    }
+
     /// A torso (height `y`, 60 kg) and a light limb on it (angle `a`, 1.2 kg, 0.6 m, its tip
     /// at `y + 0.6 a` to first order) held at its upper limit, falling at 1 m/s onto the
     /// limb's tip: the floor's row and the limit's, their mobilities from the mass matrix.
@@ -344,23 +368,7 @@ mod tests {
         let inverse = Matrix2::new(d, -b, -b, a) / (a * d - b * b);
         let row =
             |j: Vector2<f64>| Row::new([j, Vector2::zeros()], [inverse * j, Vector2::zeros()]);
-        let contact = |key, j, lambda| {
-            let mut normal = row(j);
-            normal.lambda = lambda;
-            Contact {
-                key,
-                bodies: [Some(0), None],
-                normal,
-                tangent: Row::new([Vector2::zeros(); 2], [Vector2::zeros(); 2]),
-                gap: 0.0,
-                lower: 0.0,
-                approach: 0.0,
-                drift: 0.0,
-                reach: 0.0,
-                point: [0.0; 2],
-                direction: [0.0; 2],
-            }
-        };
+        let contact = |key, j, lambda| on_one_body(key, row(j), lambda);
         let floor = contact((1, 2, 0), Vector2::new(1.0, l), 0.0);
         // Pushing in the last step: the limit holds.
         let limit = contact((u32::MAX, 0, 1), Vector2::new(0.0, -1.0), 1e-3);
@@ -425,23 +433,7 @@ mod tests {
             let b = Vector3::from_fn(|i, _| j[i] / mass[i]);
             Row::new([j, Vector3::zeros()], [b, Vector3::zeros()])
         };
-        let contact = |key, j, lambda| {
-            let mut normal = row(j);
-            normal.lambda = lambda;
-            Contact {
-                key,
-                bodies: [Some(0), None],
-                normal,
-                tangent: row(Vector3::zeros()),
-                gap: 0.0,
-                lower: 0.0,
-                approach: 0.0,
-                drift: 0.0,
-                reach: 0.0,
-                point: [0.0; 2],
-                direction: [0.0; 2],
-            }
-        };
+        let contact = |key, j, lambda| on_one_body(key, row(j), lambda);
         let mut contacts = [
             contact((1, 2, 0), Vector3::new(1.0, 0.7, -0.4), 0.0),
             contact((u32::MAX, 0, 0), Vector3::new(0.0, 1.0, 0.0), 1e-3),
