@@ -1,8 +1,11 @@
 //! [`Block`]: up to [`LOCKS`] of one body's locked rows as one small system (see `locks`).
 
-use super::locks::LOCKS;
 use lagrange_core::nalgebra::SVector;
 use lagrange_core::Real;
+
+/// The most own rows of one body locked in a step: a ragdoll lying on the floor holds two to
+/// four of its joints at their limits.
+pub(crate) const LOCKS: usize = 4;
 
 /// One locked row (a body's own, so on its side 0): its Jacobian, its mobility and its
 /// impulse in the phase under way.

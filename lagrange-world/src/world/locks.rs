@@ -31,18 +31,13 @@
 //! a locked row would pull, in place of letting it go; every touching limit locked, pushing
 //! or not (later asleep).
 
-use super::block::{Block, Locked};
+use super::block::{Block, Locked, LOCKS};
 use super::limits::MAX_OWN_ROWS;
-use super::rows::{Contact, Row};
-use super::solve::{Part, Phase};
+use super::rows::{Contact, Part, Phase, Row};
 use core::marker::PhantomData;
 use heapless::Vec;
 use lagrange_core::nalgebra::SVector;
 use lagrange_core::Real;
-
-/// The most own rows of one body locked in a step: a ragdoll lying on the floor holds two to
-/// four of its joints at their limits.
-pub(crate) const LOCKS: usize = 4;
 
 /// The end of a list.
 const END: u32 = u32::MAX;
@@ -331,8 +326,9 @@ fn lock_side<T: Real, const N: usize>(block: &Block<T, N>, row: &mut Row<T, N>, 
 #[cfg(test)]
 mod tests {
     use super::Locks;
+    use crate::world::rows::Phase;
     use crate::world::rows::{Contact, Row};
-    use crate::world::solve::{sweep, Phase};
+    use crate::world::solve::sweep;
     use lagrange_core::nalgebra::{Matrix2, SVector, Vector2, Vector3};
 
     /// A contact of body 0 alone (a floor's, or its own row) with the row `normal`, pushing

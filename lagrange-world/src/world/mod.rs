@@ -611,7 +611,7 @@ where
             // The bodies' own rows have the last word here too.
             own_last(&order, self.settings.sweeps, |rows, sweeps| {
                 let (contacts, locks, drift) =
-                    (&mut self.contacts, &self.locks, solve::Phase::Drift);
+                    (&mut self.contacts, &self.locks, rows::Phase::Drift);
                 solve::sweep(
                     &mut pseudo,
                     contacts,
@@ -890,7 +890,7 @@ fn sweep<T: Real, const N: usize, const B: usize, const K: usize>(
     (friction, sweeps): (T, u32),
     locking: bool,
 ) {
-    let velocity = solve::Phase::Velocity;
+    let velocity = rows::Phase::Velocity;
     own_last(order, sweeps, |rows, sweeps| {
         solve::sweep(
             v, contacts, locks, rows, friction, sweeps, velocity, locking,

@@ -1,9 +1,10 @@
 //! The rows of a [`World`](super::World)'s contacts: a contact point between two bodies (or a
 //! body and static geometry) as a normal row and a tangent row in the two bodies' generalized
 //! coordinates, each with its mobilities (`M^-1 j^T`, from each body's own mass solve) and
-//! the impulse it has taken.
+//! the impulse it has taken; and which of a contact's impulses a sweep solves for
+//! ([`Phase`], [`Part`]).
 
-use super::locks::LOCKS;
+use super::block::LOCKS;
 use crate::vec2::Vec2;
 use lagrange_core::nalgebra::SVector;
 use lagrange_core::Real;
@@ -125,4 +126,65 @@ pub(crate) struct Kept<T> {
     pub(crate) key: ContactKey,
     pub(crate) normal: T,
     pub(crate) tangent: T,
+}
+
+/// Which impulses a sweep solves for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Phase {
+    /// The velocities': each tangent within the cone, each normal row to its `lower` speed.
+    Velocity,
+    /// The drift's, on pseudo-velocities: each normal row to its `reach`.
+    Drift,
+}
+
+/// One of a contact's two rows.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Part {
+    /// Along the contact's normal.
+    Normal,
+    /// Across it (friction).
+    Tangent,
+}
+
+impl Phase {
+    /// The impulse of row `part` of `c` that this phase solves for.
+    pub(crate) fn impulse<T: Real, const N: usize>(
+        self,
+        c: &mut Contact<T, N>,
+        part: Part,
+    ) -> &mut T {
+        match (self, part) {
+            (Phase::Drift, _) => &mut c.drift,
+            (Phase::Velocity, Part::Normal) => &mut c.normal.lambda,
+            (Phase::Velocity, Part::Tangent) => &mut c.tangent.lambda,
+        }
+    }
+
+    /// [`Phase::impulse`], read.
+    pub(crate) fn impulse_of<T: Real, const N: usize>(self, c: &Contact<T, N>, part: Part) -> T {
+        match (self, part) {
+            (Phase::Drift, _) => c.drift,
+            (Phase::Velocity, Part::Normal) => c.normal.lambda,
+            (Phase::Velocity, Part::Tangent) => c.tangent.lambda,
+        }
+    }
+
+    /// The speed row `part` of `c` is solved to.
+    pub(crate) fn target<T: Real, const N: usize>(self, c: &Contact<T, N>, part: Part) -> T {
+        match (self, part) {
+            (Phase::Drift, _) => c.reach,
+            (Phase::Velocity, Part::Normal) => c.lower,
+            (Phase::Velocity, Part::Tangent) => T::zero(),
+        }
+    }
+}
+
+impl Part {
+    /// Row `self` of `c`.
+    pub(crate) fn of<T: Real, const N: usize>(self, c: &Contact<T, N>) -> &Row<T, N> {
+        match self {
+            Part::Normal => &c.normal,
+            Part::Tangent => &c.tangent,
+        }
+    }
 }

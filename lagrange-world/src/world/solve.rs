@@ -4,7 +4,7 @@
 //! for the drift.
 
 use super::locks::Locks;
-use super::rows::{Contact, Row};
+use super::rows::{Contact, Part, Phase, Row};
 use heapless::Vec;
 use lagrange_core::nalgebra::SVector;
 use lagrange_core::Real;
@@ -35,66 +35,6 @@ fn speed<T: Real, const N: usize>(
     row: &Row<T, N>,
 ) -> T {
     row.speed(bodies.map(|b| b.and_then(|k| v.get(k))))
-}
-
-/// Which impulses a sweep solves for.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) enum Phase {
-    /// The velocities': each tangent within the cone, each normal row to its `lower` speed.
-    Velocity,
-    /// The drift's, on pseudo-velocities: each normal row to its `reach`.
-    Drift,
-}
-
-/// One of a contact's two rows.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) enum Part {
-    /// Along the contact's normal.
-    Normal,
-    /// Across it (friction).
-    Tangent,
-}
-
-impl Phase {
-    /// The impulse of row `part` of `c` that this phase solves for.
-    pub(crate) fn impulse<T: Real, const N: usize>(
-        self,
-        c: &mut Contact<T, N>,
-        part: Part,
-    ) -> &mut T {
-        match (self, part) {
-            (Phase::Drift, _) => &mut c.drift,
-            (Phase::Velocity, Part::Normal) => &mut c.normal.lambda,
-            (Phase::Velocity, Part::Tangent) => &mut c.tangent.lambda,
-        }
-    }
-
-    /// [`Phase::impulse`], read.
-    pub(crate) fn impulse_of<T: Real, const N: usize>(self, c: &Contact<T, N>, part: Part) -> T {
-        match (self, part) {
-            (Phase::Drift, _) => c.drift,
-            (Phase::Velocity, Part::Normal) => c.normal.lambda,
-            (Phase::Velocity, Part::Tangent) => c.tangent.lambda,
-        }
-    }
-
-    /// The speed row `part` of `c` is solved to.
-    pub(crate) fn target<T: Real, const N: usize>(self, c: &Contact<T, N>, part: Part) -> T {
-        match (self, part) {
-            (Phase::Drift, _) => c.reach,
-            (Phase::Velocity, Part::Normal) => c.lower,
-            (Phase::Velocity, Part::Tangent) => T::zero(),
-        }
-    }
-}
-
-impl Part {
-    fn of<T: Real, const N: usize>(self, c: &Contact<T, N>) -> &Row<T, N> {
-        match self {
-            Part::Normal => &c.normal,
-            Part::Tangent => &c.tangent,
-        }
-    }
 }
 
 /// The impulses the contacts took last step, applied again (warm start): a row locked on a
@@ -414,9 +354,9 @@ fn interleaved<T: Real, const N: usize, const B: usize, const K: usize>(
 
 #[cfg(test)]
 mod tests {
-    use super::{sweep, Order, Phase};
+    use super::{sweep, Order};
     use crate::world::locks::Locks;
-    use crate::world::rows::{Contact, Row};
+    use crate::world::rows::{Contact, Phase, Row};
     use lagrange_core::nalgebra::SVector;
 
     /// A contact between `bodies` (of 2 coordinates), its rows drawn from `draw`.
