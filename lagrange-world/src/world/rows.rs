@@ -25,9 +25,6 @@ pub(crate) struct Row<T: Real, const N: usize> {
     pub(crate) b: [SVector<T, N>; 2],
     /// `1 / W`, `W = sum_s j[s] . b[s]`; zero for a row no impulse moves.
     pub(crate) inverse: T,
-    /// `1 / W` of the row's own mobilities, before any rows were locked in them (see
-    /// `locks`; the same as `inverse` where none are).
-    pub(crate) loose: T,
     /// The impulse taken this step (warm-started from the last step's).
     pub(crate) lambda: T,
     /// On each side, the impulses per unit of this row's that the rows locked on its body
@@ -53,17 +50,15 @@ impl<T: Real, const N: usize> Row<T, N> {
             j,
             b: [SVector::zeros(); 2],
             inverse: T::zero(),
-            loose: T::zero(),
             lambda: T::zero(),
             locks: [[T::zero(); LOCKS]; 2],
             held: false,
         }
     }
 
-    /// Its `1 / W` from its own mobilities as they are now (no rows locked in them).
+    /// Its `1 / W` from its mobilities as they are now.
     pub(crate) fn refresh(&mut self) {
         self.inverse = self.inverse_now();
-        self.loose = self.inverse;
     }
 
     /// `1 / W` from its mobilities as they are now (zero for a row no impulse moves).

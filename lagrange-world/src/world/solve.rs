@@ -82,8 +82,10 @@ pub(crate) fn warm_start<T: Real, const N: usize, const B: usize>(
 /// velocities `v` (the bodies' or, for the drift, pseudo-velocities): each tangent within
 /// `friction` times its normal impulse (Coulomb's cone), then each normal row to no less
 /// than its target speed with a push that never pulls (its accumulated impulse stays `>=
-/// 0`). Each update is the program's minimum along it (the program whose minimum the
-/// impulses are), so that with targets `<= 0` (no rebound) the kinetic energy never rises.
+/// 0`). Each plain update (`locking` off, or a row with none locked in it) is the
+/// program's minimum along it (the program whose minimum the impulses are), so that with
+/// targets `<= 0` (no rebound) and plain updates alone the kinetic energy never rises; a
+/// locked update need not be (see `locks`).
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn sweep<T: Real, const N: usize, const B: usize>(
     v: Velocities<'_, T, N>,
@@ -124,7 +126,6 @@ impl<T: Real> Run<'_, T> {
         contacts: &mut [Contact<T, N>],
         locks: &Locks<T, B>,
     ) {
-        let phase = if DRIFT { Phase::Drift } else { Phase::Velocity };
         let frictional = !DRIFT && self.friction > T::zero();
         let push = (T::zero(), T::INFINITY);
         for _ in 0..self.sweeps {
@@ -136,82 +137,72 @@ impl<T: Real> Run<'_, T> {
                     .filter(|c| frictional && c.tangent.inverse > T::zero())
                     .map(|c| self.friction * c.normal.lambda);
                 if let Some(bound) = tangent {
-                    let cone = (-bound, bound);
-                    update(
+                    self.update::<N, B, DRIFT>(
                         v,
                         contacts,
                         locks,
                         i,
                         Part::Tangent,
-                        phase,
-                        cone,
-                        self.locking,
+                        (-bound, bound),
                     );
                 }
-                update(
-                    v,
-                    contacts,
-                    locks,
-                    i,
-                    Part::Normal,
-                    phase,
-                    push,
-                    self.locking,
-                );
+                self.update::<N, B, DRIFT>(v, contacts, locks, i, Part::Normal, push);
             }
         }
     }
-}
 
-/// Row `part` of contact `i` updated to its target speed in `phase`, its impulse within
-/// `bounds`: along its mobility; or where rows are locked in it (see `locks`) and `locking`,
-/// along its locked mobility where that leaves every locked row pushing, else with those
-/// that would pull let go.
-#[allow(clippy::too_many_arguments)]
-#[inline(always)]
-fn update<T: Real, const N: usize, const B: usize>(
-    v: &mut [SVector<T, N>],
-    contacts: &mut [Contact<T, N>],
-    locks: &Locks<T, B>,
-    i: usize,
-    part: Part,
-    phase: Phase,
-    (lo, hi): (T, T),
-    locking: bool,
-) {
-    let Some(c) = contacts.get(i) else {
-        return;
-    };
-    let (bodies, row) = (c.bodies, part.of(c));
-    let residual = speed(v, bodies, row) - phase.target(c, part);
-    let lambda = phase.impulse_of(c, part);
-    let next = if !row.held {
-        let next = (lambda - residual * row.inverse).max(lo).min(hi);
-        apply(v, bodies, &row.b, next - lambda);
-        next
-    } else {
-        let locked = (lambda - residual * row.inverse).max(lo).min(hi);
-        let (next, b, mu) =
-            if locking && locks.allows(contacts, bodies, &row.locks, locked - lambda, phase) {
-                (locked, row.b, row.locks)
-            } else {
-                locks.let_go(
-                    contacts,
-                    bodies,
-                    row,
-                    residual,
-                    lambda,
-                    (lo, hi),
-                    phase,
-                    locking,
-                )
-            };
-        apply(v, bodies, &b, next - lambda);
-        locks.hold(contacts, bodies, &mu, next - lambda, phase);
-        next
-    };
-    if let Some(c) = contacts.get_mut(i) {
-        *phase.impulse(c, part) = next;
+    /// Row `part` of contact `i` updated to its target speed in the phase `DRIFT` says, its
+    /// impulse within `bounds`: along its mobility; or where rows are locked in it (see
+    /// `locks`) and `locking`, along its locked mobility where that leaves every locked row
+    /// pushing, else with those that would pull let go.
+    #[inline(always)]
+    fn update<const N: usize, const B: usize, const DRIFT: bool>(
+        &self,
+        v: &mut [SVector<T, N>],
+        contacts: &mut [Contact<T, N>],
+        locks: &Locks<T, B>,
+        i: usize,
+        part: Part,
+        (lo, hi): (T, T),
+    ) {
+        let (phase, locking) = (
+            if DRIFT { Phase::Drift } else { Phase::Velocity },
+            self.locking,
+        );
+        let Some(c) = contacts.get(i) else {
+            return;
+        };
+        let (bodies, row) = (c.bodies, part.of(c));
+        let residual = speed(v, bodies, row) - phase.target(c, part);
+        let lambda = phase.impulse_of(c, part);
+        let next = if !row.held {
+            let next = (lambda - residual * row.inverse).max(lo).min(hi);
+            apply(v, bodies, &row.b, next - lambda);
+            next
+        } else {
+            let locked = (lambda - residual * row.inverse).max(lo).min(hi);
+            let (next, b, mu) =
+                if locking && locks.allows(contacts, bodies, &row.locks, locked - lambda, phase) {
+                    (locked, row.b, row.locks)
+                } else {
+                    locks.let_go(
+                        contacts,
+                        bodies,
+                        row,
+                        residual,
+                        lambda,
+                        (lo, hi),
+                        phase,
+                        locking,
+                    )
+                };
+            apply(v, bodies, &b, next - lambda);
+            locks.hold(contacts, bodies, &mu, next - lambda, phase);
+            next
+        };
+        if let Some(c) = contacts.get_mut(i) {
+            *phase.impulse(c, part) = next;
+        }
     }
 }
 
