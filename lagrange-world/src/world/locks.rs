@@ -90,7 +90,11 @@ impl<T: Real, const B: usize> Locks<T, B> {
         for _ in 0..bodies.min(B) {
             let _ = self.held.push(Held::new());
         }
-        let Some((shared, own_rows)) = contacts.split_at_mut_checked(own) else {
+        // A world of bodies without own rows (boxes, balls) builds no lists.
+        let Some((shared, own_rows)) = contacts
+            .split_at_mut_checked(own)
+            .filter(|(_, own_rows)| !own_rows.is_empty())
+        else {
             return;
         };
         // Each body's contacts on each side as a list: `first[side][body]`, then
