@@ -1,14 +1,16 @@
 //! [`Workspace`]: the rows of one step (the normal rows' [`Delassus`], the friction
 //! directions, each with its mobility through the mechanism's own mass solve), in storage
-//! kept from step to step; and the rows' checks.
+//! kept from step to step, and taken again by a step whose free step ends where the last
+//! one's did ([`Workspace::reuse`]); and the rows' checks.
 
 use lagrange_core::constraints::contact::{Contacts, Delassus};
 use lagrange_core::nalgebra::{SMatrix, SVector};
 use lagrange_core::{all_finite, Error, Mechanism, Real, State};
 
 /// What a step fills and solves with, kept by the stepper so that a step neither makes nor
-/// clears storage of `C^2` numbers (a ragdoll's is 19 kB in `f64`): nothing in it outlives
-/// the step that filled it.
+/// clears storage of `C^2` numbers (a ragdoll's is 19 kB in `f64`). A step reads what the
+/// last one filled only where [`Workspace::reuse`] finds it filled at the same coordinates
+/// and mass matrix, bit for bit.
 #[derive(Debug, Clone, Copy)]
 pub(super) struct Workspace<T: Real, const N: usize, const C: usize> {
     /// The normal rows of the step (the candidates: in contact, or speculative).
@@ -21,6 +23,29 @@ pub(super) struct Workspace<T: Real, const N: usize, const C: usize> {
     pub(super) tangents: SMatrix<T, C, N>,
     /// The columns handed to the mechanism's mass solve.
     jumps: SMatrix<T, N, C>,
+    /// Where the rows were filled, while they are as filling left them.
+    pub(super) filled: Option<Filled<T, N, C>>,
+}
+
+/// Where a [`Workspace`]'s rows were filled: the free step's coordinates, the mass matrix
+/// there (once a step has met those coordinates again: it is not worked out for steps that
+/// move), whether the gaps came with the Jacobians, the gaps and whether the tangents count.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Filled<T: Real, const N: usize, const C: usize> {
+    pub(super) q: SVector<T, N>,
+    pub(super) mass: Option<SMatrix<T, N, N>>,
+    pub(super) rows_too: bool,
+    pub(super) gaps: SVector<T, C>,
+    pub(super) tangents: bool,
+}
+
+/// What [`Workspace::reuse`] found.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Reuse<T: Real, const N: usize, const C: usize> {
+    /// The rows as filled: their gaps and whether their tangents count.
+    pub(super) rows: Option<(SVector<T, C>, bool)>,
+    /// The mass matrix at the state, where its coordinates were the last fill's.
+    pub(super) mass: Option<SMatrix<T, N, N>>,
 }
 
 impl<T: Real, const N: usize, const C: usize> Workspace<T, N, C> {
@@ -32,7 +57,51 @@ impl<T: Real, const N: usize, const C: usize> Workspace<T, N, C> {
             jacobian: SMatrix::zeros(),
             tangents: SMatrix::zeros(),
             jumps: SMatrix::zeros(),
+            filled: None,
         }
+    }
+
+    /// The rows filled at the free state `state`, where the last fill was at its coordinates
+    /// and mass matrix, bit for bit, by the same route (`rows_too`, as [`Workspace::gaps`])
+    /// and nothing has joined the rows since: the gaps, Jacobians and tangents are functions
+    /// of the coordinates, the mobilities of the mass matrix there (a mechanism at rest
+    /// whose velocities move no coordinate by a unit of its last place finds them again).
+    /// The normal rows keep the factor their last solve left (of the same `W`), so that the
+    /// first pass of a resting step factors none of them. The record is taken: a step that
+    /// fails after this leaves none ([`Workspace::keep`] makes it again).
+    pub(super) fn reuse<M: Mechanism<T, N>>(
+        &mut self,
+        mechanism: &M,
+        state: &State<T, N>,
+        rows_too: bool,
+    ) -> Reuse<T, N, C> {
+        let none = Reuse {
+            rows: None,
+            mass: None,
+        };
+        let Some(f) = self.filled.take() else {
+            return none;
+        };
+        if f.rows_too != rows_too || !same_bits(f.q.as_slice(), state.q.as_slice()) {
+            return none;
+        }
+        // The same coordinates: the mass matrix tells whether the mobilities are the same
+        // (another mechanism, or one whose mass reads the time, gives another).
+        let mass = mechanism.mass_matrix(state);
+        let same = f
+            .mass
+            .is_some_and(|m| same_bits(m.as_slice(), mass.as_slice()));
+        Reuse {
+            rows: same.then_some((f.gaps, f.tangents)),
+            mass: Some(mass),
+        }
+    }
+
+    /// Records that the rows were filled at `filled`, when the normal rows are still the
+    /// `touching` ones filled (none joined since: speculative rows and the drift's add to
+    /// them).
+    pub(super) fn keep(&mut self, filled: Filled<T, N, C>, touching: &[bool; C]) {
+        self.filled = (self.normal.candidates() == touching).then_some(filled);
     }
 
     /// The rows of `contacts` at `q` into [`Workspace::jacobian`] and
@@ -257,6 +326,15 @@ fn finite_rows<T: Real, const N: usize, const C: usize>(
         Some(row) => Err(Error::NonFiniteRow { row }),
         None => Ok(()),
     }
+}
+
+/// Whether `a` and `b` hold the same numbers bit for bit (zero's sign too).
+fn same_bits<T: Real>(a: &[T], b: &[T]) -> bool {
+    // Widened to f64, which keeps every f32 apart.
+    a.len() == b.len()
+        && a.iter()
+            .zip(b)
+            .all(|(x, y)| x.to_f64().to_bits() == y.to_f64().to_bits())
 }
 
 /// `gaps` when every gap is finite, else [`Error::NonFiniteRow`] naming the first that is not.

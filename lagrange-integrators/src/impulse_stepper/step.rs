@@ -4,7 +4,7 @@
 
 use super::energy::guard;
 use super::report::ImpulseReport;
-use super::rows::{finite_gaps, Workspace};
+use super::rows::{finite_gaps, Filled, Workspace};
 use super::settings::ImpulseSettings;
 use super::solve::{Impulses, Problem, Solved};
 use crate::integrator::continues;
@@ -221,8 +221,14 @@ impl<T: Real, const C: usize, K> Setup<T, C, K> {
         };
         memory.dt = Some(dt);
         // After a step with rows in contact, the gaps and the rows at once (one pose of a
-        // ragdoll); in flight, the gaps alone.
-        let (gaps, given) = work.gaps(&self.contacts, &free.q, memory.report.rows > 0)?;
+        // ragdoll); in flight, the gaps alone. Where the free step ended where the last
+        // one's did, the rows it filled (a mechanism at rest).
+        let rows_too = memory.report.rows > 0;
+        let reuse = work.reuse(mechanism, &free, rows_too);
+        let (gaps, given) = match reuse.rows {
+            Some((gaps, _)) => (gaps, None),
+            None => work.gaps(&self.contacts, &free.q, rows_too)?,
+        };
         let touching: [bool; C] =
             core::array::from_fn(|i| self.bilateral[i] || gaps[i] <= T::zero());
         let in_contact = touching.iter().filter(|&&t| t).count();
@@ -244,11 +250,14 @@ impl<T: Real, const C: usize, K> Setup<T, C, K> {
         }
         let frictional: [bool; C] = core::array::from_fn(|i| touching[i] && !self.bilateral[i]);
         let friction = self.model.friction() > T::zero();
-        let tangents = match given {
-            Some(tangents) => work.checked(tangents && friction, &frictional)?,
-            None => work.jacobians(&self.contacts, &free.q, friction, &frictional)?,
+        let tangents = match (reuse.rows, given) {
+            (Some((_, tangents)), _) => tangents,
+            (None, Some(tangents)) => work.checked(tangents && friction, &frictional)?,
+            (None, None) => work.jacobians(&self.contacts, &free.q, friction, &frictional)?,
         };
-        work.fill(mechanism, &free, tangents, &touching, &frictional)?;
+        if reuse.rows.is_none() {
+            work.fill(mechanism, &free, tangents, &touching, &frictional)?;
+        }
         let Workspace {
             normal,
             tangent,
@@ -350,6 +359,14 @@ impl<T: Real, const C: usize, K> Setup<T, C, K> {
         let pushed =
             core::array::from_fn(|i| self.bilateral[i] || solved.impulses.normal[i] > T::zero());
         memory.record(solved.impulses, end, energy, pushed, report);
+        let filled = Filled {
+            q: free.q,
+            mass: reuse.mass,
+            rows_too,
+            gaps,
+            tangents,
+        };
+        work.keep(filled, &touching);
         Ok(end)
     }
 }
