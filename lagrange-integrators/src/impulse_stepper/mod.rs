@@ -78,8 +78,9 @@ use step::{Memory, Setup};
 ///   do not end, a degenerate set that cycles, 4 C sweeps of projected Gauss-Seidel over the
 ///   R rows instead, Delassus::relaxed), then sweeps of the F tangents until one changes
 ///   nothing, at most K
-/// at most 3 exact solves of the R rows for the drift; 1 position_residual after it, and at
-///   most 3 more exact solves and position_residuals on the gaps it left (1 more
+/// at most 3 exact solves of the R rows for the drift; 1 position_residual after it (none
+///   where the coordinates it reached are those the last step's reached, bit for bit), and
+///   at most 3 more exact solves and position_residuals on the gaps it left (1 more
 ///   position_residual where the coordinates stay the start's)
 /// 1 evaluation of T + V (2 after a flight); where the end would pass the start's, the
 ///   forces' power and dL/dt (one dual evaluation of L) at two states, 1 to 2 more of T + V
@@ -409,8 +410,9 @@ mod tests {
         State::new(T::zero(), q, qd)
     }
 
-    /// The thrown ragdoll for 6 s at 1/240 s, stepped by a stepper that takes its rows again
-    /// where it may and by one made to fill them every step: the same bits at every step
+    /// The thrown ragdoll for 6 s at 1/240 s, stepped by a stepper that takes its rows (and
+    /// the gaps where a step ends) again where it may and by one made to fill and measure
+    /// them every step: the same bits at every step
     /// (the rows are the same numbers; the factor kept from the last solve holds them in the
     /// order they joined, which for a resting doll is the order a fresh solve takes), and
     /// the rows taken again in most of the resting steps (the throw rests from about
@@ -431,7 +433,7 @@ mod tests {
         for step in 0..1440 {
             let before = reusing.work.filled;
             a = reusing.step(&doll, &a, dt)?;
-            filling.work.filled = None;
+            filling.work.forget();
             b = filling.step(&doll, &b, dt)?;
             let same = |x: &SVector<T, N>, y: &SVector<T, N>| {
                 x.iter()

@@ -25,6 +25,39 @@ pub(super) struct Workspace<T: Real, const N: usize, const C: usize> {
     jumps: SMatrix<T, N, C>,
     /// Where the rows were filled, while they are as filling left them.
     pub(super) filled: Option<Filled<T, N, C>>,
+    /// The last coordinates a step's end was measured at, and the gaps there (see
+    /// [`Measured::gaps`]).
+    pub(super) ended: Measured<T, N, C>,
+}
+
+/// The gaps of a contact set at the coordinates they were last measured at: a body at rest
+/// ends step after step at the same coordinates, bit for bit, and its gaps there are the
+/// same numbers (a function of the coordinates alone).
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Measured<T: Real, const N: usize, const C: usize> {
+    last: Option<(SVector<T, N>, SVector<T, C>)>,
+}
+
+impl<T: Real, const N: usize, const C: usize> Measured<T, N, C> {
+    /// The finite gaps of `contacts` at `q`: the last measured where `q` is theirs, bit for
+    /// bit, else measured now (and kept).
+    ///
+    /// # Errors
+    /// As [`finite_gaps`].
+    pub(super) fn gaps<K: Contacts<T, N, C>>(
+        &mut self,
+        contacts: &K,
+        q: &SVector<T, N>,
+    ) -> Result<SVector<T, C>, Error> {
+        if let Some((at, gaps)) = self.last {
+            if same_bits(at.as_slice(), q.as_slice()) {
+                return Ok(gaps);
+            }
+        }
+        let gaps = finite_gaps(contacts.position_residual(q))?;
+        self.last = Some((*q, gaps));
+        Ok(gaps)
+    }
 }
 
 /// Where a [`Workspace`]'s rows were filled: the free step's coordinates, the mass matrix
@@ -58,6 +91,7 @@ impl<T: Real, const N: usize, const C: usize> Workspace<T, N, C> {
             tangents: SMatrix::zeros(),
             jumps: SMatrix::zeros(),
             filled: None,
+            ended: Measured { last: None },
         }
     }
 
@@ -95,6 +129,13 @@ impl<T: Real, const N: usize, const C: usize> Workspace<T, N, C> {
             rows: same.then_some((f.gaps, f.tangents)),
             mass: Some(mass),
         }
+    }
+
+    /// Nothing kept from the steps before: the next fills its rows and measures its gaps.
+    #[cfg(test)]
+    pub(super) fn forget(&mut self) {
+        self.filled = None;
+        self.ended.last = None;
     }
 
     /// Records that the rows were filled at `filled`, when the normal rows are still the
@@ -338,9 +379,7 @@ fn same_bits<T: Real>(a: &[T], b: &[T]) -> bool {
 }
 
 /// `gaps` when every gap is finite, else [`Error::NonFiniteRow`] naming the first that is not.
-pub(super) fn finite_gaps<T: Real, const C: usize>(
-    gaps: SVector<T, C>,
-) -> Result<SVector<T, C>, Error> {
+fn finite_gaps<T: Real, const C: usize>(gaps: SVector<T, C>) -> Result<SVector<T, C>, Error> {
     if all_finite(gaps.as_slice()) {
         return Ok(gaps);
     }

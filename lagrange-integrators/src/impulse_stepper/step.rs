@@ -4,7 +4,7 @@
 
 use super::energy::guard;
 use super::report::ImpulseReport;
-use super::rows::{finite_gaps, Filled, Workspace};
+use super::rows::{Filled, Measured, Workspace};
 use super::settings::ImpulseSettings;
 use super::solve::{Impulses, Problem, Solved};
 use crate::integrator::continues;
@@ -141,7 +141,7 @@ impl<T: Real, const C: usize, K> Setup<T, C, K> {
     }
 
     /// The coordinates `q` that the drift correction reached, corrected again on their own
-    /// gaps (the same rows and Jacobian: a chord iteration) until no contact is deeper than
+    /// gaps (measured through `ended`; the same rows and Jacobian: a chord iteration) until no contact is deeper than
     /// the slop, at most [`DRIFT_ROUNDS`] times; where one still is, and deeper than at the
     /// start `start`, the start's coordinates (a contact is never left deeper than the slop
     /// by a step that took it there). The coordinates, the rounds taken, and whether they
@@ -153,6 +153,7 @@ impl<T: Real, const C: usize, K> Setup<T, C, K> {
         jacobian: &SMatrix<T, C, N>,
         kinds: &[Row<T>; C],
         mut jump: F,
+        ended: &mut Measured<T, N, C>,
         start: &SVector<T, N>,
         mut q: SVector<T, N>,
     ) -> Result<(SVector<T, N>, u32, bool), Error>
@@ -175,7 +176,7 @@ impl<T: Real, const C: usize, K> Setup<T, C, K> {
             if !q.iter().all(|x| x.is_finite()) {
                 return Err(Error::NonFiniteState);
             }
-            let gaps = finite_gaps(self.contacts.position_residual(&q))?;
+            let gaps = ended.gaps(&self.contacts, &q)?;
             if !(0..C).any(|i| deep(&gaps, &q, i)) {
                 return Ok((q, rounds, false));
             }
@@ -262,6 +263,7 @@ impl<T: Real, const C: usize, K> Setup<T, C, K> {
             normal,
             tangent,
             jacobian,
+            ended,
             ..
         } = work;
         let jacobian = &*jacobian;
@@ -334,8 +336,15 @@ impl<T: Real, const C: usize, K> Setup<T, C, K> {
         let shift = (plastic.velocity - free.qd) * share;
         let (dq, corrected) =
             self.drift(normal, jacobian, jacobian * shift + gaps, &kinds, jump)?;
-        let (q, drift_rounds, held_back) =
-            self.settle(normal, jacobian, &kinds, jump, &s.q, free.q + shift + dq)?;
+        let (q, drift_rounds, held_back) = self.settle(
+            normal,
+            jacobian,
+            &kinds,
+            jump,
+            ended,
+            &s.q,
+            free.q + shift + dq,
+        )?;
         let end = State {
             t: free.t,
             q,
