@@ -445,6 +445,36 @@ fn a_clock_changes_no_bits<T: Real>() -> Result<(), Error> {
     Ok(())
 }
 
+/// A step that fails leaves the world as it was, the impulses it warm-starts the next step
+/// from included: a pyramid of 10 boxes settling for 1 s, asked for a step of 1e300 s (1e30
+/// in f32: its boxes would fly past the largest number, `NonFiniteState`), then stepped on
+/// for 1 s, ends
+/// with the bits of the same pyramid never asked (a world that forgot its last impulses
+/// when a step failed took the next one from none, and its boxes ended elsewhere).
+fn a_failed_step_keeps_the_warm_start<T: Real>() -> Result<(), Error> {
+    let (mut asked, count) = pyramid(stacking::<T>()?, 4, false)?;
+    let (mut never, _) = pyramid(stacking::<T>()?, 4, false)?;
+    let dt = T::from_f64(1.0 / 60.0);
+    for _ in 0..60 {
+        asked.step(dt)?;
+        never.step(dt)?;
+    }
+    assert_eq!(
+        asked.step(T::from_f64(pick::<T>(1e30, 1e300))),
+        Err(Error::NonFiniteState),
+        "a step past the largest number"
+    );
+    for _ in 0..60 {
+        asked.step(dt)?;
+        never.step(dt)?;
+    }
+    for key in 0..count {
+        let (a, b) = (asked.state(key), never.state(key));
+        assert_eq!(a, b, "box {key}");
+    }
+    Ok(())
+}
+
 /// A box dropped onto the floor: one event when it lands (box and floor began touching,
 /// closing at the box's falling speed after the step's gravity, to rounding, with an impulse
 /// that stops at most that momentum), none while it rests, one when it is lifted away. A ray
@@ -780,6 +810,7 @@ for_f32_and_f64!(
     pyramid_falls_asleep_and_wakes,
     the_order_bodies_were_added_in_does_not_matter,
     a_clock_changes_no_bits,
+    a_failed_step_keeps_the_warm_start,
     events_and_queries,
     newtons_cradle,
     refuses_bad_input

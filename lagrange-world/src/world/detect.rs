@@ -2,7 +2,7 @@
 //! rows in the bodies' coordinates; sleeping bodies an awake one touches are woken.
 
 use super::limits::{Limits, MAX_OWN_ROWS};
-use super::places::{self, Place};
+use super::places;
 use super::profile::{Profile, Stopwatch};
 use super::rows::{Contact, Row};
 use super::{World, OWN_ROWS};
@@ -11,17 +11,18 @@ use crate::collide::{collide, half_plane_points};
 use crate::manifold::ContactPoint;
 use crate::vec2::{rotate, sub, Vec2};
 use heapless::Vec;
-use lagrange_core::links::Links;
+use lagrange_core::links::{Links, Pose};
 use lagrange_core::nalgebra::{SMatrix, SVector};
 use lagrange_core::{Error, Mechanism, Real};
 
 /// One side of a contact: a shape's key, the body and link it is on (none: static), and
-/// where it is.
+/// its link's pose (not its whole place: a side is handed to every contact point of a
+/// pair, and a placed polygon is hundreds of bytes to copy).
 #[derive(Debug, Clone, Copy)]
 struct Side<T> {
     key: u32,
     on: Option<(usize, usize)>,
-    place: Place<T>,
+    pose: Pose<T>,
 }
 
 impl<T, M, L, const N: usize, const B: usize, const S: usize, const K: usize>
@@ -49,12 +50,14 @@ where
             woke += woken;
         }
         self.contacts.sort_unstable_by_key(|c| c.key);
+        // Both sorted by key: matched in one walk (a binary search a contact was most of the
+        // matching).
+        let mut kept = self.kept.iter().peekable();
         for c in self.contacts.iter_mut() {
-            if let Ok(i) = self.kept.binary_search_by_key(&c.key, |k| k.key) {
-                if let Some(k) = self.kept.get(i) {
-                    c.normal.lambda = k.normal;
-                    c.tangent.lambda = k.tangent;
-                }
+            while kept.next_if(|k| k.key < c.key).is_some() {}
+            if let Some(k) = kept.next_if(|k| k.key == c.key) {
+                c.normal.lambda = k.normal;
+                c.tangent.lambda = k.tangent;
             }
         }
         profile.narrow += watch.lap();
@@ -105,17 +108,17 @@ where
         profile.broad += watch.lap();
         let mut woken = 0;
         for &(ia, ib) in &pairs {
-            let (Some(a), Some(b)) = (self.side(ia as usize), self.side(ib as usize)) else {
+            let (ia, ib) = (ia as usize, ib as usize);
+            let (Some(pa), Some(pb)) = (self.places.get(ia), self.places.get(ib)) else {
                 continue;
             };
-            let m = collide(
-                &a.place.shape,
-                &b.place.shape,
-                margin + a.place.reach + b.place.reach,
-            );
+            let m = collide(&pa.shape, &pb.shape, margin + pa.reach + pb.reach);
             if m.points().is_empty() {
                 continue;
             }
+            let (Some(a), Some(b)) = (self.side(ia), self.side(ib)) else {
+                continue;
+            };
             let sleeper = [a, b]
                 .iter()
                 .filter_map(|s| s.on)
@@ -138,22 +141,28 @@ where
                     .get(si)
                     .and_then(|s| s.on)
                     .is_some_and(|(i, _)| self.bodies.get(i).is_some_and(|b| !b.asleep));
-                let Some(s) = self.side(si).filter(|_| awake) else {
+                let (Some(place), Some(s)) = (self.places.get(si), self.side(si)) else {
                     continue;
                 };
+                if !awake {
+                    continue;
+                }
                 // Where the step may take it, for a shape that moves: every vertex that may
                 // touch (see `half_plane_points`).
+                let moved;
                 let end = match self.shapes.get(si) {
-                    Some(a) if s.place.reach > T::zero() => a.shape.placed(&s.place.then),
-                    _ => s.place.shape,
+                    Some(a) if place.reach > T::zero() => {
+                        moved = a.shape.placed(&place.then);
+                        &moved
+                    }
+                    _ => &place.shape,
                 };
-                let points =
-                    half_plane_points(&plane, &s.place.shape, &end, margin + s.place.reach);
-                // A half-plane has no shape to place; a static side's place is never read.
+                let points = half_plane_points(&plane, &place.shape, end, margin + place.reach);
+                // A half-plane has no shape to place; a static side's pose is never read.
                 let wall = Side {
                     key,
                     on: None,
-                    place: s.place,
+                    pose: s.pose,
                 };
                 for (_, p) in &points {
                     self.push(wall, s, plane.normal(), p, dt)?;
@@ -174,7 +183,7 @@ where
         Some(Side {
             key: s.key,
             on: s.on,
-            place: *place,
+            pose: place.pose,
         })
     }
 
@@ -289,7 +298,7 @@ where
             else {
                 continue;
             };
-            let pose = side.place.pose;
+            let pose = side.pose;
             let (sin, cos) = pose.angle.sin_cos();
             let local = rotate(sub(p.point, pose.origin), (-sin, cos));
             let j = body.mechanism.point(&body.state.q, link, local).jacobian;

@@ -568,11 +568,11 @@ where
         }
         let mut watch = Stopwatch::start(self.clock);
         let saved: Vec<Body<T, M, L, N>, B> = self.bodies.clone();
-        let kept = self.kept.clone();
         let result = self.advance(dt, &mut watch);
         if result.is_err() {
+            // The impulses kept for warm starting are still the last step's: a failed step
+            // keeps them only when it ends.
             self.bodies = saved;
-            self.kept = kept;
             self.contacts.clear();
         }
         result
@@ -580,15 +580,6 @@ where
 
     /// The step, unchecked, its parts timed by `watch`.
     fn advance(&mut self, dt: T, watch: &mut Stopwatch) -> Result<WorldReport, Error> {
-        self.kept.clear();
-        for c in &self.contacts {
-            // Capacity K holds every contact of the last step.
-            let _ = self.kept.push(Kept {
-                key: c.key,
-                normal: c.normal.lambda,
-                tangent: c.tangent.lambda,
-            });
-        }
         let mut report = WorldReport::default();
         for body in self.bodies.iter_mut().filter(|b| !b.asleep) {
             body.free(dt)?;
@@ -640,6 +631,7 @@ where
         report.islands = self.sleep(dt);
         report.asleep = count(self.bodies.iter().filter(|b| b.asleep).count());
         self.record_events();
+        self.keep_impulses();
         profile.sleep = watch.lap();
         report.profile = profile;
         self.report = report;
@@ -746,6 +738,20 @@ where
         count
     }
 
+    /// The step's impulses, kept for the next step's warm start (the last step's until
+    /// now: the step that ends here matched its contacts with them).
+    fn keep_impulses(&mut self) {
+        self.kept.clear();
+        for c in &self.contacts {
+            // Capacity K holds every contact of the step.
+            let _ = self.kept.push(Kept {
+                key: c.key,
+                normal: c.normal.lambda,
+                tangent: c.tangent.lambda,
+            });
+        }
+    }
+
     /// The events of the step: pairs that pushed now and not before, or before and not now.
     fn record_events(&mut self) {
         self.events.clear();
@@ -782,13 +788,13 @@ where
         {
             let _ = self.events.push(*e);
         }
-        // A pair of a sleeping body is not solved, and still touches.
-        let mut still = self.touching.clone();
-        still.retain(|&(a, b)| self.sleeping_shape(a) || self.sleeping_shape(b));
+        // A pair of a sleeping body is not solved, and still touches. (In place: a copy of
+        // the pairs is the world's capacity for them, whatever the pairs.)
+        let (shapes, bodies) = (&self.shapes, &self.bodies);
+        let asleep =
+            |(a, b): (u32, u32)| sleeping(shapes, bodies, a) || sleeping(shapes, bodies, b);
         for &pair in &self.touching {
-            if now.binary_search_by_key(&pair, |e| e.shapes).is_err()
-                && still.binary_search(&pair).is_err()
-            {
+            if now.binary_search_by_key(&pair, |e| e.shapes).is_err() && !asleep(pair) {
                 let _ = self.events.push(ContactEvent {
                     shapes: pair,
                     began: false,
@@ -800,19 +806,11 @@ where
             }
         }
         self.events.sort_unstable_by_key(|e| e.shapes);
-        self.touching = still;
+        self.touching.retain(|&pair| asleep(pair));
         for e in &now {
             let _ = self.touching.push(e.shapes);
         }
         self.touching.sort_unstable();
-    }
-
-    /// Whether shape `key` is on a sleeping body.
-    fn sleeping_shape(&self, key: u32) -> bool {
-        self.shape(key)
-            .and_then(|i| self.shapes.get(i))
-            .and_then(|s| s.on)
-            .is_some_and(|(i, _)| self.bodies.get(i).is_some_and(|b| b.asleep))
     }
 
     /// The index of body `key`.
@@ -905,6 +903,20 @@ fn sweep<T: Real, const N: usize, const B: usize, const K: usize>(
 fn own_last<const K: usize>(order: &Order<K>, sweeps: u32, mut pass: impl FnMut(&[u32], u32)) {
     pass(&order.all, sweeps);
     pass(&order.own, OWN_SWEEPS * sweeps);
+}
+
+/// Whether shape `key` of `shapes` (sorted by key) is on a sleeping body of `bodies`.
+fn sleeping<T: Real, M, L, const N: usize>(
+    shapes: &[Attached<T>],
+    bodies: &[Body<T, M, L, N>],
+    key: u32,
+) -> bool {
+    shapes
+        .binary_search_by_key(&key, |s| s.key)
+        .ok()
+        .and_then(|i| shapes.get(i))
+        .and_then(|s| s.on)
+        .is_some_and(|(i, _)| bodies.get(i).is_some_and(|b| b.asleep))
 }
 
 /// A count as the report's `u32`.
