@@ -444,7 +444,7 @@ mod tests {
             assert_eq!(reusing.impulses(), filling.impulses(), "step {step}");
             let after = reusing.work.filled;
             if let (Some(x), Some(y)) = (before, after) {
-                if x.mass.is_some() && same(&x.q, &y.q) {
+                if x.mass_known && same(&x.q, &y.q) {
                     taken_again += 1;
                 }
             }
@@ -492,7 +492,7 @@ mod tests {
             s = stepper.step(&light, &s, dt)?;
         }
         // At rest, its rows taken again.
-        assert!(stepper.work.filled.is_some_and(|f| f.mass.is_some()));
+        assert!(stepper.work.filled.is_some_and(|f| f.mass_known));
         let weight = |m: f64| m * 9.81 * dt;
         assert!((stepper.impulses().0[0] - weight(1.0)).abs() < 1e-12);
         stepper.step(&heavy, &s, dt)?;

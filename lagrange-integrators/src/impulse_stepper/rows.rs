@@ -25,6 +25,9 @@ pub(super) struct Workspace<T: Real, const N: usize, const C: usize> {
     jumps: SMatrix<T, N, C>,
     /// Where the rows were filled, while they are as filling left them.
     pub(super) filled: Option<Filled<T, N, C>>,
+    /// The mass matrix where they were filled, where [`Filled::mass_known`] says (written
+    /// only by a step that met the coordinates of the last fill: not by steps that move).
+    mass: SMatrix<T, N, N>,
     /// The last coordinates a step's end was measured at, and the gaps there (see
     /// [`Measured::gaps`]).
     pub(super) ended: Measured<T, N, C>,
@@ -60,13 +63,14 @@ impl<T: Real, const N: usize, const C: usize> Measured<T, N, C> {
     }
 }
 
-/// Where a [`Workspace`]'s rows were filled: the free step's coordinates, the mass matrix
-/// there (once a step has met those coordinates again: it is not worked out for steps that
-/// move), whether the gaps came with the Jacobians, the gaps and whether the tangents count.
+/// Where a [`Workspace`]'s rows were filled: the free step's coordinates, whether the
+/// workspace holds the mass matrix there (once a step has met those coordinates again: it
+/// is not worked out for steps that move), whether the gaps came with the Jacobians, the
+/// gaps and whether the tangents count.
 #[derive(Debug, Clone, Copy)]
 pub(super) struct Filled<T: Real, const N: usize, const C: usize> {
     pub(super) q: SVector<T, N>,
-    pub(super) mass: Option<SMatrix<T, N, N>>,
+    pub(super) mass_known: bool,
     pub(super) rows_too: bool,
     pub(super) gaps: SVector<T, C>,
     pub(super) tangents: bool,
@@ -77,8 +81,9 @@ pub(super) struct Filled<T: Real, const N: usize, const C: usize> {
 pub(super) struct Reuse<T: Real, const N: usize, const C: usize> {
     /// The rows as filled: their gaps and whether their tangents count.
     pub(super) rows: Option<(SVector<T, C>, bool)>,
-    /// The mass matrix at the state, where its coordinates were the last fill's.
-    pub(super) mass: Option<SMatrix<T, N, N>>,
+    /// Whether the workspace holds the mass matrix at the state (its coordinates were the
+    /// last fill's).
+    pub(super) mass_known: bool,
 }
 
 impl<T: Real, const N: usize, const C: usize> Workspace<T, N, C> {
@@ -91,6 +96,7 @@ impl<T: Real, const N: usize, const C: usize> Workspace<T, N, C> {
             tangents: SMatrix::zeros(),
             jumps: SMatrix::zeros(),
             filled: None,
+            mass: SMatrix::zeros(),
             ended: Measured { last: None },
         }
     }
@@ -111,7 +117,7 @@ impl<T: Real, const N: usize, const C: usize> Workspace<T, N, C> {
     ) -> Reuse<T, N, C> {
         let none = Reuse {
             rows: None,
-            mass: None,
+            mass_known: false,
         };
         let Some(f) = self.filled.take() else {
             return none;
@@ -122,12 +128,13 @@ impl<T: Real, const N: usize, const C: usize> Workspace<T, N, C> {
         // The same coordinates: the mass matrix tells whether the mobilities are the same
         // (another mechanism, or one whose mass reads the time, gives another).
         let mass = mechanism.mass_matrix(state);
-        let same = f
-            .mass
-            .is_some_and(|m| same_bits(m.as_slice(), mass.as_slice()));
+        let same = f.mass_known && same_bits(self.mass.as_slice(), mass.as_slice());
+        if !same {
+            self.mass = mass;
+        }
         Reuse {
             rows: same.then_some((f.gaps, f.tangents)),
-            mass: Some(mass),
+            mass_known: true,
         }
     }
 

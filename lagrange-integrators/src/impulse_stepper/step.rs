@@ -370,7 +370,7 @@ impl<T: Real, const C: usize, K> Setup<T, C, K> {
         memory.record(solved.impulses, end, energy, pushed, report);
         let filled = Filled {
             q: free.q,
-            mass: reuse.mass,
+            mass_known: reuse.mass_known,
             rows_too,
             gaps,
             tangents,
