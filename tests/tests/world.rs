@@ -527,6 +527,36 @@ fn events_and_queries<T: Real>() -> Result<(), Error> {
     Ok(())
 }
 
+/// A box that falls asleep on the floor still touches it: one event when it lands, none when
+/// it falls asleep or while it sleeps (another box, falling from 1 km up far away, keeps the
+/// world awake), and the pair ends when the box is lifted off.
+fn a_sleeping_box_still_touches_the_floor<T: Real>() -> Result<(), Error> {
+    let settings = stacking::<T>()?.with_sleep(T::from_f64(0.05), T::HALF)?;
+    let mut world = Box::new(Bodies::<T>::new(settings));
+    world.add_plane(7, HalfPlane::floor())?;
+    let body = RigidBody::rectangle(T::one(), T::one(), T::one(), T::from_f64(G))?;
+    for (key, [x, y]) in [(1, [0.0, 1.5]), (2, [50.0, 1000.0])] {
+        let q = [x, y, 0.0].map(T::from_f64);
+        world.add_body(key, body, State::new(T::zero(), q, [T::zero(); 3]))?;
+        world.add_shape(19 + key, key, 0, Shape::rectangle(T::one(), T::one())?)?;
+    }
+    let mut events = std::vec::Vec::new();
+    for k in 0..240 {
+        world.step(T::from_f64(1.0 / 60.0))?;
+        events.extend(world.events().iter().map(|e| (k, e.shapes, e.began)));
+    }
+    assert_eq!(world.asleep(1), Some(true));
+    assert_eq!(world.asleep(2), Some(false));
+    assert_eq!(events.len(), 1, "{events:?}");
+    assert_eq!((events[0].1, events[0].2), ((7, 20), true), "{events:?}");
+    let lifted = State::new(T::zero(), [0.0, 3.0, 0.0].map(T::from_f64), [T::zero(); 3]);
+    world.set_state(1, lifted)?;
+    world.step(T::from_f64(1.0 / 60.0))?;
+    let ended: std::vec::Vec<_> = world.events().iter().map(|e| (e.shapes, e.began)).collect();
+    assert_eq!(ended, [((7, 20), false)]);
+    Ok(())
+}
+
 /// A Newton's cradle: five 1 kg pendulums of 1 m, their pivots `0.2 + gap` apart, balls of
 /// radius 0.1 m at the rods' ends, restitution 1, 240 Hz; the first released from -0.5 rad.
 /// The rates of the five at each step; the largest rise over a step of the kinetic energy
@@ -812,6 +842,7 @@ for_f32_and_f64!(
     a_clock_changes_no_bits,
     a_failed_step_keeps_the_warm_start,
     events_and_queries,
+    a_sleeping_box_still_touches_the_floor,
     newtons_cradle,
     refuses_bad_input
 );

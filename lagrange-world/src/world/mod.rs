@@ -812,7 +812,9 @@ where
             }
         }
         self.events.sort_unstable_by_key(|e| e.shapes);
-        self.touching.retain(|&pair| asleep(pair));
+        // A pair that pushed in the step its body fell asleep in is among both: kept once.
+        self.touching
+            .retain(|&pair| asleep(pair) && now.binary_search_by_key(&pair, |e| e.shapes).is_err());
         for e in &now {
             let _ = self.touching.push(e.shapes);
         }
