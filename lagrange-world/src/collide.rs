@@ -158,39 +158,38 @@ pub fn collide_half_plane<T: Real>(
     shape: &Shape<T>,
     margin: T,
 ) -> Manifold<T> {
-    let mut deepest: [Option<&(T, ContactPoint<T>)>; 2] = [None, None];
-    let points = half_plane_points(plane, shape, shape, margin);
+    let mut deepest: [Option<&ContactPoint<T>>; 2] = [None, None];
+    let points = half_plane_points(plane, shape, margin);
     for p in &points {
-        if deepest[0].is_none_or(|d| p.0 < d.0) {
+        if deepest[0].is_none_or(|d| p.gap < d.gap) {
             deepest = [Some(p), deepest[0]];
-        } else if deepest[1].is_none_or(|d| p.0 < d.0) {
+        } else if deepest[1].is_none_or(|d| p.gap < d.gap) {
             deepest[1] = Some(p);
         }
     }
     let mut m = Manifold::along(plane.normal);
-    for (_, p) in deepest.into_iter().flatten() {
+    for p in deepest.into_iter().flatten() {
         m.push(*p);
     }
     m
 }
 
 /// Every vertex of `shape`'s core within `margin` of the half-plane `plane` as a contact
-/// point (its id the vertex, its gap and point at the start; see [`collide_half_plane`]),
-/// each with how deep it comes at either end of a move to `end` (the same shape placed
-/// where the step may take it). A world keeps them all, not the two deepest: a shape turning
-/// fast brings a vertex that is not among the deepest at the start into the plane (a plank
-/// spun about one end sweeps its far corner 20 cm down in a step), and the impulses may turn
-/// it the other way than its velocities at the start (a box struck on a corner).
+/// point (its id the vertex, its gap and point at the start; see [`collide_half_plane`]). A
+/// world keeps them all, within the margin and how far the shape may move, not the two
+/// deepest: a shape turning fast brings a vertex that is not among the deepest at the start
+/// into the plane (a plank spun about one end sweeps its far corner 20 cm down in a step),
+/// and the impulses may turn it the other way than its velocities at the start (a box struck
+/// on a corner).
 pub(crate) fn half_plane_points<T: Real>(
     plane: &HalfPlane<T>,
     shape: &Shape<T>,
-    end: &Shape<T>,
     margin: T,
-) -> heapless::Vec<(T, ContactPoint<T>), MAX_VERTICES> {
+) -> heapless::Vec<ContactPoint<T>, MAX_VERTICES> {
     let n = plane.normal;
     let gap_of = |v: Vec2<T>| dot(v, n) - plane.offset - shape.radius();
     let mut points = heapless::Vec::new();
-    for (i, (&v, &w)) in shape.vertices().iter().zip(end.vertices()).enumerate() {
+    for (i, &v) in shape.vertices().iter().enumerate() {
         let gap = gap_of(v);
         if gap > margin {
             continue;
@@ -203,7 +202,7 @@ pub(crate) fn half_plane_points<T: Real>(
             id: u32::try_from(i).unwrap_or(0),
         };
         // A core has at most MAX_VERTICES vertices.
-        let _ = points.push((gap.min(gap_of(w)), point));
+        let _ = points.push(point);
     }
     points
 }

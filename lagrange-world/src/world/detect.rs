@@ -147,24 +147,15 @@ where
                 if !awake {
                     continue;
                 }
-                // Where the step may take it, for a shape that moves: every vertex that may
-                // touch (see `half_plane_points`).
-                let moved;
-                let end = match self.shapes.get(si) {
-                    Some(a) if place.reach > T::zero() => {
-                        moved = a.shape.placed(&place.then);
-                        &moved
-                    }
-                    _ => &place.shape,
-                };
-                let points = half_plane_points(&plane, &place.shape, end, margin + place.reach);
+                // Every vertex that may touch in the step (see `half_plane_points`).
+                let points = half_plane_points(&plane, &place.shape, margin + place.reach);
                 // A half-plane has no shape to place; a static side's pose is never read.
                 let wall = Side {
                     key,
                     on: None,
                     pose: s.pose,
                 };
-                for (_, p) in &points {
+                for p in &points {
                     self.push(wall, s, plane.normal(), p, dt)?;
                 }
             }

@@ -19,9 +19,6 @@ pub(crate) struct Place<T> {
     pub(crate) shape: Shape<T>,
     /// Its link's pose (the world's frame for a static shape).
     pub(crate) pose: Pose<T>,
-    /// Its link's pose where its body's velocities take it in the step (`pose` where it
-    /// does not move).
-    pub(crate) then: Pose<T>,
     /// How far any point of it moves in the step at its body's velocity (zero for a static
     /// or sleeping one): its link's origin's move and its turn times its reach from that
     /// origin.
@@ -57,7 +54,6 @@ pub(crate) fn place<T, M, L, const N: usize, const B: usize, const S: usize>(
         let _ = places.push(Place {
             shape: s.shape,
             pose: identity(),
-            then: identity(),
             reach: T::zero(),
         });
     }
@@ -99,7 +95,6 @@ pub(crate) fn place<T, M, L, const N: usize, const B: usize, const S: usize>(
             *place = Place {
                 shape: s.shape.placed(&pose),
                 pose,
-                then,
                 reach,
             };
         }
