@@ -78,7 +78,7 @@ pub(super) struct Filled<T: Real, const N: usize, const C: usize> {
 
 /// What [`Workspace::reuse`] found.
 #[derive(Debug, Clone, Copy)]
-pub(super) struct Reuse<T: Real, const N: usize, const C: usize> {
+pub(super) struct Reuse<T: Real, const C: usize> {
     /// The rows as filled: their gaps and whether their tangents count.
     pub(super) rows: Option<(SVector<T, C>, bool)>,
     /// Whether the workspace holds the mass matrix at the state (its coordinates were the
@@ -114,7 +114,7 @@ impl<T: Real, const N: usize, const C: usize> Workspace<T, N, C> {
         mechanism: &M,
         state: &State<T, N>,
         rows_too: bool,
-    ) -> Reuse<T, N, C> {
+    ) -> Reuse<T, C> {
         let none = Reuse {
             rows: None,
             mass_known: false,
