@@ -31,6 +31,9 @@ pub(super) struct Workspace<T: Real, const N: usize, const C: usize> {
     /// The last coordinates a step's end was measured at, and the gaps there (see
     /// [`Measured::gaps`]).
     pub(super) ended: Measured<T, N, C>,
+    /// The steps that took the rows again (what the tests count).
+    #[cfg(test)]
+    pub(super) reused: u32,
 }
 
 /// The gaps of a contact set at the coordinates they were last measured at: a body at rest
@@ -98,6 +101,8 @@ impl<T: Real, const N: usize, const C: usize> Workspace<T, N, C> {
             filled: None,
             mass: SMatrix::zeros(),
             ended: Measured { last: None },
+            #[cfg(test)]
+            reused: 0,
         }
     }
 
@@ -131,6 +136,10 @@ impl<T: Real, const N: usize, const C: usize> Workspace<T, N, C> {
         let same = f.mass_known && same_bits(self.mass.as_slice(), mass.as_slice());
         if !same {
             self.mass = mass;
+        }
+        #[cfg(test)]
+        {
+            self.reused += u32::from(same);
         }
         Reuse {
             rows: same.then_some((f.gaps, f.tangents)),

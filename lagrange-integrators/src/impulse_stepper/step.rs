@@ -141,11 +141,11 @@ impl<T: Real, const C: usize, K> Setup<T, C, K> {
     }
 
     /// The coordinates `q` that the drift correction reached, corrected again on their own
-    /// gaps (measured through `ended`; the same rows and Jacobian: a chord iteration) until no contact is deeper than
-    /// the slop, at most [`DRIFT_ROUNDS`] times; where one still is, and deeper than at the
-    /// start `start`, the start's coordinates (a contact is never left deeper than the slop
-    /// by a step that took it there). The coordinates, the rounds taken, and whether they
-    /// are the start's.
+    /// gaps (measured through `ended`; the same rows and Jacobian: a chord iteration) until
+    /// no contact is deeper than the slop, at most [`DRIFT_ROUNDS`] times; where one still
+    /// is, and deeper than at the start `start`, the start's coordinates (a contact is never
+    /// left deeper than the slop by a step that took it there). The coordinates, the rounds
+    /// taken, and whether they are the start's.
     #[allow(clippy::too_many_arguments)]
     fn settle<const N: usize, F>(
         &self,
