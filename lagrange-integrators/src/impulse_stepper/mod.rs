@@ -87,12 +87,14 @@ use step::{Memory, Setup};
 ///   and at most 4 of V
 /// ```
 ///
-/// A step whose free step ends at the coordinates the last one's filled its rows at, bit
-/// for bit, with the same mass matrix there, takes those rows as they are (gaps, Jacobians,
-/// tangents, mobilities, `W`): 1 `mass_matrix` in place of the `position_residual`,
-/// `jacobians` and `velocity_jumps` above. A body at rest is such a step most of the time
-/// (its velocities move its coordinates by less than a unit of their last place); the
-/// first step back at a place pays the `mass_matrix` and the rows both.
+/// A step whose free step ends at the coordinates the last one's filled its rows at, to
+/// within a unit of the last place of the largest coordinate (or of 1), with the same mass
+/// matrix there, bit for bit, takes those rows as they are (gaps, Jacobians, tangents,
+/// mobilities, `W`): 1 `mass_matrix` in place of the `position_residual`, `jacobians` and
+/// `velocity_jumps` above. The rows it takes are those of its coordinates to the rounding
+/// they are worked out with; a body at rest is such a step (its velocities are the
+/// rounding of the last solve); the first step back at a place pays the `mass_matrix` and
+/// the rows both.
 ///
 /// The stepper keeps the storage of its rows from step to step (about `2 C^2 + 5 C N + N^2`
 /// numbers: 16 kB for the ragdoll's 31 rows in `f32`), so that a step neither makes nor
@@ -412,14 +414,14 @@ mod tests {
 
     /// The thrown ragdoll for 6 s at 1/240 s, stepped by a stepper that takes its rows (and
     /// the gaps where a step ends) again where it may and by one made to fill and measure
-    /// them every step: the same bits at every step
-    /// (the rows are the same numbers; the factor kept from the last solve holds them in the
-    /// order they joined, which for a resting doll is the order a fresh solve takes), and
-    /// the rows taken again in most of the resting steps (the throw rests from about
-    /// step 480 of 1,440; a resting doll's velocities, 1e-7 in f32 and zero in f64, move few
-    /// coordinates by a unit of their last place: measured, 673 steps took them again in f32
-    /// and 851 in f64).
-    fn reused_rows_change_no_bit<T: Real>() -> Result<(), Error> {
+    /// them every step: the same states to rounding at every step, and the rows taken again
+    /// in most of the resting steps (the throw rests from about step 480 of 1,440; measured,
+    /// 960 steps took them again in f32 and 947 in f64). Rows taken again are those of
+    /// coordinates within a unit of the last place of the largest coordinate; the states
+    /// then differ by what that moves through a solve: measured, 2.4 such units in the
+    /// coordinates and 11 in the velocities at most (of 1, or of the largest, whichever is
+    /// larger), bounded here at 16 and 64.
+    fn reused_rows_change_only_rounding<T: Real>() -> Result<(), Error> {
         let doll = Ragdoll::new(RagdollBody::<T>::adult())?;
         let contacts = RagdollContacts::adult(&doll, T::zero())?;
         let model = ContactModel::new(T::from_f64(0.3), T::from_f64(0.3), T::from_f64(1e-7))?
@@ -429,17 +431,22 @@ mod tests {
         let mut filling = reusing;
         let (mut a, mut b) = (thrown::<T>(), thrown::<T>());
         let dt = T::from_f64(1.0 / 240.0);
+        // The distance of two states' coordinates or velocities in units of the last place
+        // of 1 or of the largest of the first, whichever is larger.
+        let apart = |x: &SVector<T, N>, y: &SVector<T, N>| {
+            let scale = x.iter().fold(1.0_f64, |m, v| m.max(v.to_f64().abs()));
+            let most = x
+                .iter()
+                .zip(y.iter())
+                .fold(0.0_f64, |m, (a, b)| m.max((a.to_f64() - b.to_f64()).abs()));
+            most / (T::EPSILON.to_f64() * scale)
+        };
         for step in 0..1440 {
             a = reusing.step(&doll, &a, dt)?;
             filling.work.forget();
             b = filling.step(&doll, &b, dt)?;
-            let same = |x: &SVector<T, N>, y: &SVector<T, N>| {
-                x.iter()
-                    .zip(y.iter())
-                    .all(|(x, y)| x.to_f64().to_bits() == y.to_f64().to_bits())
-            };
-            assert!(same(&a.q, &b.q) && same(&a.qd, &b.qd), "step {step}");
-            assert_eq!(reusing.impulses(), filling.impulses(), "step {step}");
+            let (dq, dv) = (apart(&a.q, &b.q), apart(&a.qd, &b.qd));
+            assert!(dq <= 16.0 && dv <= 64.0, "step {step}: {dq}, {dv}");
         }
         let taken_again = reusing.work.reused;
         assert!(taken_again >= 600, "{taken_again}");
@@ -448,13 +455,13 @@ mod tests {
     }
 
     #[test]
-    fn reused_rows_change_no_bit_f32() -> Result<(), Error> {
-        reused_rows_change_no_bit::<f32>()
+    fn reused_rows_change_only_rounding_f32() -> Result<(), Error> {
+        reused_rows_change_only_rounding::<f32>()
     }
 
     #[test]
-    fn reused_rows_change_no_bit_f64() -> Result<(), Error> {
-        reused_rows_change_no_bit::<f64>()
+    fn reused_rows_change_only_rounding_f64() -> Result<(), Error> {
+        reused_rows_change_only_rounding::<f64>()
     }
 
     /// The ground at y = 0.

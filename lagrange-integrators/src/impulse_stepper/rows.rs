@@ -1,7 +1,7 @@
 //! [`Workspace`]: the rows of one step (the normal rows' [`Delassus`], the friction
 //! directions, each with its mobility through the mechanism's own mass solve), in storage
 //! kept from step to step, and taken again by a step whose free step ends where the last
-//! one's did ([`Workspace::reuse`]); and the rows' checks.
+//! fill's did, to rounding ([`Workspace::reuse`]); and the rows' checks.
 
 use lagrange_core::constraints::contact::{Contacts, Delassus};
 use lagrange_core::nalgebra::{SMatrix, SVector};
@@ -10,7 +10,7 @@ use lagrange_core::{all_finite, Error, Mechanism, Real, State};
 /// What a step fills and solves with, kept by the stepper so that a step neither makes nor
 /// clears storage of `C^2` numbers (a ragdoll's is 19 kB in `f64`). A step reads what the
 /// last one filled only where [`Workspace::reuse`] finds it filled at the same coordinates
-/// and mass matrix, bit for bit.
+/// (to their rounding) and mass matrix (bit for bit).
 #[derive(Debug, Clone, Copy)]
 pub(super) struct Workspace<T: Real, const N: usize, const C: usize> {
     /// The normal rows of the step (the candidates: in contact, or speculative).
@@ -81,12 +81,15 @@ pub(super) struct Filled<T: Real, const N: usize, const C: usize> {
 
 /// What [`Workspace::reuse`] found.
 #[derive(Debug, Clone, Copy)]
-pub(super) struct Reuse<T: Real, const C: usize> {
+pub(super) struct Reuse<T: Real, const N: usize, const C: usize> {
     /// The rows as filled: their gaps and whether their tangents count.
     pub(super) rows: Option<(SVector<T, C>, bool)>,
-    /// Whether the workspace holds the mass matrix at the state (its coordinates were the
-    /// last fill's).
+    /// Whether the workspace holds the mass matrix at `at` (the state came near the last
+    /// fill's coordinates).
     pub(super) mass_known: bool,
+    /// The coordinates of the step's rows: the last fill's where they are taken again, else
+    /// the state's.
+    pub(super) at: SVector<T, N>,
 }
 
 impl<T: Real, const N: usize, const C: usize> Workspace<T, N, C> {
@@ -107,43 +110,57 @@ impl<T: Real, const N: usize, const C: usize> Workspace<T, N, C> {
     }
 
     /// The rows filled at the free state `state`, where the last fill was at its coordinates
-    /// and mass matrix, bit for bit, by the same route (`rows_too`, as [`Workspace::gaps`])
-    /// and nothing has joined the rows since: the gaps, Jacobians and tangents are functions
-    /// of the coordinates, the mobilities of the mass matrix there (a mechanism at rest
-    /// whose velocities move no coordinate by a unit of its last place finds them again).
-    /// The normal rows keep the factor their last solve left (of the same `W`), so that the
-    /// first pass of a resting step factors none of them. The record is taken: a step that
-    /// fails after this leaves none ([`Workspace::keep`] makes it again).
+    /// to their rounding ([`close`]) and with the same mass matrix there, bit for bit, by the
+    /// same route (`rows_too`, as [`Workspace::gaps`]) and nothing has joined the rows since:
+    /// the gaps, Jacobians and tangents are functions of the coordinates, the mobilities of
+    /// the mass matrix there (a mechanism at rest, whose velocities are the rounding of its
+    /// last solve, finds them again). The normal rows keep the factor their last solve left
+    /// (of the same `W`), so that the first pass of a resting step factors none of them. The
+    /// record is taken: a step that fails after this leaves none ([`Workspace::keep`] makes
+    /// it again).
     pub(super) fn reuse<M: Mechanism<T, N>>(
         &mut self,
         mechanism: &M,
         state: &State<T, N>,
         rows_too: bool,
-    ) -> Reuse<T, C> {
+    ) -> Reuse<T, N, C> {
         let none = Reuse {
             rows: None,
             mass_known: false,
+            at: state.q,
         };
         let Some(f) = self.filled.take() else {
             return none;
         };
-        if f.rows_too != rows_too || !same_bits(f.q.as_slice(), state.q.as_slice()) {
+        if f.rows_too != rows_too || !close(&f.q, &state.q) {
             return none;
         }
-        // The same coordinates: the mass matrix tells whether the mobilities are the same
-        // (another mechanism, or one whose mass reads the time, gives another).
-        let mass = mechanism.mass_matrix(state);
+        // Near the fill's coordinates: the mass matrix at them tells whether the mobilities
+        // are the same (another mechanism, or one whose mass reads the time, gives another).
+        let at_fill = State { q: f.q, ..*state };
+        let mass = mechanism.mass_matrix(&at_fill);
         let same = f.mass_known && same_bits(self.mass.as_slice(), mass.as_slice());
-        if !same {
-            self.mass = mass;
-        }
         #[cfg(test)]
         {
             self.reused += u32::from(same);
         }
+        if same {
+            return Reuse {
+                rows: Some((f.gaps, f.tangents)),
+                mass_known: true,
+                at: f.q,
+            };
+        }
+        // Filled again here: the mass matrix kept is this state's.
+        self.mass = if same_bits(f.q.as_slice(), state.q.as_slice()) {
+            mass
+        } else {
+            mechanism.mass_matrix(state)
+        };
         Reuse {
-            rows: same.then_some((f.gaps, f.tangents)),
+            rows: None,
             mass_known: true,
+            at: state.q,
         }
     }
 
@@ -383,6 +400,20 @@ fn finite_rows<T: Real, const N: usize, const C: usize>(
         Some(row) => Err(Error::NonFiniteRow { row }),
         None => Ok(()),
     }
+}
+
+/// Whether the coordinates `b` are the coordinates `a` to their rounding: no coordinate
+/// apart by more than a unit of the last place of the largest of `a` (and of 1: a
+/// coordinate near zero rounds on the others' scale in every sum it meets). The rows at
+/// `b` are those at `a` to the rounding they are worked out with; a mechanism at rest moves
+/// by less, step after step (its velocities are the rounding of the last solve: 1e-15 in
+/// f64 moves a coordinate by 4e-18 at 1/240 s), a mechanism that moves by more.
+fn close<T: Real, const N: usize>(a: &SVector<T, N>, b: &SVector<T, N>) -> bool {
+    let scale = a.iter().fold(T::one(), |m, x| m.max(x.abs()));
+    let allowed = T::EPSILON * scale;
+    a.iter()
+        .zip(b.iter())
+        .all(|(x, y)| (*x - *y).abs() <= allowed)
 }
 
 /// Whether `a` and `b` hold the same numbers bit for bit (zero's sign too).

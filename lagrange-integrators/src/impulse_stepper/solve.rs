@@ -48,6 +48,8 @@ pub(super) struct Solved<T: Real, const N: usize, const C: usize> {
     /// Whether the last friction sweep changed no tangent's speed by more than the tolerance
     /// (always, without friction).
     pub(super) settled: bool,
+    /// The normal rows the last round solved for: the first guess of a solve after it.
+    pub(super) active: [bool; C],
 }
 
 /// The rows of one step's solve.
@@ -60,7 +62,8 @@ pub(super) struct Problem<'a, T: Real, const N: usize, const C: usize> {
     pub(super) tangent: &'a [Option<Direction<T, N>>; C],
     /// The Coulomb coefficient.
     pub(super) friction: T,
-    /// The rows that pushed last: the first guess of each normal solve's active rows.
+    /// The first guess of the normal solve's active rows: the rows that pushed last (in the
+    /// last step; for a solve after a step's plastic one, the rows that solve ended with).
     pub(super) pushed: &'a [bool; C],
 }
 
@@ -173,6 +176,7 @@ impl<T: Real, const N: usize, const C: usize> Problem<'_, T, N, C> {
             velocity,
             rounds: taken,
             settled: settled && exact,
+            active: guess,
         })
     }
 

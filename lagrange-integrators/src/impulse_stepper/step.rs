@@ -282,7 +282,8 @@ impl<T: Real, const C: usize, K> Setup<T, C, K> {
             settings.slop(),
         );
         // The solves after the plastic one (speculative rows, rebounds) start from its
-        // impulses and share the rounds it left, at least one each: a step takes at most
+        // impulses and the rows it ended with (from the last step's, a rebound's solve took
+        // ten passes where the plastic one had found its rows) and share the rounds it left, at least one each: a step takes at most
         // `max_iterations + 3` rounds (ImpulseSettings::max_rounds), where each solve
         // capped on its own took four times as many in the landing steps whose friction
         // does not settle (the rounds shrink its change by a third each).
@@ -294,17 +295,18 @@ impl<T: Real, const C: usize, K> Setup<T, C, K> {
         let solve = |normal: &mut Delassus<T, N, C>,
                      target: &SVector<T, C>,
                      warm: &Impulses<T, C>,
+                     guess: &[bool; C],
                      cap: u32| {
             Problem {
                 normal,
                 kinds: &kinds,
                 tangent,
                 friction,
-                pushed: &guess,
+                pushed: guess,
             }
             .solve(&free.qd, target, warm, cap, rounds, tolerance)
         };
-        let mut plastic = solve(normal, &target, &warm, rounds)?;
+        let mut plastic = solve(normal, &target, &warm, &guess, rounds)?;
         let (mut taken, mut speculative) = (plastic.rounds, 0u32);
         for _ in 0..SPECULATIVE_ROUNDS {
             let reach = jacobian * ((plastic.velocity - free.qd) * share) + gaps;
@@ -318,13 +320,25 @@ impl<T: Real, const C: usize, K> Setup<T, C, K> {
                 target[i] = w[i] - gaps[i] / share;
                 speculative += 1;
             }
-            plastic = solve(normal, &target, &plastic.impulses, left(taken))?;
+            plastic = solve(
+                normal,
+                &target,
+                &plastic.impulses,
+                &plastic.active,
+                left(taken),
+            )?;
             taken += plastic.rounds;
         }
         let rebound = self.rebounds(&gaps, &w);
         let solved = if rebound.iter().any(|&r| r > T::zero()) {
             let bounce = target.zip_map(&rebound, |t, r| t.max(r));
-            let bounced = solve(normal, &bounce, &plastic.impulses, left(taken))?;
+            let bounced = solve(
+                normal,
+                &bounce,
+                &plastic.impulses,
+                &plastic.active,
+                left(taken),
+            )?;
             taken += bounced.rounds;
             Solved {
                 settled: plastic.settled && bounced.settled,
@@ -369,7 +383,7 @@ impl<T: Real, const C: usize, K> Setup<T, C, K> {
             core::array::from_fn(|i| self.bilateral[i] || solved.impulses.normal[i] > T::zero());
         memory.record(solved.impulses, end, energy, pushed, report);
         let filled = Filled {
-            q: free.q,
+            q: reuse.at,
             mass_known: reuse.mass_known,
             rows_too,
             gaps,

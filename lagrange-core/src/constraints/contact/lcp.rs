@@ -227,7 +227,13 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
                 reason: "must be below the set's size",
             });
         }
-        self.factored_n = 0;
+        // The factor holds as far as this row, where it is one of its rows.
+        self.factored_n = self
+            .factored
+            .iter()
+            .take(self.factored_n)
+            .position(|&r| r == i)
+            .unwrap_or(self.factored_n);
         self.rows.set_column(i, j);
         self.mobility.set_column(i, b);
         self.candidate[i] = true;
@@ -949,6 +955,29 @@ mod tests {
         assert_eq!(e.candidates(), &[true, true, false]);
         let two = Delassus::new(&j, |_| Ok(()), &[true, true, false])?;
         assert_eq!(e.w(), two.w());
+        Ok(())
+    }
+
+    /// A row inserted after a solve keeps the factor of the rows before it, and a row
+    /// replaced in the factor is factored again: the multipliers are those of a set built
+    /// afresh with the same rows, bit for bit (the same operations in the same order).
+    #[test]
+    fn inserted_rows_keep_only_the_factor_that_holds() -> Result<(), Error> {
+        let j = SMatrix::<f64, 3, 3>::new(1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 1.0, 1.0, 1.0);
+        let kinds = [Row::Unilateral; 3];
+        let b = SVector::<f64, 3>::new(-1.0, -2.0, -3.0);
+        let mut d = Delassus::new(&j, |_| Ok(()), &[true, true, false])?;
+        d.complementary(&b, &kinds)?;
+        d.insert(2, &j.row(2).transpose(), &j.row(2).transpose())?;
+        let all = Delassus::new(&j, |_| Ok(()), &[true; 3])?.complementary(&b, &kinds)?;
+        assert_eq!(d.complementary(&b, &kinds)?, all);
+        // The first row replaced: the factor of the old one must not serve the new.
+        let moved = SVector::<f64, 3>::new(2.0, 0.5, 1.0);
+        d.insert(0, &moved, &moved)?;
+        let mut k = j;
+        k.set_row(0, &moved.transpose());
+        let fresh = Delassus::new(&k, |_| Ok(()), &[true; 3])?.complementary(&b, &kinds)?;
+        assert_eq!(d.complementary(&b, &kinds)?, fresh);
         Ok(())
     }
 
