@@ -135,8 +135,18 @@ impl<T: Real> Run<'_, T> {
                 let tangent = contacts
                     .get(i)
                     .filter(|c| frictional && c.tangent.inverse > T::zero())
-                    .map(|c| self.friction * c.normal.lambda);
-                if let Some(bound) = tangent {
+                    .map(|c| {
+                        (
+                            self.friction * c.normal.lambda,
+                            c.normal.held || c.tangent.held,
+                        )
+                    });
+                if let Some((_, false)) = tangent {
+                    if pair(v, contacts, i, self.friction) {
+                        continue;
+                    }
+                }
+                if let Some((bound, _)) = tangent {
                     self.update::<N, B, DRIFT>(
                         v,
                         contacts,
@@ -204,6 +214,50 @@ impl<T: Real> Run<'_, T> {
             *phase.impulse(c, part) = next;
         }
     }
+}
+
+/// Contact `i`'s tangent, then its normal row, in the velocities' phase, neither with rows
+/// locked in it and its sides on two bodies (or one and static geometry): the updates of
+/// [`Run::update`], the same operations in the same order, on a copy of the two bodies'
+/// velocities written back once. The normal row reads the velocities the tangent's impulse
+/// has just changed from the copy, not from memory: a vector of three `f32` written as two
+/// and one and read as one and two cannot be forwarded from the store, and a pyramid's
+/// sweeps spent a fifth of their time waiting there. Whether it took the contact.
+#[inline(always)]
+fn pair<T: Real, const N: usize>(
+    v: &mut [SVector<T, N>],
+    contacts: &mut [Contact<T, N>],
+    i: usize,
+    friction: T,
+) -> bool {
+    let Some(c) = contacts.get_mut(i) else {
+        return false;
+    };
+    let bodies = c.bodies;
+    if bodies[0].is_some() && bodies[0] == bodies[1] {
+        return false;
+    }
+    let mut near = bodies.map(|b| b.and_then(|k| v.get(k)).copied());
+    let mut update = |row: &mut Row<T, N>, target: T, (lo, hi): (T, T)| {
+        let residual = row.speed([near[0].as_ref(), near[1].as_ref()]) - target;
+        let lambda = row.lambda;
+        let next = (lambda - residual * row.inverse).max(lo).min(hi);
+        for (x, b) in near.iter_mut().zip(&row.b) {
+            if let Some(x) = x {
+                *x += b * (next - lambda);
+            }
+        }
+        row.lambda = next;
+    };
+    let bound = friction * c.normal.lambda;
+    update(&mut c.tangent, T::zero(), (-bound, bound));
+    update(&mut c.normal, c.lower, (T::zero(), T::INFINITY));
+    for (body, x) in bodies.iter().zip(near) {
+        if let (Some(slot), Some(x)) = (body.and_then(|k| v.get_mut(k)), x) {
+            *slot = x;
+        }
+    }
+    true
 }
 
 /// The drift's targets: each row's gap where the velocities `v` take it over the step `dt`,
@@ -345,9 +399,9 @@ fn interleaved<T: Real, const N: usize, const B: usize, const K: usize>(
 
 #[cfg(test)]
 mod tests {
-    use super::{sweep, Order};
+    use super::{sweep, Order, Run};
     use crate::world::locks::Locks;
-    use crate::world::rows::{Contact, Phase, Row};
+    use crate::world::rows::{Contact, Part, Phase, Row};
     use lagrange_core::nalgebra::SVector;
 
     /// A contact between `bodies` (of 2 coordinates), its rows drawn from `draw`.
@@ -387,6 +441,76 @@ mod tests {
         let order = Order::<8>::of::<f64, 2, 6>(&contacts, 2);
         assert_eq!(order.all.as_slice(), &[0, 2, 1, 3]);
         assert_eq!(order.own.as_slice(), &[2, 3]);
+    }
+
+    /// A contact's two rows taken at once (`pair`, on a copy of the two bodies' velocities)
+    /// give the bits of the tangent's update and then the normal's, each on the velocities
+    /// in memory: 100 random sets of contacts among 6 bodies, three sweeps.
+    #[test]
+    fn a_contacts_two_rows_at_once_are_its_two_updates() {
+        let mut seed = 0x9e37_79b9_7f4a_7c15_u64;
+        let mut draw = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        };
+        for round in 0..100 {
+            let count = 1 + round % 30;
+            let mut contacts: heapless::Vec<Contact<f64, 2>, 32> = heapless::Vec::new();
+            for _ in 0..count {
+                let body = |x: f64| ((x + 0.5) * 6.0) as usize;
+                let (a, b) = (body(draw()), body(draw()));
+                let first = (draw() > -0.3).then_some(a);
+                let second = if b == a { None } else { Some(b) };
+                let mut c = contact([first, second], &mut draw);
+                c.normal.lambda = draw() + 0.5;
+                c.tangent.lambda = draw() * 0.2;
+                assert!(contacts.push(c).is_ok());
+            }
+            let keys: heapless::Vec<u32, 32> = (0..count as u32).collect();
+            let start = [0; 6].map(|_| SVector::<f64, 2>::new(draw(), draw()));
+            let (mut v, mut w) = (start, start);
+            let mut other = contacts.clone();
+            let locks = Locks::<f64, 6>::new();
+            let friction = 0.5;
+            sweep(
+                &mut v,
+                &mut contacts,
+                &locks,
+                &keys,
+                friction,
+                3,
+                Phase::Velocity,
+                true,
+            );
+            let run = Run {
+                order: &keys,
+                friction,
+                sweeps: 3,
+                locking: true,
+            };
+            for _ in 0..3 {
+                for i in 0..count {
+                    let bound = friction * other[i].normal.lambda;
+                    if other[i].tangent.inverse > 0.0 {
+                        let tangent = (Part::Tangent, (-bound, bound));
+                        run.update::<2, 6, false>(
+                            &mut w, &mut other, &locks, i, tangent.0, tangent.1,
+                        );
+                    }
+                    let normal = (0.0, f64::INFINITY);
+                    run.update::<2, 6, false>(&mut w, &mut other, &locks, i, Part::Normal, normal);
+                }
+            }
+            assert_eq!(v, w, "round {round}");
+            for (a, b) in contacts.iter().zip(&other) {
+                assert_eq!(
+                    (a.normal.lambda, a.tangent.lambda),
+                    (b.normal.lambda, b.tangent.lambda)
+                );
+            }
+        }
     }
 
     /// Over 200 random sets of contacts among 6 bodies (some on static geometry), the
