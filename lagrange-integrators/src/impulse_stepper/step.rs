@@ -283,10 +283,11 @@ impl<T: Real, const C: usize, K> Setup<T, C, K> {
         );
         // The solves after the plastic one (speculative rows, rebounds) start from its
         // impulses and the rows it ended with (from the last step's, a rebound's solve took
-        // ten passes where the plastic one had found its rows) and share the rounds it left, at least one each: a step takes at most
-        // `max_iterations + 3` rounds (ImpulseSettings::max_rounds), where each solve
-        // capped on its own took four times as many in the landing steps whose friction
-        // does not settle (the rounds shrink its change by a third each).
+        // ten passes where the plastic one had found its rows) and share the rounds it
+        // left, at least one each: a step takes at most `max_iterations + 3` rounds
+        // (ImpulseSettings::max_rounds), where each solve capped on its own took four
+        // times as many in the landing steps whose friction does not settle (the rounds
+        // shrink its change by a third each).
         let left = |taken: u32| rounds.saturating_sub(taken).max(1);
         let friction = self.model.friction();
         let w = jacobian * free.qd;
