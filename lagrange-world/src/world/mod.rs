@@ -33,7 +33,7 @@ use locks::Locks;
 use places::Place;
 use profile::Stopwatch;
 use rows::{Contact, Kept};
-use solve::Order;
+use solve::{Order, Ordered};
 
 /// The first key of a body's own rows' contacts, `(OWN_ROWS, body, row)`: a key no shape
 /// or half-plane may take.
@@ -221,6 +221,8 @@ pub struct World<
     contacts: Vec<Contact<T, N>, K>,
     /// The bodies' own rows locked in the last step's contacts.
     locks: Locks<T, B>,
+    /// The order the last step's sweeps took its contacts in.
+    ordered: Ordered<K>,
     /// The last step's impulses, sorted by key (the next step's warm start).
     kept: Vec<Kept<T>, K>,
     /// The pairs of shapes that pushed on each other in the last step, sorted.
@@ -252,6 +254,7 @@ where
             settings,
             contacts: Vec::new(),
             locks: Locks::new(),
+            ordered: Ordered::new(),
             kept: Vec::new(),
             touching: Vec::new(),
             events: Vec::new(),
@@ -592,7 +595,8 @@ where
         let own = self.contacts.partition_point(|c| c.key.0 != OWN_ROWS);
         self.locks
             .lock::<N, K>(&mut self.contacts, own, self.bodies.len());
-        let order = Order::of::<T, N, B>(&self.contacts, own);
+        // The order of the contacts' bodies decides it: a pile at rest takes the last one.
+        let order = self.ordered.of::<T, N, B>(&self.contacts, own).clone();
         report.guarded = self.solve(&order);
         profile.solve = watch.lap();
         let mut pseudo = [SVector::<T, N>::zeros(); B];

@@ -327,6 +327,60 @@ impl<const K: usize> Order<K> {
     }
 }
 
+/// The last [`Order`] made and what it was made of (each contact's bodies, in order, and
+/// where the bodies' own rows began): an order depends on nothing else, so contacts that
+/// join the same bodies in the same order (a pile at rest, step after step) take it again.
+#[derive(Debug, Clone)]
+pub(crate) struct Ordered<const K: usize> {
+    order: Order<K>,
+    bodies: Vec<[u32; 2], K>,
+    own: usize,
+}
+
+impl<const K: usize> Ordered<K> {
+    /// None made yet.
+    pub(crate) fn new() -> Self {
+        Self {
+            order: Order {
+                all: Vec::new(),
+                own: Vec::new(),
+            },
+            bodies: Vec::new(),
+            own: 0,
+        }
+    }
+
+    /// The order of `contacts`, their own rows from `own` on, in a world of `B` bodies:
+    /// [`Order::of`] them, or the last one where it was made of the same bodies.
+    pub(crate) fn of<T: Real, const N: usize, const B: usize>(
+        &mut self,
+        contacts: &[Contact<T, N>],
+        own: usize,
+    ) -> &Order<K> {
+        // A body's index as stored (bodies are fewer than u32::MAX: none is `u32::MAX`).
+        let packed = |c: &Contact<T, N>| {
+            c.bodies
+                .map(|b| b.map_or(u32::MAX, |i| u32::try_from(i).unwrap_or(u32::MAX - 1)))
+        };
+        let same = self.own == own
+            && self.bodies.len() == contacts.len()
+            && contacts
+                .iter()
+                .zip(&self.bodies)
+                .all(|(c, b)| packed(c) == *b);
+        if !same {
+            self.order = Order::of::<T, N, B>(contacts, own);
+            self.bodies.clear();
+            for c in contacts {
+                // Capacity K holds every contact of a step.
+                let _ = self.bodies.push(packed(c));
+            }
+            self.own = own;
+        }
+        &self.order
+    }
+}
+
 /// The contacts from `first` on, interleaved (see [`Order`]).
 fn interleaved<T: Real, const N: usize, const B: usize, const K: usize>(
     contacts: &[Contact<T, N>],
@@ -399,7 +453,7 @@ fn interleaved<T: Real, const N: usize, const B: usize, const K: usize>(
 
 #[cfg(test)]
 mod tests {
-    use super::{sweep, Order, Run};
+    use super::{sweep, Order, Ordered, Run};
     use crate::world::locks::Locks;
     use crate::world::rows::{Contact, Part, Phase, Row};
     use lagrange_core::nalgebra::SVector;
@@ -567,6 +621,40 @@ mod tests {
                     assert!(tangent.abs() <= friction * normal, "round {round}: {c:?}");
                 }
             }
+        }
+    }
+
+    /// A kept order serves only contacts of the same bodies with their own rows from the
+    /// same place: over 200 steps of contacts kept, drawn again (as many, or more), their
+    /// own rows moved, or one contact's body changed, the kept order is the one made afresh.
+    #[test]
+    fn a_kept_order_is_that_of_the_same_bodies() {
+        let mut draw = draws(0x5851_f42d_4c95_7f2d);
+        let mut ordered = Ordered::<64>::new();
+        let (mut count, mut own) = (20, 5);
+        let mut contacts = random_contacts::<64>(count, &mut draw);
+        for round in 0..200 {
+            match round % 5 {
+                0 => {}
+                1 => contacts = random_contacts::<64>(count, &mut draw),
+                2 => {
+                    count = 1 + round % 40;
+                    contacts = random_contacts::<64>(count, &mut draw);
+                }
+                3 => own = round % (count + 1),
+                _ => {
+                    let last = count - 1;
+                    contacts[last].bodies[1] = Some((round % 6 + 1) % 6);
+                }
+            }
+            own = own.min(count);
+            let kept = ordered.of::<f64, 2, 6>(&contacts, own).clone();
+            let fresh = Order::<64>::of::<f64, 2, 6>(&contacts, own);
+            assert_eq!(
+                (kept.all, kept.own),
+                (fresh.all, fresh.own),
+                "round {round}"
+            );
         }
     }
 
