@@ -449,7 +449,10 @@ mod tests {
             assert!(dq <= 16.0 && dv <= 64.0, "step {step}: {dq}, {dv}");
         }
         let taken_again = reusing.work.reused;
-        assert!(taken_again >= 600, "{taken_again}");
+        // Measured 965 (f32) and 942 (f64); taken again only where the coordinates are the
+        // same bits (the rule before rounding was allowed), 915 and 897: 930 tells them
+        // apart in both.
+        assert!(taken_again >= 930, "{taken_again}");
         assert_eq!(filling.work.reused, 0);
         Ok(())
     }
