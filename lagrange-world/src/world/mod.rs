@@ -595,29 +595,35 @@ where
         let own = self.contacts.partition_point(|c| c.key.0 != OWN_ROWS);
         self.locks
             .lock::<N, K>(&mut self.contacts, own, self.bodies.len());
-        // The order of the contacts' bodies decides it: a pile at rest takes the last one.
-        let order = self.ordered.of::<T, N, B>(&self.contacts, own).clone();
-        report.guarded = self.solve(&order);
+        // The order of the contacts' bodies decides it: a pile at rest takes the last one
+        // (read where it is kept, not copied: a copy is the size of the capacity, every
+        // step, asleep or not).
+        self.ordered.of::<T, N, B>(&self.contacts, own);
+        report.guarded = self.solve();
         profile.solve = watch.lap();
         let mut pseudo = [SVector::<T, N>::zeros(); B];
         let velocities: [SVector<T, N>; B] =
             core::array::from_fn(|i| self.bodies.get(i).map_or(SVector::zeros(), |b| b.state.qd));
         if solve::drift(&velocities, &mut self.contacts, self.settings.slop, dt) {
             // The bodies' own rows have the last word here too.
-            own_last(&order, self.settings.sweeps, |rows, sweeps| {
-                let (contacts, locks, drift) =
-                    (&mut self.contacts, &self.locks, rows::Phase::Drift);
-                solve::sweep(
-                    &mut pseudo,
-                    contacts,
-                    locks,
-                    rows,
-                    T::zero(),
-                    sweeps,
-                    drift,
-                    true,
-                );
-            });
+            own_last(
+                self.ordered.order(),
+                self.settings.sweeps,
+                |rows, sweeps| {
+                    let (contacts, locks, drift) =
+                        (&mut self.contacts, &self.locks, rows::Phase::Drift);
+                    solve::sweep(
+                        &mut pseudo,
+                        contacts,
+                        locks,
+                        rows,
+                        T::zero(),
+                        sweeps,
+                        drift,
+                        true,
+                    );
+                },
+            );
         }
         for (body, p) in self
             .bodies
@@ -644,7 +650,8 @@ where
 
     /// Step 3 of the scheme: the impulses, into the awake bodies' velocities. Whether the
     /// guard solved again (see [`WorldReport::guarded`]).
-    fn solve(&mut self, order: &Order<K>) -> bool {
+    fn solve(&mut self) -> bool {
+        let order = self.ordered.order();
         let free = self.velocities();
         let before = self.kinetic(&free);
         let mut v = free;

@@ -350,6 +350,11 @@ impl<const K: usize> Ordered<K> {
         }
     }
 
+    /// The order made last.
+    pub(crate) fn order(&self) -> &Order<K> {
+        &self.order
+    }
+
     /// The order of `contacts`, their own rows from `own` on, in a world of `B` bodies:
     /// [`Order::of`] them, or the last one where it was made of the same bodies.
     pub(crate) fn of<T: Real, const N: usize, const B: usize>(
