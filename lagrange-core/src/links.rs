@@ -106,6 +106,42 @@ pub trait Links<T: Real, const N: usize> {
         }
     }
 
+    /// The Jacobian `d at / dq` of the point at `at` (world coordinates) fixed on link
+    /// `link`, whose pose at `q` is `pose` (the caller has it: a world places its shapes by
+    /// it). By default the point in the link's frame, then [`Links::point`]; a mechanism
+    /// whose Jacobian needs no trigonometry given the point (a rigid body's) overrides it.
+    ///
+    /// ```
+    /// use lagrange_core::links::{Links, Pose};
+    /// use lagrange_core::{nalgebra::SVector, Scalar};
+    ///
+    /// struct Rod;
+    /// impl Links<f64, 1> for Rod {
+    ///     const LINKS: usize = 1;
+    ///     fn pose<S: Scalar<Real = f64> + 'static>(&self, q: &SVector<S, 1>, _link: usize) -> Pose<S> {
+    ///         Pose { origin: [S::zero(); 2], angle: q[0] }
+    ///     }
+    /// }
+    ///
+    /// let q = SVector::from([0.5]);
+    /// let pose = Rod.pose(&q, 0);
+    /// let at = pose.point([0.0, -2.0]);
+    /// let j = Rod.jacobian_at(&q, 0, &pose, at);
+    /// assert!((j - Rod.point(&q, 0, [0.0, -2.0]).jacobian).abs().max() < 1e-15);
+    /// ```
+    fn jacobian_at(
+        &self,
+        q: &SVector<T, N>,
+        link: usize,
+        pose: &Pose<T>,
+        at: [T; 2],
+    ) -> SMatrix<T, 2, N> {
+        let (s, c) = pose.angle.sin_cos();
+        let (dx, dy) = (at[0] - pose.origin[0], at[1] - pose.origin[1]);
+        let local = [c * dx + s * dy, c * dy - s * dx];
+        self.point(q, link, local).jacobian
+    }
+
     /// The point `local` of link `link` at coordinates `q`: where it is and its Jacobian, by
     /// one evaluation of [`Links::pose`] in dual numbers.
     fn point(&self, q: &SVector<T, N>, link: usize, local: [T; 2]) -> LinkPoint<T, N> {

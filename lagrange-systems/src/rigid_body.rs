@@ -209,6 +209,19 @@ impl<T: Real> Links<T, 3> for RigidBody<T> {
         }
     }
 
+    /// `d/dth` of the point's offset from the centre of mass is that offset turned a
+    /// quarter turn: no trigonometry.
+    fn jacobian_at(
+        &self,
+        q: &SVector<T, 3>,
+        _link: usize,
+        _pose: &Pose<T>,
+        at: [T; 2],
+    ) -> SMatrix<T, 2, 3> {
+        let (dx, dy) = (at[0] - q[0], at[1] - q[1]);
+        SMatrix::<T, 2, 3>::new(T::one(), T::zero(), -dy, T::zero(), T::one(), dx)
+    }
+
     /// By hand: `d/dth` of the turned offset is the offset turned a further quarter turn.
     fn point(&self, q: &SVector<T, 3>, _link: usize, local: [T; 2]) -> LinkPoint<T, 3> {
         let (s, c) = q[2].sin_cos();

@@ -406,7 +406,43 @@ fn all_poses_at_once<T: Real>() -> Result<(), Error> {
     every_mechanism::<T>(&mut AtOnce(Rng::new(347)))
 }
 
+/// `Links::jacobian_at` of a point where `Links::point` places it is that point's Jacobian,
+/// to 8 ulps of the sizes of the coordinates and the point (a rigid body's own takes the
+/// offset from its centre where the point is, not turned there from its frame), at 20
+/// random states and points on every link.
+fn jacobian_at_is_the_points<T: Real, L: Links<T, N>, const N: usize>(l: &L, rng: &mut Rng) {
+    for _ in 0..20 {
+        let q = random_state::<T, N>(rng, (-3.2, 3.2), (0.0, 0.0)).q;
+        let size = 2.0 + q.iter().map(|x| x.to_f64().abs()).sum::<f64>();
+        for link in 0..L::LINKS {
+            let local = [rng.uniform(-1.0, 1.0), rng.uniform(-1.0, 1.0)];
+            let point = l.point(&q, link, local);
+            let at = l.jacobian_at(&q, link, &l.pose(&q, link), point.position);
+            let worst = (at - point.jacobian)
+                .iter()
+                .fold(0.0_f64, |m, x| m.max(x.to_f64().abs()));
+            assert!(
+                worst <= 8.0 * T::EPSILON.to_f64() * size,
+                "{}, link {link}: {worst:e}",
+                core::any::type_name::<L>()
+            );
+        }
+    }
+}
+
+/// Every standard mechanism's Jacobians of points given where they are.
+fn jacobians_at_points<T: Real>() -> Result<(), Error> {
+    struct At(Rng);
+    impl<T: Real> Check<T> for At {
+        fn check<L: Links<T, N>, const N: usize>(&mut self, l: &L) {
+            jacobian_at_is_the_points(l, &mut self.0);
+        }
+    }
+    every_mechanism::<T>(&mut At(Rng::new(348)))
+}
+
 for_f32_and_f64!(
+    jacobians_at_points,
     all_poses_at_once,
     energies_agree,
     positions_follow_the_conventions,

@@ -9,7 +9,7 @@ use super::{World, OWN_ROWS};
 use crate::broad::Proxy;
 use crate::collide::{collide, half_plane_points};
 use crate::manifold::ContactPoint;
-use crate::vec2::{rotate, sub, Vec2};
+use crate::vec2::Vec2;
 use heapless::Vec;
 use lagrange_core::links::{Links, Pose};
 use lagrange_core::nalgebra::{SMatrix, SVector};
@@ -289,10 +289,9 @@ where
             else {
                 continue;
             };
-            let pose = side.pose;
-            let (sin, cos) = pose.angle.sin_cos();
-            let local = rotate(sub(p.point, pose.origin), (-sin, cos));
-            let j = body.mechanism.point(&body.state.q, link, local).jacobian;
+            let j = body
+                .mechanism
+                .jacobian_at(&body.state.q, link, &side.pose, p.point);
             let along = |d: Vec2<T>| {
                 SVector::<T, N>::from_fn(|k, _| sign * (d[0] * j[(0, k)] + d[1] * j[(1, k)]))
             };
