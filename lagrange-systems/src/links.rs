@@ -202,6 +202,34 @@ impl<T: Real> Links<T, RAGDOLL_COORDINATES> for Ragdoll<T> {
         }
     }
 
+    /// As [`Links::point`], from the link's pose: the joints between it and the torso found
+    /// back from it (the torso's children need no trigonometry, their children one
+    /// `sin_cos`), where the ragdoll's pose of every link took ten.
+    fn jacobian_at(
+        &self,
+        q: &SVector<T, RAGDOLL_COORDINATES>,
+        link: usize,
+        pose: &Pose<T>,
+        at: [T; 2],
+    ) -> SMatrix<T, 2, RAGDOLL_COORDINATES> {
+        let mut jacobian = SMatrix::<T, 2, RAGDOLL_COORDINATES>::zeros();
+        jacobian[(0, 0)] = T::one();
+        jacobian[(1, 1)] = T::one();
+        jacobian[(0, 2)] = q[1] - at[1];
+        jacobian[(1, 2)] = at[0] - q[0];
+        let (mut k, mut origin, mut angle) = (link.min(RAGDOLL_LINKS - 1), pose.origin, pose.angle);
+        while k != TORSO {
+            jacobian[(0, k + 2)] = origin[1] - at[1];
+            jacobian[(1, k + 2)] = at[0] - origin[0];
+            if PARENT[k] == TORSO {
+                break;
+            }
+            (origin, angle) = self.parent_frame(q, k, origin, angle);
+            k = PARENT[k];
+        }
+        jacobian
+    }
+
     /// By hand, from one pose: the torso's translation moves the point as it is; each
     /// coordinate that turns the link (the torso's angle and every joint from the torso out
     /// to it) turns the point about that joint, `perp(point - joint)`.

@@ -514,6 +514,27 @@ impl<T: Real> Ragdoll<T> {
         pose
     }
 
+    /// The origin and absolute angle of link `k`'s parent from `k`'s own at `q` (`k` not
+    /// the torso): the parent's angle is `k`'s less its joint's turn, and `k`'s joint sits
+    /// at its mark on the parent (one `sin_cos`, of the parent's angle).
+    pub(crate) fn parent_frame(
+        &self,
+        q: &SVector<T, RAGDOLL_COORDINATES>,
+        k: usize,
+        origin: [T; 2],
+        angle: T,
+    ) -> ([T; 2], T) {
+        let k = k.min(RAGDOLL_LINKS - 1);
+        let parent = angle - q[(k + 2).min(RAGDOLL_COORDINATES - 1)] - self.rest[k];
+        let (s, c) = parent.sin_cos();
+        let j = self.joint[k];
+        let at = [
+            origin[0] - (j.along * s + j.across * c),
+            origin[1] - (-(j.along * c) + j.across * s),
+        ];
+        (at, parent)
+    }
+
     /// Each link's absolute angle: a link points from its joint along `(sin a, -cos a)`.
     pub(crate) fn angles<S: Scalar<Real = T>>(
         &self,
