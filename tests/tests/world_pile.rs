@@ -199,17 +199,17 @@ fn deepest<T: Real>(
 /// the depths' median within the slop and 2% (a resting contact rests at the slop) and the
 /// worst within 20 mm.
 ///
-/// Measured over the throws (f32, f64): the median depth 5.0 mm and 5.0 mm, the worst 7.4
-/// and 14.3 mm (a forearm struck at a wall); a joint past its limit moving 2.6e-3 rad/s at
-/// worst further past it (1.4e-5 to 2.3e-5 for the first throw, this test's only one once).
+/// Measured over the throws (f32, f64): the median depth 5.0 mm and 5.0 mm, the worst 7.6
+/// and 5.5 mm; a joint past its limit moving 2.4e-4 and 2.2e-13 rad/s at worst further past
+/// it (2.6e-3 when the limits were swept 32 times, not solved).
 /// The solve without locked limits (see `lagrange_world`'s `locks`) fails these: depths 24
 /// mm at worst, 1.4e-2 rad/s into a limit, a limit passed by 5.29 mm.
 fn three_ragdolls_land<T: Real>() -> Result<(), Error> {
     let runs = throws::<T>(3, 180)?;
-    // The joints' limits have the last word in each step's solve (sweeps of their rows
-    // alone after the contacts'): a joint past its limit then moves no further past it, to
-    // the solve's convergence (with 12 such sweeps instead of 32, 0.04 rad/s; with none,
-    // 5.6, and the dolls never fall asleep).
+    // The joints' limits have the last word in each step's solve (each body's rows solved
+    // exactly after the contacts'): a joint past its limit then moves no further past it,
+    // to rounding (with 12 sweeps of their rows alone instead, 0.04 rad/s; with none, 5.6,
+    // and the dolls never fall asleep).
     let bounds = Bounds {
         limits: SLOP * 1.02,
         into: 5e-3,
@@ -283,17 +283,21 @@ fn check<T: Real>(runs: &[Measured], bounds: &Bounds) -> Result<(), Error> {
 for_f32_and_f64!(three_ragdolls_land);
 
 /// Ten ragdolls thrown together for 30 s, each of the [`THROWS`] (the world bench's throw is
-/// the first): limits within the slop and 5%, a joint past its limit moving 0.03 rad/s at
-/// most further past it (more dolls press on each limb), impulses and energy as the three,
-/// the depths' median within 30 mm and the worst within 70 mm, and all asleep within 15 s.
+/// the first): limits within the slop and 5%, a joint past its limit moving 0.01 rad/s at
+/// most further past it, impulses and energy as the three, the depths' median within 30 mm
+/// and the worst within 70 mm, and all asleep within 15 s.
 ///
-/// Measured over the throws (f32, f64): limits passed by 5.18 and 5.09 mm at worst, joints
-/// moving 0.015 and 0.025 rad/s further past them; median depths 19 and 26 mm, the worst 55
-/// and 64 mm; asleep between steps 318 and 755. Not the slop for depth: where a pile lands
-/// at 20 m/s, a limb struck hard passes into another within a step, and the drift takes
-/// some steps to push them apart. The solve without locked limits fails these: median
-/// depth 89 mm and the worst 192 mm (f64), a limit passed by 5.38 mm, a pile asleep only
-/// at step 1,521.
+/// Measured over the throws (f32, f64): limits passed by 5.002 and 5.000 mm at worst, joints
+/// moving 2.0e-3 and 9.5e-13 rad/s further past them (0.015 to 0.037 when the limits were
+/// swept, not solved: the bound was 0.03, and throws not drawn here passed it); median
+/// depths 19 and 20 mm, the worst 32 and 66 mm; asleep between steps 301 and 752. Over 16
+/// more throws (seeds 8 to 23) joints moved 3.8e-3 rad/s at most past their limits, but two
+/// f64 throws went 100 and 98 mm deep (a head struck by a shin at landing, inside one step)
+/// and one f32 throw 82 mm: the depth bound holds for these throws, not for every throw.
+/// Not the slop for depth: where a pile lands at 20 m/s, a limb struck hard passes into
+/// another within a step, and the drift takes some steps to push them apart. The solve
+/// without locked limits fails these: median depth 89 mm and the worst 192 mm (f64), a
+/// limit passed by 5.38 mm, a pile asleep only at step 1,521.
 #[test]
 #[ignore = "long: cargo xtask test runs it optimised"]
 fn a_pile_of_ten_ragdolls() -> Result<(), Error> {
@@ -301,7 +305,7 @@ fn a_pile_of_ten_ragdolls() -> Result<(), Error> {
         let runs = throws::<T>(10, 1800)?;
         let bounds = Bounds {
             limits: SLOP * 1.05,
-            into: 0.03,
+            into: 0.01,
             median: 0.03,
             worst: 0.07,
         };

@@ -8,6 +8,7 @@ mod islands;
 mod limits;
 mod locks;
 mod mobilities;
+mod own;
 mod places;
 mod profile;
 mod rows;
@@ -39,11 +40,12 @@ use solve::{Order, Ordered};
 /// or half-plane may take.
 pub(crate) const OWN_ROWS: u32 = u32::MAX;
 
-/// The sweeps over the bodies' own rows alone after each solve, per sweep of the settings: a
-/// body's rows are coupled through its mass matrix (a ragdoll's hand and torso differ 20
-/// times in mass), and they are few and cheap (one dot product of `N` a row). Measured on
-/// ten ragdolls thrown into a pile at 60 Hz, 8 sweeps: limits passed by 0.038 rad at worst
-/// with one, 0.0051 with four (the slop is 0.005).
+/// The sweeps over a body's own rows alone after each solve, per sweep of the settings, where
+/// their exact solve (see `own`) fails: a body's rows are coupled through its mass matrix
+/// (a ragdoll's hand and torso differ 20 times in mass), and they are few and cheap (one dot
+/// product of `N` a row). Measured on ten ragdolls thrown into a pile at 60 Hz, 8 sweeps,
+/// when they were all there was: limits passed by 0.038 rad at worst with one, 0.0051 with
+/// four (the slop is 0.005).
 const OWN_SWEEPS: u32 = 4;
 
 /// Static half-planes a world holds at most (floors and walls).
@@ -135,7 +137,8 @@ pub struct WorldHit<T> {
 ///               -e J v* for a contact that strikes (and would leave at the rest speed
 ///               or faster); a body's limits that pushed in the last step held still in
 ///               the updates of its contacts' rows (a limb at its limit moves with its
-///               body), the bodies' own rows swept last
+///               body), the bodies' own rows last: each body's solved exactly with
+///               the contacts' impulses held
 /// 4. move       q+ = q + dt v+                                v+ the solved velocities
 /// 5. drift      q+ += dt p, pseudo-velocities p that bring every row the move leaves
 ///               deeper than the slop back to it, and close no other past it (split
@@ -606,23 +609,13 @@ where
             core::array::from_fn(|i| self.bodies.get(i).map_or(SVector::zeros(), |b| b.state.qd));
         if solve::drift(&velocities, &mut self.contacts, self.settings.slop, dt) {
             // The bodies' own rows have the last word here too.
-            own_last(
+            sweep(
+                &mut pseudo,
+                &mut self.contacts,
+                &self.locks,
                 self.ordered.order(),
-                self.settings.sweeps,
-                |rows, sweeps| {
-                    let (contacts, locks, drift) =
-                        (&mut self.contacts, &self.locks, rows::Phase::Drift);
-                    solve::sweep(
-                        &mut pseudo,
-                        contacts,
-                        locks,
-                        rows,
-                        T::zero(),
-                        sweeps,
-                        drift,
-                        true,
-                    );
-                },
+                (T::zero(), self.settings.sweeps),
+                (rows::Phase::Drift, true),
             );
         }
         for (body, p) in self
@@ -657,7 +650,7 @@ where
         let mut v = free;
         solve::warm_start(&mut v, &mut self.contacts, &self.locks);
         let solve = (self.settings.model.friction(), self.settings.sweeps);
-        sweep(&mut v, &mut self.contacts, &self.locks, order, solve, true);
+        sweep(&mut v, &mut self.contacts, &self.locks, order, solve, (rows::Phase::Velocity, true));
         let after = self.kinetic(&v);
         // 16 ulps of the energies: the rounding of sums of a few products.
         let rounding = T::from_f64(16.0) * T::EPSILON * (before.abs() + after.abs());
@@ -672,7 +665,7 @@ where
             }
             // Plain updates, no rows locked: each lowers the program, whose value from
             // zero impulses is the kinetic energy's change.
-            sweep(&mut v, &mut self.contacts, &self.locks, order, solve, false);
+            sweep(&mut v, &mut self.contacts, &self.locks, order, solve, (rows::Phase::Velocity, false));
         }
         self.set_velocities(&v);
         guarded
@@ -902,30 +895,41 @@ where
     }
 }
 
-/// The impulse solve over `contacts` in `order`, the bodies' own rows last ([`own_last`]).
+/// The impulse solve of `phase` over `contacts` in `order`: `sweeps` sweeps over every row,
+/// then the bodies' own rows solved exactly with the others held (`own`; where that fails,
+/// [`OWN_SWEEPS`] times as many sweeps over them): a joint's limit has the last word over
+/// the contacts that strike its limb (their leftover depth is the drift's to remove; a limit
+/// passed is what a viewer sees).
 fn sweep<T: Real, const N: usize, const B: usize, const K: usize>(
     v: &mut [SVector<T, N>],
     contacts: &mut [Contact<T, N>],
     locks: &Locks<T, B>,
     order: &Order<K>,
     (friction, sweeps): (T, u32),
-    locking: bool,
+    (phase, locking): (rows::Phase, bool),
 ) {
-    let velocity = rows::Phase::Velocity;
-    own_last(order, sweeps, |rows, sweeps| {
-        solve::sweep(
-            v, contacts, locks, rows, friction, sweeps, velocity, locking,
+    solve::sweep(
+        v,
+        contacts,
+        locks,
+        &order.all,
+        friction,
+        sweeps,
+        phase,
+        locking,
+    );
+    if !order.own.is_empty() {
+        let first = contacts.partition_point(|c| c.key.0 != OWN_ROWS);
+        own::settle(
+            v,
+            contacts,
+            locks,
+            first,
+            phase,
+            OWN_SWEEPS * sweeps,
+            locking,
         );
-    });
-}
-
-/// `sweeps` sweeps over every row of `order` by `pass`, then [`OWN_SWEEPS`] times as many
-/// over the bodies' own rows alone: a joint's limit has the last word over the contacts that
-/// strike its limb (their leftover depth is the drift's to remove; a limit passed is what a
-/// viewer sees).
-fn own_last<const K: usize>(order: &Order<K>, sweeps: u32, mut pass: impl FnMut(&[u32], u32)) {
-    pass(&order.all, sweeps);
-    pass(&order.own, OWN_SWEEPS * sweeps);
+    }
 }
 
 /// Whether shape `key` of `shapes` (sorted by key) is on a sleeping body of `bodies`.
