@@ -650,7 +650,14 @@ where
         let mut v = free;
         solve::warm_start(&mut v, &mut self.contacts, &self.locks);
         let solve = (self.settings.model.friction(), self.settings.sweeps);
-        sweep(&mut v, &mut self.contacts, &self.locks, order, solve, (rows::Phase::Velocity, true));
+        sweep(
+            &mut v,
+            &mut self.contacts,
+            &self.locks,
+            order,
+            solve,
+            (rows::Phase::Velocity, true),
+        );
         let after = self.kinetic(&v);
         // 16 ulps of the energies: the rounding of sums of a few products.
         let rounding = T::from_f64(16.0) * T::EPSILON * (before.abs() + after.abs());
@@ -665,7 +672,14 @@ where
             }
             // Plain updates, no rows locked: each lowers the program, whose value from
             // zero impulses is the kinetic energy's change.
-            sweep(&mut v, &mut self.contacts, &self.locks, order, solve, (rows::Phase::Velocity, false));
+            sweep(
+                &mut v,
+                &mut self.contacts,
+                &self.locks,
+                order,
+                solve,
+                (rows::Phase::Velocity, false),
+            );
         }
         self.set_velocities(&v);
         guarded
@@ -909,14 +923,7 @@ fn sweep<T: Real, const N: usize, const B: usize, const K: usize>(
     (phase, locking): (rows::Phase, bool),
 ) {
     solve::sweep(
-        v,
-        contacts,
-        locks,
-        &order.all,
-        friction,
-        sweeps,
-        phase,
-        locking,
+        v, contacts, locks, &order.all, friction, sweeps, phase, locking,
     );
     if !order.own.is_empty() {
         let first = contacts.partition_point(|c| c.key.0 != OWN_ROWS);

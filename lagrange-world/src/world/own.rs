@@ -50,7 +50,9 @@ pub(crate) fn settle<T: Real, const N: usize, const B: usize>(
         let body = contacts.get(start).and_then(|c| c.bodies[0]);
         let count = contacts
             .get(start..)
-            .map_or(0, |rest| rest.iter().take_while(|c| c.bodies[0] == body).count())
+            .map_or(0, |rest| {
+                rest.iter().take_while(|c| c.bodies[0] == body).count()
+            })
             .max(1);
         let end = start + count;
         let exact = body.is_some_and(|i| {
