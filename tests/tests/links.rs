@@ -284,20 +284,22 @@ fn hand_against_duals<T: Real, L: Links<T, N>, const N: usize>(l: &L, rng: &mut 
 }
 
 /// A link number out of range is the caller's error, for which `Links::pose` promises any
-/// pose and no panic: the pose and the point (hand-derived or dual) of links `LINKS`,
-/// `LINKS + 1` and `usize::MAX` are finite at a random state.
+/// pose and no panic: the pose, the point (hand-derived or dual) and the Jacobian at it of
+/// links `LINKS`, `LINKS + 1` and `usize::MAX` are finite at a random state.
 fn out_of_range_is_no_panic<T: Real, L: Links<T, N>, const N: usize>(l: &L, rng: &mut Rng) {
     let q = random_state::<T, N>(rng, (-3.2, 3.2), (0.0, 0.0)).q;
     for link in [L::LINKS, L::LINKS + 1, usize::MAX] {
         let pose: Pose<T> = l.pose(&q, link);
         let point = l.point(&q, link, [T::HALF, -T::one()]);
+        let at = l.jacobian_at(&q, link, &pose, point.position);
         let finite = pose
             .origin
             .iter()
             .chain(&[pose.angle])
             .all(|x| x.is_finite())
             && point.position.iter().all(|x| x.is_finite())
-            && point.jacobian.iter().all(|x| x.is_finite());
+            && point.jacobian.iter().all(|x| x.is_finite())
+            && at.iter().all(|x| x.is_finite());
         assert!(
             finite,
             "{}, link {link}: {pose:?} {point:?}",

@@ -142,3 +142,142 @@ fn exactly<T: Real, const N: usize>(
     }
     true
 }
+
+#[cfg(test)]
+mod tests {
+    use super::settle;
+    use crate::world::locks::Locks;
+    use crate::world::rows::{Contact, Phase, Row};
+    use crate::world::OWN_ROWS;
+    use lagrange_core::nalgebra::{Matrix3, SVector};
+
+    /// Uniform draws in `[-0.5, 0.5)` from a xorshift generator seeded with `seed`.
+    fn draws(mut seed: u64) -> impl FnMut() -> f64 {
+        move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        }
+    }
+
+    /// Row `row` of body 0's own: Jacobian `j`, mobility `inverse j` (`inverse` the mass
+    /// matrix's), lowest speed `lower`, impulse `lambda` already taken.
+    fn own(
+        row: u32,
+        j: SVector<f64, 3>,
+        inverse: &Matrix3<f64>,
+        lower: f64,
+        lambda: f64,
+    ) -> Contact<f64, 3> {
+        let zero = SVector::zeros();
+        let mut normal = Row::new([j, zero], [inverse * j, zero]);
+        normal.lambda = lambda;
+        Contact {
+            key: (OWN_ROWS, 0, row),
+            bodies: [Some(0), None],
+            normal,
+            tangent: Row::new([zero; 2], [zero; 2]),
+            gap: 0.0,
+            lower,
+            approach: 0.0,
+            drift: 0.0,
+            reach: 0.0,
+            point: [0.0; 2],
+            direction: [0.0; 2],
+        }
+    }
+
+    /// A mass matrix's inverse that couples every coordinate to the others nearly as much
+    /// as to itself (positive definite: its leading minors 1, 0.0975 and 0.0095), as a
+    /// ragdoll's limits are coupled through its links.
+    fn coupled() -> Matrix3<f64> {
+        Matrix3::new(1.0, 0.95, 0.9, 0.95, 1.0, 0.95, 0.9, 0.95, 1.0)
+    }
+
+    /// Three own rows of one body, coupled (`coupled`), their lowest speeds, impulses taken
+    /// and the body's velocity drawn, 200 times: after `settle` with no sweeps to fall back
+    /// on, each row meets its conditions (impulse >= 0, speed >= its lowest, one of them an
+    /// equality) to 1e-12, and the velocity moved by exactly what the impulses changed.
+    /// Gauss-Seidel's 32 sweeps over the same rows (what the world did before) leave a row
+    /// 1e-3 off at worst over the draws: the exact solve is what closes that.
+    #[test]
+    fn each_bodys_rows_meet_their_conditions() {
+        let mut draw = draws(41);
+        let inverse = coupled();
+        let locks = Locks::<f64, 1>::new();
+        let (mut worst, mut swept) = (0.0_f64, 0.0_f64);
+        for _ in 0..200 {
+            let mut rows: [Contact<f64, 3>; 3] = core::array::from_fn(|k| {
+                let mut j = SVector::<f64, 3>::zeros();
+                j[k] = if draw() < 0.0 { -1.0 } else { 1.0 };
+                let taken = (draw() + 0.5).max(0.0) * f64::from(u8::from(draw() < 0.0));
+                own(k as u32, j, &inverse, draw(), taken)
+            });
+            let v0 = [SVector::<f64, 3>::new(draw(), draw(), draw())];
+            let conditions = |rows: &[Contact<f64, 3>], v: &SVector<f64, 3>| {
+                rows.iter().fold(0.0_f64, |m, c| {
+                    let (l, a) = (c.normal.lambda, c.normal.j[0].dot(v) - c.lower);
+                    m.max(-l).max(-a).max((l * a).abs())
+                })
+            };
+            let mut gs = (rows, v0);
+            let order = [0_u32, 1, 2];
+            crate::world::solve::sweep(
+                &mut gs.1,
+                &mut gs.0,
+                &locks,
+                &order,
+                0.0,
+                32,
+                Phase::Velocity,
+                true,
+            );
+            swept = swept.max(conditions(&gs.0, &gs.1[0]));
+            let before: [f64; 3] = core::array::from_fn(|k| rows[k].normal.lambda);
+            let mut v = v0;
+            settle(&mut v, &mut rows, &locks, 0, Phase::Velocity, 0, true);
+            worst = worst.max(conditions(&rows, &v[0]));
+            let moved = rows
+                .iter()
+                .zip(before)
+                .fold(v0[0], |x, (c, l)| x + c.normal.b[0] * (c.normal.lambda - l));
+            assert!((moved - v[0]).amax() < 1e-12, "{moved} {}", v[0]);
+        }
+        assert!(worst < 1e-12, "{worst:e}");
+        assert!(swept > 1e-3, "{swept:e}");
+    }
+
+    /// Rows the exact method cannot solve (two opposed rows of one coordinate, both asked to
+    /// move it faster than it moves: no impulses reach both) are swept `fallback` times
+    /// instead: their impulses grow with each sweep, and with none they are as they were.
+    #[test]
+    fn rows_with_no_solution_are_swept() {
+        let inverse = Matrix3::identity();
+        let locks = Locks::<f64, 1>::new();
+        let e0 = SVector::<f64, 3>::new(1.0, 0.0, 0.0);
+        let opposed = || {
+            [
+                own(0, e0, &inverse, 1.0, 0.0),
+                own(1, -e0, &inverse, 1.0, 0.0),
+            ]
+        };
+        let mut taken = [0.0; 2];
+        for (fallback, slot) in [0_u32, 4].into_iter().zip(&mut taken) {
+            let mut rows = opposed();
+            let mut v = [SVector::<f64, 3>::zeros()];
+            settle(
+                &mut v,
+                &mut rows,
+                &locks,
+                0,
+                Phase::Velocity,
+                fallback,
+                true,
+            );
+            *slot = rows[0].normal.lambda + rows[1].normal.lambda;
+        }
+        assert_eq!(taken[0], 0.0);
+        assert!(taken[1] > 4.0, "{taken:?}");
+    }
+}
