@@ -146,20 +146,12 @@ fn exactly<T: Real, const N: usize>(
 #[cfg(test)]
 mod tests {
     use super::settle;
+    use crate::world::limits::MAX_OWN_ROWS;
     use crate::world::locks::Locks;
     use crate::world::rows::{Contact, Phase, Row};
+    use crate::world::solve::tests::draws;
     use crate::world::OWN_ROWS;
     use lagrange_core::nalgebra::{Matrix3, SVector};
-
-    /// Uniform draws in `[-0.5, 0.5)` from a xorshift generator seeded with `seed`.
-    fn draws(mut seed: u64) -> impl FnMut() -> f64 {
-        move || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        }
-    }
 
     /// Row `row` of body 0's own: Jacobian `j`, mobility `inverse j` (`inverse` the mass
     /// matrix's), lowest speed `lower`, impulse `lambda` already taken.
@@ -279,5 +271,24 @@ mod tests {
         }
         assert_eq!(taken[0], 0.0);
         assert!(taken[1] > 4.0, "{taken:?}");
+    }
+
+    /// A body with as many own rows as a body may have ([`MAX_OWN_ROWS`]), one of them
+    /// closing (the others far open, their lowest speeds far below): the exact solve takes
+    /// them all (the closing row stops, to 1e-12), not the fallback.
+    #[test]
+    fn a_body_with_all_its_rows_is_solved_exactly() {
+        let inverse = coupled();
+        let locks = Locks::<f64, 1>::new();
+        let mut rows: [Contact<f64, 3>; MAX_OWN_ROWS] = core::array::from_fn(|k| {
+            let mut j = SVector::<f64, 3>::zeros();
+            j[k % 3] = 1.0;
+            let lower = if k == 0 { 0.0 } else { -1e3 };
+            own(k as u32, j, &inverse, lower, 0.0)
+        });
+        let mut v = [SVector::<f64, 3>::new(-1.0, 0.5, 0.2)];
+        settle(&mut v, &mut rows, &locks, 0, Phase::Velocity, 0, true);
+        assert!(v[0][0].abs() < 1e-12, "{}", v[0]);
+        assert!(rows[0].normal.lambda > 0.0);
     }
 }

@@ -457,7 +457,7 @@ fn interleaved<T: Real, const N: usize, const B: usize, const K: usize>(
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::{sweep, Order, Ordered, Run};
     use crate::world::locks::Locks;
     use crate::world::rows::{Contact, Part, Phase, Row};
@@ -485,7 +485,7 @@ mod tests {
     }
 
     /// Uniform draws in `[-0.5, 0.5)` from a xorshift generator seeded with `seed`.
-    fn draws(mut seed: u64) -> impl FnMut() -> f64 {
+    pub(crate) fn draws(mut seed: u64) -> impl FnMut() -> f64 {
         move || {
             seed ^= seed << 13;
             seed ^= seed >> 7;
