@@ -40,14 +40,6 @@ use solve::{Order, Ordered};
 /// or half-plane may take.
 pub(crate) const OWN_ROWS: u32 = u32::MAX;
 
-/// The sweeps over a body's own rows alone after each solve, per sweep of the settings, where
-/// their exact solve (see `own`) fails: a body's rows are coupled through its mass matrix
-/// (a ragdoll's hand and torso differ 20 times in mass), and they are few and cheap (one dot
-/// product of `N` a row). Measured on ten ragdolls thrown into a pile at 60 Hz, 8 sweeps,
-/// when they were all there was: limits passed by 0.038 rad at worst with one, 0.0051 with
-/// four (the slop is 0.005).
-const OWN_SWEEPS: u32 = 4;
-
 /// Static half-planes a world holds at most (floors and walls).
 pub const MAX_PLANES: usize = 8;
 
@@ -911,7 +903,7 @@ where
 
 /// The impulse solve of `phase` over `contacts` in `order`: `sweeps` sweeps over every row,
 /// then the bodies' own rows solved exactly with the others held (`own`; where that fails,
-/// [`OWN_SWEEPS`] times as many sweeps over them): a joint's limit has the last word over
+/// sweeps over them alone): a joint's limit has the last word over
 /// the contacts that strike its limb (their leftover depth is the drift's to remove; a limit
 /// passed is what a viewer sees).
 fn sweep<T: Real, const N: usize, const B: usize, const K: usize>(
@@ -927,15 +919,7 @@ fn sweep<T: Real, const N: usize, const B: usize, const K: usize>(
     );
     if !order.own.is_empty() {
         let first = contacts.partition_point(|c| c.key.0 != OWN_ROWS);
-        own::settle(
-            v,
-            contacts,
-            locks,
-            first,
-            phase,
-            OWN_SWEEPS * sweeps,
-            locking,
-        );
+        own::settle(v, contacts, locks, first, phase, sweeps, locking);
     }
 }
 

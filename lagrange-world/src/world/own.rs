@@ -26,9 +26,18 @@ use lagrange_core::constraints::contact::{Delassus, Row as Kind};
 use lagrange_core::nalgebra::{SMatrix, SVector};
 use lagrange_core::Real;
 
+/// The sweeps over a body's own rows alone after each solve, per sweep of the settings, where
+/// their exact solve (below) fails: a body's rows are coupled through its mass matrix
+/// (a ragdoll's hand and torso differ 20 times in mass), and they are few and cheap (one dot
+/// product of `N` a row). Measured on ten ragdolls thrown into a pile at 60 Hz, 8 sweeps,
+/// when they were all there was: limits passed by 0.038 rad at worst with one, 0.0051 with
+/// four (the slop is 0.005).
+const OWN_SWEEPS: u32 = 4;
+
 /// The own rows of every body, `contacts[own..]` (their keys put them last, each body's
 /// together), solved exactly in `phase`, one body at a time, at the velocities `v`; a body
-/// whose exact solve fails takes `fallback` sweeps over its rows instead.
+/// whose exact solve fails takes [`OWN_SWEEPS`] times `sweeps` sweeps over its rows
+/// instead.
 #[allow(clippy::too_many_arguments)]
 #[inline(never)]
 pub(crate) fn settle<T: Real, const N: usize, const B: usize>(
@@ -37,7 +46,7 @@ pub(crate) fn settle<T: Real, const N: usize, const B: usize>(
     locks: &Locks<T, B>,
     own: usize,
     phase: Phase,
-    fallback: u32,
+    sweeps: u32,
     locking: bool,
 ) {
     if own >= contacts.len() {
@@ -71,7 +80,7 @@ pub(crate) fn settle<T: Real, const N: usize, const B: usize>(
                 locks,
                 &order,
                 T::zero(),
-                fallback,
+                OWN_SWEEPS * sweeps,
                 phase,
                 locking,
             );
@@ -241,36 +250,26 @@ mod tests {
     }
 
     /// Rows the exact method cannot solve (two opposed rows of one coordinate, both asked to
-    /// move it faster than it moves: no impulses reach both) are swept `fallback` times
-    /// instead: their impulses grow with each sweep, and with none they are as they were.
+    /// move it at unit speed its way: no impulses reach both) are swept [`OWN_SWEEPS`] times
+    /// `sweeps` instead. Each sweep moves the coordinate to `+1` and back to `-1` (a unit
+    /// mass): the first row takes 1 then 2 a sweep, the second 2 a sweep, `4 s - 1` in all
+    /// after `s` sweeps, exactly; with no sweeps asked, none.
     #[test]
     fn rows_with_no_solution_are_swept() {
         let inverse = Matrix3::identity();
         let locks = Locks::<f64, 1>::new();
         let e0 = SVector::<f64, 3>::new(1.0, 0.0, 0.0);
-        let opposed = || {
-            [
+        for sweeps in [0_u32, 2] {
+            let mut rows = [
                 own(0, e0, &inverse, 1.0, 0.0),
                 own(1, -e0, &inverse, 1.0, 0.0),
-            ]
-        };
-        let mut taken = [0.0; 2];
-        for (fallback, slot) in [0_u32, 4].into_iter().zip(&mut taken) {
-            let mut rows = opposed();
+            ];
             let mut v = [SVector::<f64, 3>::zeros()];
-            settle(
-                &mut v,
-                &mut rows,
-                &locks,
-                0,
-                Phase::Velocity,
-                fallback,
-                true,
-            );
-            *slot = rows[0].normal.lambda + rows[1].normal.lambda;
+            settle(&mut v, &mut rows, &locks, 0, Phase::Velocity, sweeps, true);
+            let s = f64::from(super::OWN_SWEEPS * sweeps);
+            let expected = if sweeps == 0 { 0.0 } else { 4.0 * s - 1.0 };
+            assert_eq!(rows[0].normal.lambda + rows[1].normal.lambda, expected);
         }
-        assert_eq!(taken[0], 0.0);
-        assert!(taken[1] > 4.0, "{taken:?}");
     }
 
     /// A body with as many own rows as a body may have ([`MAX_OWN_ROWS`]), one of them
