@@ -80,7 +80,7 @@ pub(crate) fn settle<T: Real, const N: usize, const B: usize>(
                 locks,
                 &order,
                 T::zero(),
-                OWN_SWEEPS * sweeps,
+                OWN_SWEEPS.saturating_mul(sweeps),
                 phase,
                 locking,
             );
