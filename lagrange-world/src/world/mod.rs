@@ -593,7 +593,7 @@ where
         // The order of the contacts' bodies decides it: a pile at rest takes the last one
         // (read where it is kept, not copied: a copy is the size of the capacity, every
         // step, asleep or not).
-        self.ordered.of::<T, N, B>(&self.contacts, own);
+        self.ordered.of::<T, N, B>(&self.contacts);
         report.guarded = self.solve();
         profile.solve = watch.lap();
         let mut pseudo = [SVector::<T, N>::zeros(); B];
@@ -917,10 +917,10 @@ fn sweep<T: Real, const N: usize, const B: usize, const K: usize>(
     solve::sweep(
         v, contacts, locks, &order.all, friction, sweeps, phase, locking,
     );
-    if !order.own.is_empty() {
-        let first = contacts.partition_point(|c| c.key.0 != OWN_ROWS);
-        own::settle(v, contacts, locks, first, phase, sweeps, locking);
-    }
+    // Each body's own rows come last (their keys' first part is OWN_ROWS); `settle` does
+    // nothing where there are none.
+    let first = contacts.partition_point(|c| c.key.0 != OWN_ROWS);
+    own::settle(v, contacts, locks, first, phase, sweeps, locking);
 }
 
 /// Whether shape `key` of `shapes` (sorted by key) is on a sleeping body of `bodies`.

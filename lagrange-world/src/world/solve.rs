@@ -309,44 +309,32 @@ const NONE: u32 = u32::MAX;
 pub(crate) struct Order<const K: usize> {
     /// Every contact.
     pub(crate) all: Vec<u32, K>,
-    /// The bodies' own rows alone (solved again after the others: see `World::sweep`).
-    pub(crate) own: Vec<u32, K>,
 }
 
 impl<const K: usize> Order<K> {
-    /// The order of `contacts` (sorted by key, the bodies' own rows, from `own` on, last)
-    /// of a world of `B` bodies.
-    pub(crate) fn of<T: Real, const N: usize, const B: usize>(
-        contacts: &[Contact<T, N>],
-        own: usize,
-    ) -> Self {
+    /// The order of `contacts` (sorted by key) of a world of `B` bodies.
+    pub(crate) fn of<T: Real, const N: usize, const B: usize>(contacts: &[Contact<T, N>]) -> Self {
         Self {
-            all: interleaved::<T, N, B, K>(contacts, 0),
-            own: interleaved::<T, N, B, K>(contacts, own),
+            all: interleaved::<T, N, B, K>(contacts),
         }
     }
 }
 
-/// The last [`Order`] made and what it was made of (each contact's bodies, in order, and
-/// where the bodies' own rows began): an order depends on nothing else, so contacts that
-/// join the same bodies in the same order (a pile at rest, step after step) take it again.
+/// The last [`Order`] made and what it was made of (each contact's bodies, in order): an
+/// order depends on nothing else, so contacts that join the same bodies in the same order
+/// (a pile at rest, step after step) take it again.
 #[derive(Debug, Clone)]
 pub(crate) struct Ordered<const K: usize> {
     order: Order<K>,
     bodies: Vec<[u32; 2], K>,
-    own: usize,
 }
 
 impl<const K: usize> Ordered<K> {
     /// None made yet.
     pub(crate) fn new() -> Self {
         Self {
-            order: Order {
-                all: Vec::new(),
-                own: Vec::new(),
-            },
+            order: Order { all: Vec::new() },
             bodies: Vec::new(),
-            own: 0,
         }
     }
 
@@ -355,50 +343,46 @@ impl<const K: usize> Ordered<K> {
         &self.order
     }
 
-    /// The order of `contacts`, their own rows from `own` on, in a world of `B` bodies:
-    /// [`Order::of`] them, or the last one where it was made of the same bodies.
+    /// The order of `contacts` in a world of `B` bodies: [`Order::of`] them, or the last
+    /// one where it was made of the same bodies.
     pub(crate) fn of<T: Real, const N: usize, const B: usize>(
         &mut self,
         contacts: &[Contact<T, N>],
-        own: usize,
     ) -> &Order<K> {
         // A body's index as stored (bodies are fewer than u32::MAX: none is `u32::MAX`).
         let packed = |c: &Contact<T, N>| {
             c.bodies
                 .map(|b| b.map_or(u32::MAX, |i| u32::try_from(i).unwrap_or(u32::MAX - 1)))
         };
-        let same = self.own == own
-            && self.bodies.len() == contacts.len()
+        let same = self.bodies.len() == contacts.len()
             && contacts
                 .iter()
                 .zip(&self.bodies)
                 .all(|(c, b)| packed(c) == *b);
         if !same {
-            self.order = Order::of::<T, N, B>(contacts, own);
+            self.order = Order::of::<T, N, B>(contacts);
             self.bodies.clear();
             for c in contacts {
                 // Capacity K holds every contact of a step.
                 let _ = self.bodies.push(packed(c));
             }
-            self.own = own;
         }
         &self.order
     }
 }
 
-/// The contacts from `first` on, interleaved (see [`Order`]).
+/// The contacts, interleaved (see [`Order`]).
 fn interleaved<T: Real, const N: usize, const B: usize, const K: usize>(
     contacts: &[Contact<T, N>],
-    first: usize,
 ) -> Vec<u32, K> {
-    if first >= contacts.len() {
+    if contacts.is_empty() {
         return Vec::new();
     }
     // Each body's contacts as a list: `front[body]` its first not yet taken, then
     // `after[side][c]` after contact `c` on that side (built from the last back).
     let mut front = [NONE; B];
     let mut after = [[NONE; K]; 2];
-    for (c, contact) in contacts.iter().enumerate().skip(first).rev() {
+    for (c, contact) in contacts.iter().enumerate().rev() {
         for (side, body) in contact.bodies.iter().enumerate() {
             let (Some(head), Some(next)) = (
                 body.and_then(|b| front.get_mut(b)),
@@ -413,7 +397,7 @@ fn interleaved<T: Real, const N: usize, const B: usize, const K: usize>(
     let bodies = |c: usize| contacts.get(c).map_or([None; 2], |c| c.bodies);
     let mut order = Vec::new();
     let mut window: Vec<usize, AHEAD> = Vec::new();
-    let mut next = first;
+    let mut next = 0;
     let mut last = [[None; 2]; APART];
     loop {
         while !window.is_full() && next < contacts.len() {
@@ -514,7 +498,7 @@ pub(crate) mod tests {
     /// Rows of bodies apart go one after another: of contacts between bodies (0, 1), (0, 2)
     /// and (3, 4), the third (ready: no contact before it shares a body with it) goes before
     /// the second (which shares body 0 with the first); a contact with no body before it
-    /// that shares one goes in its keys' place; the own rows alone from their first.
+    /// that shares one goes in its keys' place.
     #[test]
     fn rows_of_bodies_apart_take_turns() {
         let mut draw = || 0.25;
@@ -524,9 +508,8 @@ pub(crate) mod tests {
             contact([Some(3), Some(4)], &mut draw),
             contact([Some(2), None], &mut draw),
         ];
-        let order = Order::<8>::of::<f64, 2, 6>(&contacts, 2);
+        let order = Order::<8>::of::<f64, 2, 6>(&contacts);
         assert_eq!(order.all.as_slice(), &[0, 2, 1, 3]);
-        assert_eq!(order.own.as_slice(), &[2, 3]);
     }
 
     /// A contact's two rows taken at once (`pair`, on a copy of the two bodies' velocities)
@@ -629,42 +612,36 @@ pub(crate) mod tests {
         }
     }
 
-    /// A kept order serves only contacts of the same bodies with their own rows from the
-    /// same place: over 200 steps of contacts kept, drawn again (as many, or more), their
-    /// own rows moved, or one contact's body changed, the kept order is the one made afresh.
+    /// A kept order serves only contacts of the same bodies: over 200 steps of contacts
+    /// kept, drawn again (as many, or more), or one contact's body changed, the kept order is
+    /// the one made afresh.
     #[test]
     fn a_kept_order_is_that_of_the_same_bodies() {
         let mut draw = draws(0x5851_f42d_4c95_7f2d);
         let mut ordered = Ordered::<64>::new();
-        let (mut count, mut own) = (20, 5);
+        let mut count = 20;
         let mut contacts = random_contacts::<64>(count, &mut draw);
         for round in 0..200 {
-            match round % 5 {
+            match round % 4 {
                 0 => {}
                 1 => contacts = random_contacts::<64>(count, &mut draw),
                 2 => {
                     count = 1 + round % 40;
                     contacts = random_contacts::<64>(count, &mut draw);
                 }
-                3 => own = round % (count + 1),
                 _ => {
                     let last = count - 1;
                     contacts[last].bodies[1] = Some((round % 6 + 1) % 6);
                 }
             }
-            own = own.min(count);
-            let kept = ordered.of::<f64, 2, 6>(&contacts, own).clone();
-            let fresh = Order::<64>::of::<f64, 2, 6>(&contacts, own);
-            assert_eq!(
-                (kept.all, kept.own),
-                (fresh.all, fresh.own),
-                "round {round}"
-            );
+            let kept = ordered.of::<f64, 2, 6>(&contacts).clone();
+            let fresh = Order::<64>::of::<f64, 2, 6>(&contacts);
+            assert_eq!(kept.all, fresh.all, "round {round}");
         }
     }
 
     /// Over 200 random sets of contacts among 6 bodies (some on static geometry), the
-    /// interleaved order takes every contact once, from `first` on, and its sweeps give the
+    /// interleaved order takes every contact once, and its sweeps give the
     /// keys' order's bits.
     #[test]
     fn the_interleaved_order_is_the_keys_bits() {
@@ -672,14 +649,10 @@ pub(crate) mod tests {
         for round in 0..200 {
             let count = 1 + round % 40;
             let mut contacts = random_contacts::<64>(count, &mut draw);
-            let own = round % (count + 1);
-            let order = Order::<64>::of::<f64, 2, 6>(&contacts, own);
+            let order = Order::<64>::of::<f64, 2, 6>(&contacts);
             let mut all = order.all.clone();
             all.sort_unstable();
             assert!(all.iter().copied().eq(0..count as u32), "{all:?}");
-            let mut rest = order.own.clone();
-            rest.sort_unstable();
-            assert!(rest.iter().copied().eq(own as u32..count as u32));
             let keys: heapless::Vec<u32, 64> = (0..count as u32).collect();
             let start = [0; 6].map(|_| SVector::<f64, 2>::new(draw(), draw()));
             let (mut v, mut w) = (start, start);
