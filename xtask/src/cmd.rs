@@ -54,7 +54,14 @@ pub fn cargo() -> Command {
 pub fn run(command: &mut Command) -> Result<(), String> {
     let shown = format!("{command:?}").replace('"', "");
     println!("$ {shown}");
-    match command.status() {
+    let start = std::time::Instant::now();
+    let status = command.status();
+    // Each command's wall time, so that a CI run's log says where its minutes went.
+    let seconds = start.elapsed().as_secs_f64();
+    if seconds >= 1.0 {
+        println!("  ({seconds:.0} s)");
+    }
+    match status {
         Ok(s) if s.success() => Ok(()),
         Ok(s) => Err(format!("failed ({s}): {shown}")),
         Err(e) => Err(format!("could not start ({e}): {shown}")),

@@ -274,23 +274,34 @@ fn targets_with_ignored(dir: &std::path::Path) -> Result<Vec<String>, String> {
     Ok(targets)
 }
 
-/// Everything CI checks; every step runs and every failure is reported at the end.
+/// A step of CI: what it is called in the log, and what it runs.
+type Step<'a> = (&'a str, &'a dyn Fn() -> Result<(), String>);
+
+/// Everything CI checks; every step runs and every failure is reported at the end, with
+/// each step's wall time (CI's budget is 20 minutes on an idle 2-core machine).
 fn ci() -> Result<(), String> {
-    let failures: Vec<String> = [
-        cmd::run_all(&CHECKS),
-        publish::run(),
-        cmd::run_all(&TEST),
-        cmd::run_all(&DOC_TEST),
-        long_test(),
-        derive::check(),
-        cross::run(),
-        qemu::run(),
-        web::run(&["--test".to_string()]),
-        guide::run(&[]),
-    ]
-    .into_iter()
-    .filter_map(Result::err)
-    .collect();
+    let steps: [Step; 10] = [
+        ("checks", &|| cmd::run_all(&CHECKS)),
+        ("publish", &publish::run),
+        ("tests", &|| cmd::run_all(&TEST)),
+        ("doc tests", &|| cmd::run_all(&DOC_TEST)),
+        ("long tests", &long_test),
+        ("derive", &derive::check),
+        ("cross", &cross::run),
+        ("qemu", &qemu::run),
+        ("web", &|| web::run(&["--test".to_string()])),
+        ("guide", &|| guide::run(&[])),
+    ];
+    let mut failures = Vec::new();
+    let mut times = Vec::new();
+    for (name, step) in steps {
+        let start = std::time::Instant::now();
+        if let Err(e) = step() {
+            failures.push(e);
+        }
+        times.push(format!("{name} {:.0} s", start.elapsed().as_secs_f64()));
+    }
+    println!("xtask ci: {}", times.join(", "));
     if failures.is_empty() {
         println!("xtask ci: all steps passed");
         Ok(())
