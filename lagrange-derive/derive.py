@@ -677,6 +677,8 @@ class Derivation:
         for what, e in [("M", x) for x in self.M] + [("f", x) for x in self.f]:
             check_supported(e, what)
         self.explicit_time = s.t in T.free_symbols
+        # READS_TIME's default is true (the safe answer); a Lagrangian free of t says false.
+        self.reads_time = s.t in (T.free_symbols | V.free_symbols)
         self.driven = self.explicit_time or s.t in V.free_symbols or (
             self.Q is not None and any(s.t in e.free_symbols for e in self.Q)
         )
@@ -1526,7 +1528,9 @@ class Generator:
             o.append("    const CONSTANT_MASS: bool = true;")
         if d.driven and not d.explicit_time:
             o.append("    const DRIVEN: bool = true;")
-        if d.explicit_time or d.constant_mass or (d.driven and not d.explicit_time):
+        if not d.reads_time:
+            o.append("    const READS_TIME: bool = false;")
+        if d.explicit_time or d.constant_mass or d.driven or not d.reads_time:
             o.append("")
 
         def arg(name, block, symbols):

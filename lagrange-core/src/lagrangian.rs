@@ -68,6 +68,16 @@ pub trait Lagrangian<T: Real, const N: usize> {
     /// A scene never puts a driven mechanism to sleep by default.
     const DRIVEN: bool = Self::EXPLICIT_TIME;
 
+    /// Whether `T` or `V` reads the time `t`: `true` unless the type says otherwise (the safe
+    /// answer). Answer `false` only when [`Lagrangian::kinetic`] and
+    /// [`Lagrangian::potential`] give the same at every `t` (then
+    /// [`Lagrangian::EXPLICIT_TIME`] is `false` too); the library then knows that `dL/dt` at
+    /// fixed `q` and `q'` is zero without evaluating it (an impulse stepper's energy guard
+    /// evaluates `L` in dual numbers of `t` otherwise, twice in a step it acts in). A force
+    /// that changes with time ([`Lagrangian::non_conservative_force`]) does not make `L` read
+    /// it.
+    const READS_TIME: bool = true;
+
     /// Every term of `L` that depends on the velocities: the kinetic energy `T(t, q, q')`.
     fn kinetic<S: Scalar<Real = T>>(&self, t: S, q: &SVector<S, N>, qd: &SVector<S, N>) -> S;
 
@@ -353,6 +363,7 @@ impl<T: Real, const N: usize, L: Lagrangian<T, N>> Lagrangian<T, N> for EulerLag
     const EXPLICIT_TIME: bool = L::EXPLICIT_TIME;
     const CONSTANT_MASS: bool = L::CONSTANT_MASS;
     const DRIVEN: bool = L::DRIVEN;
+    const READS_TIME: bool = L::READS_TIME;
     fn kinetic<S: Scalar<Real = T>>(&self, t: S, q: &SVector<S, N>, qd: &SVector<S, N>) -> S {
         self.lagrangian.kinetic(t, q, qd)
     }

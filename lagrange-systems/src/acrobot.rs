@@ -338,6 +338,7 @@ impl<T: Real> Mechanism<T, 2> for Acrobot<T> {
 }
 
 impl<T: Real> Lagrangian<T, 2> for Acrobot<T> {
+    const READS_TIME: bool = false;
     /// Each link's `m |v_c|^2 / 2` with the Cartesian velocity of its centre of mass, plus its
     /// spin `i w^2 / 2` at its absolute rate (`th1'`, `th1' + th2'`).
     fn kinetic<S: Scalar<Real = T>>(&self, _t: S, q: &SVector<S, 2>, qd: &SVector<S, 2>) -> S {

@@ -129,6 +129,7 @@ impl<T: Real> Mechanism<T, 1> for BeadOnRotatingHoop<T> {
 }
 
 impl<T: Real> Lagrangian<T, 1> for BeadOnRotatingHoop<T> {
+    const READS_TIME: bool = false;
     /// The hoop is kept spinning: `T + V` is not conserved (the Jacobi integral is).
     const DRIVEN: bool = true;
     fn kinetic<S: Scalar<Real = T>>(&self, _t: S, q: &SVector<S, 1>, qd: &SVector<S, 1>) -> S {

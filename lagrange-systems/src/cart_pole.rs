@@ -231,6 +231,7 @@ impl<T: Real> Mechanism<T, 2> for CartPole<T> {
 }
 
 impl<T: Real> Lagrangian<T, 2> for CartPole<T> {
+    const READS_TIME: bool = false;
     /// The cart's `M x'^2 / 2`, the pole's `m |v_c|^2 / 2` with the Cartesian velocity of its
     /// centre of mass, and its spin `(m l^2 / 3) th'^2 / 2`.
     fn kinetic<S: Scalar<Real = T>>(&self, _t: S, q: &SVector<S, 2>, qd: &SVector<S, 2>) -> S {

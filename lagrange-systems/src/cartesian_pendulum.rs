@@ -149,6 +149,7 @@ impl<T: Real> HolonomicConstraints<T, 2, 1> for CartesianPendulum<T> {
 
 /// The free particle, for the automatic Euler-Lagrange check.
 impl<T: Real> Lagrangian<T, 2> for CartesianPendulum<T> {
+    const READS_TIME: bool = false;
     fn kinetic<S: Scalar<Real = T>>(&self, _t: S, _q: &SVector<S, 2>, qd: &SVector<S, 2>) -> S {
         S::from_real(T::HALF * self.mass) * (qd[0] * qd[0] + qd[1] * qd[1])
     }

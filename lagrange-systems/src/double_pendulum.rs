@@ -241,6 +241,7 @@ impl<T: Real> Mechanism<T, 2> for DoublePendulum<T> {
 }
 
 impl<T: Real> Lagrangian<T, 2> for DoublePendulum<T> {
+    const READS_TIME: bool = false;
     fn kinetic<S: Scalar<Real = T>>(&self, _t: S, q: &SVector<S, 2>, qd: &SVector<S, 2>) -> S {
         let mu_l1l1 = S::from_real(T::HALF * (self.m1 + self.m2) * self.l1 * self.l1);
         let m2_l2l2 = S::from_real(T::HALF * self.m2 * self.l2 * self.l2);

@@ -165,6 +165,7 @@ impl<T: Real> Mechanism<T, 2> for ElasticPendulum<T> {
 }
 
 impl<T: Real> Lagrangian<T, 2> for ElasticPendulum<T> {
+    const READS_TIME: bool = false;
     /// `m |v|^2 / 2` with the Cartesian velocity of the mass.
     fn kinetic<S: Scalar<Real = T>>(&self, _t: S, q: &SVector<S, 2>, qd: &SVector<S, 2>) -> S {
         let (r, rd, thd) = (q[0], qd[0], qd[1]);

@@ -110,6 +110,7 @@ impl<T: Real> Mechanism<T, 1> for FallingParticle<T> {
 }
 
 impl<T: Real> Lagrangian<T, 1> for FallingParticle<T> {
+    const READS_TIME: bool = false;
     fn kinetic<S: Scalar<Real = T>>(&self, _t: S, _q: &SVector<S, 1>, qd: &SVector<S, 1>) -> S {
         S::from_real(T::HALF * self.mass) * qd[0] * qd[0]
     }

@@ -391,6 +391,7 @@ impl<T: Real> HolonomicConstraints<T, 3, 2> for FourBarLinkage<T> {
 /// The open chain (crank and coupler as a double pendulum, rocker as a pendulum), for the
 /// automatic Euler-Lagrange check.
 impl<T: Real> Lagrangian<T, 3> for FourBarLinkage<T> {
+    const READS_TIME: bool = false;
     fn kinetic<S: Scalar<Real = T>>(&self, _t: S, q: &SVector<S, 3>, qd: &SVector<S, 3>) -> S {
         let (i1, i2, i3, k) = self.inertias();
         let h = |x: T| S::from_real(T::HALF * x);

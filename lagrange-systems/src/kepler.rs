@@ -125,6 +125,7 @@ impl<T: Real> Mechanism<T, 2> for Kepler<T> {
 }
 
 impl<T: Real> Lagrangian<T, 2> for Kepler<T> {
+    const READS_TIME: bool = false;
     /// `|v|^2 / 2` with the Cartesian velocity `d/dt (r cos phi, r sin phi)`.
     fn kinetic<S: Scalar<Real = T>>(&self, _t: S, q: &SVector<S, 2>, qd: &SVector<S, 2>) -> S {
         let (r, rd, phid) = (q[0], qd[0], qd[1]);

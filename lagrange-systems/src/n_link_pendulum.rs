@@ -436,6 +436,7 @@ impl<T: Real, const N: usize> Mechanism<T, N> for NLinkPendulum<T, N> {
 }
 
 impl<T: Real, const N: usize> Lagrangian<T, N> for NLinkPendulum<T, N> {
+    const READS_TIME: bool = false;
     /// `sum_i m_i |v_i|^2 / 2` with the Cartesian velocity `v_i` of each mass.
     fn kinetic<S: Scalar<Real = T>>(&self, _t: S, q: &SVector<S, N>, qd: &SVector<S, N>) -> S {
         let (mut vx, mut vy, mut t) = (S::zero(), S::zero(), S::zero());

@@ -865,6 +865,7 @@ impl<T: Real> Ragdoll<T> {
 }
 
 impl<T: Real> Lagrangian<T, RAGDOLL_COORDINATES> for Ragdoll<T> {
+    const READS_TIME: bool = false;
     /// `sum_k (m_k |v_k|^2 + I_k w_k^2) / 2`, each link's centre-of-mass velocity from its
     /// parent's: `v = v_parent + w_parent x (o - o_parent)` at the joint `o`, then
     /// `+ w x (c - o)` to the centre of mass `c`.

@@ -188,6 +188,7 @@ impl<T: Real> Mechanism<T, 3> for RigidBody<T> {
 }
 
 impl<T: Real> Lagrangian<T, 3> for RigidBody<T> {
+    const READS_TIME: bool = false;
     fn kinetic<S: Scalar<Real = T>>(&self, _t: S, _q: &SVector<S, 3>, qd: &SVector<S, 3>) -> S {
         S::from_real(T::HALF * self.mass) * (qd[0] * qd[0] + qd[1] * qd[1])
             + S::from_real(T::HALF * self.inertia) * qd[2] * qd[2]

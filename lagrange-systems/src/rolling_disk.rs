@@ -152,6 +152,7 @@ impl<T: Real> PfaffianConstraints<T, 4, 2> for RollingDisk<T> {
 
 /// The free disk, for the automatic Euler-Lagrange check.
 impl<T: Real> Lagrangian<T, 4> for RollingDisk<T> {
+    const READS_TIME: bool = false;
     fn kinetic<S: Scalar<Real = T>>(&self, _t: S, _q: &SVector<S, 4>, qd: &SVector<S, 4>) -> S {
         let i = self.inertias();
         let mut t = S::zero();

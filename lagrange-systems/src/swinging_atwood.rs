@@ -145,6 +145,7 @@ impl<T: Real> Mechanism<T, 2> for SwingingAtwood<T> {
 }
 
 impl<T: Real> Lagrangian<T, 2> for SwingingAtwood<T> {
+    const READS_TIME: bool = false;
     /// The big mass moves at `r'`; the small one's Cartesian velocity is squared.
     fn kinetic<S: Scalar<Real = T>>(&self, _t: S, q: &SVector<S, 2>, qd: &SVector<S, 2>) -> S {
         let (r, rd, thd) = (q[0], qd[0], qd[1]);

@@ -136,6 +136,7 @@ where
     const EXPLICIT_TIME: bool = A::EXPLICIT_TIME || B::EXPLICIT_TIME;
     const CONSTANT_MASS: bool = A::CONSTANT_MASS && B::CONSTANT_MASS;
     const DRIVEN: bool = A::DRIVEN || B::DRIVEN;
+    const READS_TIME: bool = A::READS_TIME || B::READS_TIME;
 
     fn kinetic<S: Scalar<Real = T>>(&self, t: S, q: &SVector<S, N>, qd: &SVector<S, N>) -> S {
         match self {

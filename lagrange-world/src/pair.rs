@@ -110,6 +110,7 @@ where
     const EXPLICIT_TIME: bool = A::EXPLICIT_TIME || B::EXPLICIT_TIME;
     const CONSTANT_MASS: bool = A::CONSTANT_MASS && B::CONSTANT_MASS;
     const DRIVEN: bool = A::DRIVEN || B::DRIVEN;
+    const READS_TIME: bool = A::READS_TIME || B::READS_TIME;
 
     fn kinetic<S: Scalar<Real = T>>(&self, t: S, q: &SVector<S, N>, qd: &SVector<S, N>) -> S {
         let ((qa, qb), (va, vb)) = (split::<S, NA, NB, N>(q), split::<S, NA, NB, N>(qd));

@@ -142,6 +142,16 @@ where
         let e = relative([hand.energy(&s)], [auto.energy(&s)], scale.energy);
         assert!(e < tolerance, "energy at {s:?} ({e:e})");
         worst.energy = worst.energy.max(e);
+        // A Lagrangian that says it does not read the time gives the same `T` and `V`, bit
+        // for bit, at another time (an impulse stepper's guard takes its `dL/dt` as zero).
+        if !S::READS_TIME {
+            let later = s.t + T::from_f64(1234.5);
+            assert!(
+                hand.kinetic(later, &s.q, &s.qd) == hand.kinetic(s.t, &s.q, &s.qd)
+                    && hand.potential(later, &s.q) == hand.potential(s.t, &s.q),
+                "READS_TIME is false, but L changes with t at {s:?}"
+            );
+        }
     }
     Ok(worst)
 }

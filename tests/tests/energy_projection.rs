@@ -337,6 +337,7 @@ struct Recording<M, const N: usize> {
 
 impl<M: Mechanism<f64, N>, const N: usize> Lagrangian<f64, N> for Recording<M, N> {
     const DRIVEN: bool = M::DRIVEN;
+    const READS_TIME: bool = M::READS_TIME;
     fn kinetic<S: Scalar<Real = f64>>(&self, t: S, q: &SVector<S, N>, qd: &SVector<S, N>) -> S {
         self.inner.kinetic(t, q, qd)
     }

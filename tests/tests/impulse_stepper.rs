@@ -7,8 +7,8 @@
 use lagrange_core::constraints::contact::Contacts;
 use lagrange_core::nalgebra::{SMatrix, SVector};
 use lagrange_core::{
-    Constraints, Error, EulerLagrange, Holonomic, HolonomicConstraints, Lagrangian, Mechanism,
-    Real, Scalar, State,
+    Constraints, Error, EulerLagrange, GeneralizedForce, Holonomic, HolonomicConstraints,
+    Lagrangian, Mechanism, Real, Scalar, State,
 };
 use lagrange_integrators::scene::{Bank, Scene, Sleeps, Status};
 use lagrange_integrators::{
@@ -1261,6 +1261,94 @@ fn a_lift_is_paid_from_the_start_energy<T: Real>() -> Result<(), Error> {
     Ok(())
 }
 
+/// A mechanism that keeps [`Lagrangian::READS_TIME`]'s default (`true`) and is its inner
+/// mechanism in everything else (each method passed on, so that the bits are the same).
+#[derive(Clone, Copy)]
+struct SaysItReadsTime<M>(M);
+
+impl<T: Real, const N: usize, M: Lagrangian<T, N>> Lagrangian<T, N> for SaysItReadsTime<M> {
+    const EXPLICIT_TIME: bool = M::EXPLICIT_TIME;
+    const CONSTANT_MASS: bool = M::CONSTANT_MASS;
+    const DRIVEN: bool = M::DRIVEN;
+    fn kinetic<S: Scalar<Real = T>>(&self, t: S, q: &SVector<S, N>, qd: &SVector<S, N>) -> S {
+        self.0.kinetic(t, q, qd)
+    }
+    fn potential<S: Scalar<Real = T>>(&self, t: S, q: &SVector<S, N>) -> S {
+        self.0.potential(t, q)
+    }
+    fn non_conservative_force(&self, state: &State<T, N>) -> SVector<T, N> {
+        self.0.non_conservative_force(state)
+    }
+}
+
+impl<T: Real, const N: usize, M: Mechanism<T, N>> Mechanism<T, N> for SaysItReadsTime<M> {
+    fn mass_matrix(&self, state: &State<T, N>) -> SMatrix<T, N, N> {
+        self.0.mass_matrix(state)
+    }
+    fn rhs(&self, state: &State<T, N>) -> SVector<T, N> {
+        self.0.rhs(state)
+    }
+    fn solve_mass(&self, state: &State<T, N>, b: &SVector<T, N>) -> Result<SVector<T, N>, Error> {
+        self.0.solve_mass(state, b)
+    }
+    fn law<F: GeneralizedForce<T, N>>(
+        &self,
+        state: &State<T, N>,
+        extra: &F,
+    ) -> Result<SVector<T, N>, Error> {
+        self.0.law(state, extra)
+    }
+    fn velocity_jump(
+        &self,
+        state: &State<T, N>,
+        impulse: &SVector<T, N>,
+    ) -> Result<SVector<T, N>, Error> {
+        self.0.velocity_jump(state, impulse)
+    }
+    fn velocity_jumps<const K: usize>(
+        &self,
+        state: &State<T, N>,
+        impulses: &mut SMatrix<T, N, K>,
+    ) -> Result<(), Error> {
+        self.0.velocity_jumps(state, impulses)
+    }
+}
+
+/// The ragdoll says that its Lagrangian does not read the time (`READS_TIME` false), and the
+/// energy guard then takes `dL/dt` as zero without evaluating it: the same bits as the
+/// evaluation (whose derivative in `t` is exactly zero) at every step of the bench's throw
+/// with restitution 1 and a hip driven at 30 N m (work the guard allows: taking the
+/// allowance as zero, not the push's power, changes the bits), in which the guard acts (in
+/// 8 and 9 steps of the two scalars; the test asks for one at least).
+fn saying_l_reads_no_time_changes_no_bits<T: Real>() -> Result<(), Error> {
+    const { assert!(!<Ragdoll<f64> as Lagrangian<f64, RAGDOLL_COORDINATES>>::READS_TIME) };
+    let doll = Ragdoll::new(RagdollBody::<T>::adult())?;
+    // A hip driven at 30 N m: work the guard must allow (its power, positive where the
+    // thigh turns with it).
+    let push = |_: &State<T, RAGDOLL_COORDINATES>| {
+        SVector::from_fn(|i, _| if i == 8 { T::from_f64(30.0) } else { T::zero() })
+    };
+    let says = doll.with_force(push);
+    let reads = SaysItReadsTime(doll).with_force(push);
+    let contacts = RagdollContacts::adult(&doll, T::zero())?;
+    let model = ContactModel::new(T::one(), T::from_f64(0.3), T::from_f64(1e-7))?
+        .with_friction(T::from_f64(0.8))?;
+    let settings = ImpulseSettings::new(T::from_f64(SLOP), 4)?;
+    let mut plain = ImpulseStepper::new(SemiImplicitEuler, contacts, model, settings);
+    let mut timed = plain;
+    let (mut a, mut b) = (thrown::<T>(), thrown::<T>());
+    let mut guarded = 0;
+    for _ in 0..1440 {
+        a = plain.step(&says, &a, T::from_f64(1.0 / 240.0))?;
+        b = timed.step(&reads, &b, T::from_f64(1.0 / 240.0))?;
+        assert!(a == b, "{a:?} against {b:?}");
+        guarded += u32::from(plain.last_report().energy_guard);
+    }
+    println!("the guard acted in {guarded} steps");
+    assert!(guarded > 0);
+    Ok(())
+}
+
 /// The guard's rounding allowance, both sides of it. A unit point sliding along the floor at
 /// 1 m/s under `V = g y + 32` (J), 1 mm + `d` deep (slop 1 mm): the drift lifts it by `d`,
 /// a gain of `g d`. The guard allows the start's energy plus 16 ulps of each of the sizes
@@ -2102,6 +2190,7 @@ for_f32_and_f64!(
     with_bilateral_holds_and_starts_afresh,
     law_acceleration_reads_a_step_from_rest,
     energy_that_time_adds_is_allowed,
+    saying_l_reads_no_time_changes_no_bits,
     a_lift_is_not_paid_for,
     a_lift_is_paid_from_the_start_energy,
     the_guard_allows_rounding_only,

@@ -52,6 +52,7 @@ impl<T: Real, const N: usize, M: Mechanism<T, N>> Lagrangian<T, N> for Counting<
     const EXPLICIT_TIME: bool = M::EXPLICIT_TIME;
     const CONSTANT_MASS: bool = M::CONSTANT_MASS;
     const DRIVEN: bool = M::DRIVEN;
+    const READS_TIME: bool = M::READS_TIME;
     fn kinetic<S: Scalar<Real = T>>(&self, t: S, q: &SVector<S, N>, qd: &SVector<S, N>) -> S {
         self.inner.kinetic(t, q, qd)
     }

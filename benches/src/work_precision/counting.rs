@@ -38,6 +38,7 @@ impl<'a, M> Counting<'a, M> {
 impl<T: Real, const N: usize, M: Lagrangian<T, N>> Lagrangian<T, N> for Counting<'_, M> {
     const EXPLICIT_TIME: bool = M::EXPLICIT_TIME;
     const DRIVEN: bool = M::DRIVEN;
+    const READS_TIME: bool = M::READS_TIME;
     fn kinetic<S: Scalar<Real = T>>(&self, t: S, q: &SVector<S, N>, qd: &SVector<S, N>) -> S {
         self.inner.kinetic(t, q, qd)
     }

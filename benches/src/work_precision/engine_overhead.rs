@@ -332,6 +332,7 @@ impl<'a, M, const N: usize> Recording<'a, M, N> {
 impl<M: Lagrangian<f64, N>, const N: usize> Lagrangian<f64, N> for Recording<'_, M, N> {
     const EXPLICIT_TIME: bool = M::EXPLICIT_TIME;
     const DRIVEN: bool = M::DRIVEN;
+    const READS_TIME: bool = M::READS_TIME;
     fn kinetic<S: Scalar<Real = f64>>(&self, t: S, q: &SVector<S, N>, qd: &SVector<S, N>) -> S {
         self.inner.kinetic(t, q, qd)
     }

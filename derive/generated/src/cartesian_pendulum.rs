@@ -68,6 +68,7 @@ lagrange_core::parameters! {
 
 impl<T: Real> Lagrangian<T, 2> for CartesianPendulum<T> {
     const CONSTANT_MASS: bool = true;
+    const READS_TIME: bool = false;
 
     fn kinetic<S: Scalar<Real = T>>(&self, _t: S, _q: &SVector<S, 2>, qd: &SVector<S, 2>) -> S {
         let x_d = qd[0];

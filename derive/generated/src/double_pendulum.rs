@@ -64,6 +64,8 @@ lagrange_core::parameters! {
 }
 
 impl<T: Real> Lagrangian<T, 2> for DoublePendulum<T> {
+    const READS_TIME: bool = false;
+
     fn kinetic<S: Scalar<Real = T>>(&self, _t: S, q: &SVector<S, 2>, qd: &SVector<S, 2>) -> S {
         let th1 = q[0];
         let th2 = q[1];

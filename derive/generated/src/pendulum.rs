@@ -57,6 +57,7 @@ lagrange_core::parameters! {
 
 impl<T: Real> Lagrangian<T, 1> for Pendulum<T> {
     const CONSTANT_MASS: bool = true;
+    const READS_TIME: bool = false;
 
     fn kinetic<S: Scalar<Real = T>>(&self, _t: S, _q: &SVector<S, 1>, qd: &SVector<S, 1>) -> S {
         let th_d = qd[0];

@@ -67,6 +67,8 @@ lagrange_core::parameters! {
 }
 
 impl<T: Real> Lagrangian<T, 2> for SpringCartPendulum<T> {
+    const READS_TIME: bool = false;
+
     fn kinetic<S: Scalar<Real = T>>(&self, _t: S, q: &SVector<S, 2>, qd: &SVector<S, 2>) -> S {
         let th = q[1];
         let x_d = qd[0];

@@ -78,6 +78,8 @@ lagrange_core::parameters! {
 }
 
 impl<T: Real> Lagrangian<T, 3> for TriplePendulum<T> {
+    const READS_TIME: bool = false;
+
     fn kinetic<S: Scalar<Real = T>>(&self, _t: S, q: &SVector<S, 3>, qd: &SVector<S, 3>) -> S {
         let th1 = q[0];
         let th2 = q[1];

@@ -360,6 +360,7 @@ where
     const EXPLICIT_TIME: bool = P::EXPLICIT_TIME;
     const CONSTANT_MASS: bool = P::CONSTANT_MASS;
     const DRIVEN: bool = P::DRIVEN;
+    const READS_TIME: bool = P::READS_TIME;
     fn kinetic<S: Scalar<Real = T>>(&self, t: S, q: &SVector<S, N>, qd: &SVector<S, N>) -> S {
         self.parts.kinetic(t, q, qd)
     }
@@ -465,6 +466,7 @@ impl<T: Real, const N: usize, M: Lagrangian<T, N>, K> Lagrangian<T, N> for Held<
     const EXPLICIT_TIME: bool = M::EXPLICIT_TIME;
     const CONSTANT_MASS: bool = M::CONSTANT_MASS;
     const DRIVEN: bool = M::DRIVEN;
+    const READS_TIME: bool = M::READS_TIME;
     fn kinetic<S: Scalar<Real = T>>(&self, t: S, q: &SVector<S, N>, qd: &SVector<S, N>) -> S {
         self.mechanism.kinetic(t, q, qd)
     }

@@ -10,13 +10,18 @@ const GUARD_REFINEMENTS: u32 = 4;
 
 /// The rate at which the forces and the time dependence of `mechanism` change its energy
 /// `T + V` at `s`: the power of its non-conservative forces (inputs, damping), `Q . q'`,
-/// less `dL/dt` at fixed `q` and `q'` (one evaluation of `L` in dual numbers).
+/// less `dL/dt` at fixed `q` and `q'` (one evaluation of `L` in dual numbers, none where `L`
+/// does not read `t`: [`Lagrangian::READS_TIME`](lagrange_core::Lagrangian::READS_TIME)).
 fn energy_rate<T: Real, M: Mechanism<T, N>, const N: usize>(mechanism: &M, s: &State<T, N>) -> T {
+    let power = mechanism.non_conservative_force(s).dot(&s.qd);
+    if !M::READS_TIME {
+        return power;
+    }
     let t = Dual::<T, 1>::variable(s.t, 0);
     let q = s.q.map(Dual::constant);
     let qd = s.qd.map(Dual::constant);
     let explicit = mechanism.kinetic(t, &q, &qd) - mechanism.potential(t, &q);
-    mechanism.non_conservative_force(s).dot(&s.qd) - explicit.eps[0]
+    power - explicit.eps[0]
 }
 
 /// The energy guard of a step from `start` (whose energy `T + V` is `known`, when the step

@@ -204,6 +204,7 @@ where
     const EXPLICIT_TIME: bool = M::EXPLICIT_TIME;
     const CONSTANT_MASS: bool = M::CONSTANT_MASS;
     const DRIVEN: bool = M::DRIVEN;
+    const READS_TIME: bool = M::READS_TIME;
     fn kinetic<S: Scalar<Real = T>>(&self, t: S, q: &SVector<S, N>, qd: &SVector<S, N>) -> S {
         self.mechanism.kinetic(t, q, qd)
     }
