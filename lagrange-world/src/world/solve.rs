@@ -282,6 +282,19 @@ pub(crate) fn drift<T: Real, const N: usize>(
     contacts.iter().any(|c| c.reach > T::zero())
 }
 
+/// Whether the drift's pseudo-velocities `p` leave a normal row slower than its target by
+/// more than `quiet`: a contact the drift would leave deeper than it asks (by `quiet dt`),
+/// for more sweeps to push out.
+pub(crate) fn left_deep<T: Real, const N: usize>(
+    p: &[SVector<T, N>],
+    contacts: &[Contact<T, N>],
+    quiet: T,
+) -> bool {
+    contacts
+        .iter()
+        .any(|c| speed(p, c.bodies, &c.normal) - c.reach < -quiet)
+}
+
 /// How many contacts ahead of the keys' order the solve may take one: far enough to reach
 /// past a ragdoll's nine joint-limit rows to the next body's (measured, three runs each: 8
 /// ahead, ten ragdolls 0.117 ms a step, 55 boxes 72 us, 1,000 balls 1.68 ms; 16: 0.103,
