@@ -143,7 +143,8 @@ pub struct WorldHit<T> {
 /// 4. move       q+ = q + dt v+                                v+ the solved velocities
 /// 5. drift      q+ += dt p, pseudo-velocities p that bring every row the move leaves
 ///               deeper than the slop back to it, and close no other past it (split
-///               impulses: the velocities are untouched)
+///               impulses: the velocities are untouched); swept again while a row is
+///               left more than a slop deeper than that, up to four times
 /// 6. sleep      islands (bodies joined by contacts) at rest for the set time fall asleep
 /// ```
 ///
@@ -163,7 +164,8 @@ pub struct WorldHit<T> {
 /// of [`Mechanism::velocity_jumps`] (one factorisation of a ragdoll's mass matrix for
 /// them; a constant mass matrix: a multiply a row). The solve: `sweeps` passes over the
 /// contacts, `8 N` multiply-adds a contact a pass, in an order that lets rows of bodies
-/// apart go at once. Asleep bodies cost nothing but their shapes' place in the broad
+/// apart go at once; the drift: `sweeps` passes again, up to `4 sweeps` where a pile is
+/// left deep (each time one pass more over the contacts to see whether). Asleep bodies cost nothing but their shapes' place in the broad
 /// phase.
 ///
 /// **Determinism.** Contacts are solved in the order of their keys (the shapes' keys and
