@@ -66,6 +66,11 @@ pub struct WorldReport {
     pub asleep: u32,
     /// Bodies an awake body's touch woke.
     pub woke: u32,
+    /// Times the drift correction swept the contacts (the settings' `sweeps` each time):
+    /// 0 where no contact was deeper than the slop, 1 where the first sweeps left none
+    /// more than a slop deeper than it asks, at most 4 (a pile whose weight the sweeps
+    /// carry down one body at a time).
+    pub drift_rounds: u32,
     /// Whether the impulses would have added kinetic energy (rebounds of several contacts
     /// at once, or last step's impulses applied again), so that the step was solved again
     /// without them: never more kinetic energy than the free step's.
@@ -618,6 +623,7 @@ where
             // stepped as before, bit for bit).
             let quiet = slop / dt;
             for round in 1..=DRIFT_ROUNDS {
+                report.drift_rounds = round;
                 sweep(
                     &mut pseudo,
                     &mut self.contacts,
