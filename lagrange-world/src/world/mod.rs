@@ -170,8 +170,8 @@ pub struct WorldHit<T> {
 /// them; a constant mass matrix: a multiply a row). The solve: `sweeps` passes over the
 /// contacts, `8 N` multiply-adds a contact a pass, in an order that lets rows of bodies
 /// apart go at once; the drift: `sweeps` passes again, up to `4 sweeps` where a pile is
-/// left deep (each time one pass more over the contacts to see whether). Asleep bodies cost nothing but their shapes' place in the broad
-/// phase.
+/// left deep (each time one pass more over the contacts to see whether). Asleep bodies
+/// cost nothing but their shapes' place in the broad phase.
 ///
 /// **Determinism.** Contacts are solved in the order of their keys (the shapes' keys and
 /// the features that meet), islands are named by their least body key, and each body's free

@@ -23,9 +23,9 @@ impl<T: Real> WorldSettings<T> {
     /// stepper's and is not used), contacts resting within `slop` (m, > 0: the drift
     /// correction leaves a contact that deep, which keeps it in touch and quiet), `sweeps`
     /// sweeps of the impulse solve a step (>= 1; the drift correction's sweeps run again,
-    /// up to four times as many in all, while a contact is left deeper than it asks). A
-    /// speculative margin of `4 slop` (bodies moving faster widen it by how far they move
-    /// in the step); no sleeping.
+    /// up to four times as many in all, while a contact is left more than a slop deeper
+    /// than it asks). A speculative margin of `4 slop` (bodies moving faster widen it by how
+    /// far they move in the step); no sleeping.
     ///
     /// How many sweeps: a step's work grows with them, and a tall stack needs more, its
     /// weight carried down one row a sweep. A pyramid of 10 rows of boxes stands with 8
