@@ -173,7 +173,7 @@ fn check_box<T: Real>(proxy: &Proxy<T>) -> Result<(), Error> {
 }
 
 /// Whether `a` and `b`, overlapping along x, overlap along y and may touch.
-fn may_touch<T: Real>(a: &Proxy<T>, b: &Proxy<T>) -> bool {
+pub(crate) fn may_touch<T: Real>(a: &Proxy<T>, b: &Proxy<T>) -> bool {
     let overlap = a.bounds.0[1] <= b.bounds.1[1] && b.bounds.0[1] <= a.bounds.1[1];
     let resting = (a.fixed || a.asleep) && (b.fixed || b.asleep);
     let groups = a.group & b.mask != 0 && b.group & a.mask != 0;

@@ -33,23 +33,31 @@ where
     L: Limits<T, N>,
 {
     /// The step's contacts, sorted by key, warm-started from the last step's impulses; the
-    /// number of bodies woken.
+    /// number of bodies woken. Each awake body's shapes are looked for as far as its velocity
+    /// takes them in the step. A second look (`before`: the velocities before the first
+    /// phase's impulses, by body) looks as far as either takes them, and starts from no
+    /// impulses: the first's are in the velocities.
     pub(super) fn detect(
         &mut self,
         dt: T,
+        before: Option<&[SVector<T, N>; B]>,
         watch: &mut Stopwatch,
         profile: &mut Profile,
     ) -> Result<u32, Error> {
         let mut woke = 0;
         loop {
             // A body woken has had no free step; its contacts are found again with it.
-            let woken = self.find(dt, watch, profile)?;
+            let woken = self.find(dt, before, watch, profile)?;
             if woken == 0 {
                 break;
             }
             woke += woken;
         }
         self.contacts.sort_unstable_by_key(|c| c.key);
+        if before.is_some() {
+            profile.narrow += watch.lap();
+            return Ok(woke);
+        }
         // Both sorted by key: matched in one walk (a binary search a contact was most of the
         // matching).
         let mut kept = self.kept.iter().peekable();
@@ -66,7 +74,13 @@ where
 
     /// One pass of detection; the number of sleeping bodies it woke (their contacts are then
     /// incomplete: the caller finds them again).
-    fn find(&mut self, dt: T, watch: &mut Stopwatch, profile: &mut Profile) -> Result<u32, Error> {
+    fn find(
+        &mut self,
+        dt: T,
+        before: Option<&[SVector<T, N>; B]>,
+        watch: &mut Stopwatch,
+        profile: &mut Profile,
+    ) -> Result<u32, Error> {
         self.contacts.clear();
         self.broad.clear();
         // Every pair and every half-plane needs a body awake: a world asleep finds nothing
@@ -81,6 +95,7 @@ where
             &self.by_body,
             &self.bodies,
             dt,
+            before,
         );
         let margin = self.settings.margin;
         for (index, (s, place)) in self.shapes.iter().zip(&self.places).enumerate() {

@@ -4,12 +4,16 @@
 //! each pair and each half-plane then read the shapes placed, not their links posed again (a
 //! ragdoll's link pose is its whole tree's: ten shapes on it were thirty poses a step, and
 //! as many again per pair).
+//!
+//! The reach is taken at the free velocities, before the impulses; where the impulses send a
+//! body farther (see `outran`), its shapes are placed again with the reach of both.
 
 use super::bodies::{Attached, Body};
 use crate::shape::Shape;
 use crate::vec2::{length, sub};
 use heapless::Vec;
 use lagrange_core::links::{Links, Pose};
+use lagrange_core::nalgebra::SVector;
 use lagrange_core::{Mechanism, Real};
 
 /// A shape where it is this step.
@@ -36,14 +40,75 @@ fn identity<T: Real>() -> Pose<T> {
     }
 }
 
+/// A body's links posed at its coordinates, or where a velocity takes them in a step.
+pub(super) struct Posed<T, const N: usize> {
+    q: SVector<T, N>,
+    poses: [Pose<T>; POSED],
+}
+
+impl<T: Real, const N: usize> Posed<T, N> {
+    /// `body`'s links at `q`.
+    fn at<M, L>(body: &Body<T, M, L, N>, q: SVector<T, N>) -> Self
+    where
+        M: Mechanism<T, N> + Links<T, N>,
+    {
+        let mut poses = [identity(); POSED];
+        body.poses(&q, &mut poses[..M::LINKS.min(POSED)]);
+        Self { q, poses }
+    }
+
+    /// `body`'s links where velocity `v` takes them in `dt`.
+    pub(super) fn ahead<M, L>(body: &Body<T, M, L, N>, v: &SVector<T, N>, dt: T) -> Self
+    where
+        M: Mechanism<T, N> + Links<T, N>,
+    {
+        Self::at(body, body.state.q + v * dt)
+    }
+
+    /// Link `link`'s pose (every link below [`POSED`] is posed, and the array holds no more:
+    /// a link past them is posed on its own).
+    pub(super) fn link<M, L>(&self, body: &Body<T, M, L, N>, link: usize) -> Pose<T>
+    where
+        M: Mechanism<T, N> + Links<T, N>,
+    {
+        match self.poses.get(link) {
+            Some(&p) if link < M::LINKS.min(POSED) => p,
+            _ => body.pose(&self.q, link),
+        }
+    }
+
+    /// How far any point of `shape`, on link `link` at `pose`, moves to here.
+    pub(super) fn reach<M, L>(
+        &self,
+        body: &Body<T, M, L, N>,
+        shape: &Shape<T>,
+        link: usize,
+        pose: &Pose<T>,
+    ) -> T
+    where
+        M: Mechanism<T, N> + Links<T, N>,
+    {
+        let extent = shape
+            .vertices()
+            .iter()
+            .map(|&v| length(v))
+            .fold(T::zero(), T::max)
+            + shape.radius();
+        let then = self.link(body, link);
+        length(sub(then.origin, pose.origin)) + (then.angle - pose.angle).abs() * extent
+    }
+}
+
 /// Every shape of `shapes` placed (in their order), `by_body` naming the shapes on bodies
-/// `(body, shape)` sorted by body, for a step of `dt`.
+/// `(body, shape)` sorted by body, for a step of `dt`; each awake body's reach the farther of
+/// its velocity's and, where given, its velocity in `also` (by body).
 pub(crate) fn place<T, M, L, const N: usize, const B: usize, const S: usize>(
     places: &mut Vec<Place<T>, S>,
     shapes: &[Attached<T>],
     by_body: &[(u32, u32)],
     bodies: &Vec<Body<T, M, L, N>, B>,
     dt: T,
+    also: Option<&[SVector<T, N>; B]>,
 ) where
     T: Real,
     M: Mechanism<T, N> + Links<T, N>,
@@ -57,64 +122,37 @@ pub(crate) fn place<T, M, L, const N: usize, const B: usize, const S: usize>(
             reach: T::zero(),
         });
     }
-    let posed = M::LINKS.min(POSED);
     for group in by_body.chunk_by(|x, y| x.0 == y.0) {
-        let Some(body) = group.first().and_then(|&(b, _)| bodies.get(b as usize)) else {
+        let Some((b, body)) = group
+            .first()
+            .and_then(|&(b, _)| Some((b as usize, bodies.get(b as usize)?)))
+        else {
             continue;
         };
-        let q = body.state.q;
-        let ahead = q + body.state.qd * dt;
-        let mut now = [identity(); POSED];
-        body.poses(&q, &mut now[..posed]);
-        let mut next = now;
-        if !body.asleep {
-            body.poses(&ahead, &mut next[..posed]);
-        }
+        let now = Posed::at(body, body.state.q);
+        let awake = !body.asleep;
+        let ahead = awake.then(|| Posed::ahead(body, &body.state.qd, dt));
+        let also = also
+            .and_then(|v| v.get(b))
+            .filter(|v| awake && **v != body.state.qd)
+            .map(|v| Posed::ahead(body, v, dt));
         for &(_, index) in group {
             let index = index as usize;
             let (Some(s), Some(place)) = (shapes.get(index), places.get_mut(index)) else {
                 continue;
             };
             let link = s.on.map_or(0, |(_, link)| link);
-            let (pose, then) = (
-                posed_link(&now, body, &q, link),
-                posed_link(&next, body, &ahead, link),
-            );
-            let reach = if body.asleep {
-                T::zero()
-            } else {
-                let extent = s
-                    .shape
-                    .vertices()
-                    .iter()
-                    .map(|&v| length(v))
-                    .fold(T::zero(), T::max)
-                    + s.shape.radius();
-                length(sub(then.origin, pose.origin)) + (then.angle - pose.angle).abs() * extent
-            };
+            let pose = now.link(body, link);
+            let reach = [&ahead, &also]
+                .into_iter()
+                .flatten()
+                .map(|then| then.reach(body, &s.shape, link, &pose))
+                .fold(T::zero(), T::max);
             *place = Place {
                 shape: s.shape.placed(&pose),
                 pose,
                 reach,
             };
         }
-    }
-}
-
-/// Link `link` of `body` at `q` from its links posed there (`posed`), or posed on its own
-/// past them (every link below [`POSED`] is posed, and the arrays hold no more).
-fn posed_link<T, M, L, const N: usize>(
-    posed: &[Pose<T>],
-    body: &Body<T, M, L, N>,
-    q: &lagrange_core::nalgebra::SVector<T, N>,
-    link: usize,
-) -> Pose<T>
-where
-    T: Real,
-    M: Mechanism<T, N> + Links<T, N>,
-{
-    match posed.get(link) {
-        Some(&p) if link < M::LINKS.min(POSED) => p,
-        _ => body.pose(q, link),
     }
 }
