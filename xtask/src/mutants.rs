@@ -846,6 +846,7 @@ const AREAS: [Area; 29] = [
             "lagrange-world/src/world/limits.rs",
             "lagrange-world/src/world/locks.rs",
             "lagrange-world/src/world/mobilities.rs",
+            "lagrange-world/src/world/outran.rs",
             "lagrange-world/src/world/own.rs",
             "lagrange-world/src/world/places.rs",
             "lagrange-world/src/world/profile.rs",
