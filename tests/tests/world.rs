@@ -8,7 +8,7 @@ use lagrange_core::constraints::contact::ContactModel;
 use lagrange_core::{Error, Lagrangian, Real, State};
 use lagrange_systems::{RigidBody, SimplePendulum};
 use lagrange_tests::{for_f32_and_f64, pick};
-use lagrange_world::{collide, HalfPlane, Profile, Shape, World, WorldSettings};
+use lagrange_world::{collide, HalfPlane, Profile, Shape, World, WorldReport, WorldSettings};
 
 const G: f64 = 9.81;
 
@@ -343,54 +343,205 @@ fn the_drift_is_swept_until_it_is_settled<T: Real>() -> Result<(), Error> {
     Ok(())
 }
 
-/// A body the impulses send into one no contact was looked for with is stopped by it in the
-/// same step: a second phase of impacts. Three 1 m boxes of 1 kg in a row, weightless: the
-/// first strikes the second (1 mm apart) at 6 m/s, the third waits 50 mm beyond the second,
-/// out of the speculative margin (4 slops, 20 mm) of boxes at rest. The strike (`e = 1`)
-/// sends the second at 6 m/s, 100 mm in the step: without a second look it ended 50 mm in
-/// the third. Looked again, the second strikes the third from the velocities the first
-/// phase left, as Newton's law says: the first two stop, the third leaves at 6 m/s (to a
-/// millionth of it: the sweeps share each impact between a face's two points, and their 8
-/// sweeps leave 2e-11 of it in f64, a few ulps in f32), momentum kept to rounding, no kinetic
-/// energy gained, nothing deeper than the slop. The next step, nothing is struck and
-/// nothing looked again.
-fn a_body_sent_into_another_strikes_it_in_the_step<T: Real>() -> Result<(), Error> {
-    let model = ContactModel::new(T::one(), T::from_f64(0.1), T::one())?;
-    let mut world = Box::new(Bodies::<T>::new(WorldSettings::new(
-        model,
-        T::from_f64(SLOP),
-        8,
-    )?));
-    let speed = 6.0;
-    for (key, x, v) in [(0, 0.0, speed), (1, 1.001, 0.0), (2, 2.051, 0.0)] {
+/// A row of three 1 m boxes of 1 kg along x at y = 10, weightless: the first (key 0)
+/// `first_gap` m from the second and moving towards it at `speed`, the third `gap` m beyond
+/// the second and `lift` m higher (or, with `wall`, a wall there in its place).
+#[derive(Clone, Copy)]
+struct Struck {
+    speed: f64,
+    first_gap: f64,
+    gap: f64,
+    lift: f64,
+    restitution: f64,
+    /// The third in a group the others' masks leave out.
+    filtered: bool,
+    wall: bool,
+    /// Bodies at rest for a step fall asleep.
+    sleep: bool,
+}
+
+/// The first strikes the second 1 mm away at 6 m/s (`e = 1`), the third 50 mm beyond it.
+const STRUCK: Struck = Struck {
+    speed: 6.0,
+    first_gap: 0.001,
+    gap: 0.05,
+    lift: 0.0,
+    restitution: 1.0,
+    filtered: false,
+    wall: false,
+    sleep: false,
+};
+
+/// What the step in which the first box was struck did: its report, the boxes' x
+/// velocities, the deepest overlap of two boxes or a box and the wall after it, each pair's
+/// total normal impulse `(0-1, 1-2)`, whether the third is awake; then the next step's
+/// report.
+type Strike = (WorldReport, [f64; 3], f64, [f64; 2], bool, WorldReport);
+
+fn strike<T: Real>(row: Struck) -> Result<Strike, Error> {
+    let model = ContactModel::new(T::from_f64(row.restitution), T::from_f64(0.1), T::one())?;
+    let mut settings = WorldSettings::new(model, T::from_f64(SLOP), 8)?;
+    if row.sleep {
+        settings = settings.with_sleep(T::from_f64(0.01), T::from_f64(1e-3))?;
+    }
+    let mut world = Box::new(Bodies::<T>::new(settings));
+    let second = 1.0 + row.first_gap;
+    let third = second + 1.0 + row.gap;
+    let boxes = if row.wall { 2 } else { 3 };
+    let placed = [
+        (0.0, 0.0, row.speed),
+        (second, 0.0, 0.0),
+        (third, row.lift, 0.0),
+    ];
+    for (key, &(x, lift, v)) in (0..boxes).zip(&placed) {
         let body = RigidBody::rectangle(T::one(), T::one(), T::one(), T::zero())?;
-        let q = [x, 10.0, 0.0].map(T::from_f64);
+        let q = [x, 10.0 + lift, 0.0].map(T::from_f64);
         let qd = [v, 0.0, 0.0].map(T::from_f64);
         world.add_body(key, body, State::new(T::zero(), q, qd))?;
         world.add_shape(1000 + key, key, 0, Shape::rectangle(T::one(), T::one())?)?;
     }
-    let report = world.step(T::from_f64(1.0 / 60.0))?;
-    let v: std::vec::Vec<f64> = (0..3)
-        .filter_map(|k| world.state(k))
-        .map(|s| s.qd[0].to_f64())
-        .collect();
-    let depth = deepest(&world, 3)?;
-    println!("{report:?}: velocities {v:?}, deepest {depth}");
-    assert!(report.looked_again, "{report:?}");
-    let rounding = 16.0 * T::EPSILON.to_f64() * speed;
-    let converged = 1e-6 * speed;
-    assert!(v[0].abs() <= converged && v[1].abs() <= converged, "{v:?}");
-    assert!((v[2] - speed).abs() <= converged, "{v:?}");
-    let momentum: f64 = v.iter().sum();
-    assert!((momentum - speed).abs() <= rounding, "{momentum}");
-    let kinetic: f64 = v.iter().map(|v| v * v / 2.0).sum();
-    assert!(
-        kinetic <= speed * speed / 2.0 + rounding * speed,
-        "{kinetic}"
-    );
-    assert!(depth <= SLOP, "{depth}");
-    let report = world.step(T::from_f64(1.0 / 60.0))?;
+    let wall = HalfPlane::new([-T::one(), T::zero()], T::from_f64(-(third - 0.5)))?;
+    if row.wall {
+        world.add_plane(10_000, wall)?;
+    }
+    if row.filtered {
+        world.set_filter(1002, 2, 2)?;
+        for key in [1000, 1001] {
+            world.set_filter(key, 1, 1)?;
+        }
+    }
+    let dt = T::from_f64(1.0 / 60.0);
+    let mut report = world.step(dt)?;
+    for _ in 0..8 {
+        if world
+            .state(0)
+            .is_some_and(|s| s.qd[0].to_f64() < row.speed / 2.0)
+        {
+            break;
+        }
+        report = world.step(dt)?;
+    }
+    let v = [0, 1, 2].map(|k| world.state(k).map_or(0.0, |s| s.qd[0].to_f64()));
+    let mut depth = deepest(&world, boxes)?;
+    if row.wall {
+        let unit = Shape::rectangle(T::one(), T::one())?;
+        for s in (0..boxes).filter_map(|k| world.state(k)) {
+            let placed = unit.placed(&lagrange_core::links::Pose {
+                origin: [s.q[0], s.q[1]],
+                angle: s.q[2],
+            });
+            let gap = lagrange_world::collide_half_plane(&wall, &placed, T::zero()).gap();
+            depth = depth.max(-gap.map_or(0.0, |g| g.to_f64()));
+        }
+    }
+    let mut impulses = [0.0; 2];
+    for ((a, b, _), l) in world.impulses() {
+        if let Some(sum) = impulses.get_mut(match (a, b) {
+            (1000, 1001) => 0,
+            (1001, 1002) => 1,
+            _ => 2,
+        }) {
+            *sum += l.to_f64();
+        }
+    }
+    let awake = world.asleep(2) == Some(false);
+    let next = world.step(dt)?;
+    Ok((report, v, depth, impulses, awake, next))
+}
+
+/// A body the impulses send into one no contact was looked for with strikes it in the same
+/// step: a second phase of impacts. The first of three boxes strikes the second at 6 m/s
+/// (`e = 1`), the third 50 mm beyond the second, out of the speculative margin (4 slops,
+/// 20 mm) of boxes at rest; the strike sends the second 100 mm in the step: without a
+/// second look it ended 50 mm in the third. Looked again, the second strikes the third from
+/// the velocities the first phase left, as Newton's law says: the first two stop, the third
+/// leaves at 6 m/s (to a millionth of it: the sweeps share each impact between a face's two
+/// points, and their 8 sweeps leave 2e-11 of it in f64, a few ulps in f32), momentum kept
+/// to rounding, no kinetic energy gained, each impact's impulse 6 N s (the first phase's
+/// and the second's added), nothing deeper than the slop; the next step looks at nothing
+/// again. Sent 30 mm (at 1.8 m/s) towards a box 25 mm away, the same (the second outruns
+/// its reach by more than half the margin, and meets the third).
+fn a_body_sent_into_another_strikes_it_in_the_step<T: Real>() -> Result<(), Error> {
+    for (speed, gap) in [(6.0, 0.05), (1.8, 0.025)] {
+        let (report, v, depth, impulses, _, next) = strike::<T>(Struck {
+            speed,
+            gap,
+            ..STRUCK
+        })?;
+        println!("{report:?}: velocities {v:?}, deepest {depth}, impulses {impulses:?}");
+        assert!(report.looked_again, "{report:?}");
+        let rounding = 16.0 * T::EPSILON.to_f64() * speed;
+        let converged = 1e-6 * speed;
+        assert!(v[0].abs() <= converged && v[1].abs() <= converged, "{v:?}");
+        assert!((v[2] - speed).abs() <= converged, "{v:?}");
+        let momentum: f64 = v.iter().sum();
+        assert!((momentum - speed).abs() <= rounding, "{momentum}");
+        let kinetic: f64 = v.iter().map(|v| v * v / 2.0).sum();
+        assert!(
+            kinetic <= speed * speed / 2.0 + rounding * speed,
+            "{kinetic}"
+        );
+        for impulse in impulses {
+            assert!((impulse - speed).abs() <= converged, "{impulses:?}");
+        }
+        assert!(depth <= SLOP, "{depth}");
+        assert!(!next.looked_again, "{next:?}");
+    }
+    Ok(())
+}
+
+/// The step looks again only where a body is sent into a shape it has no contact with. Not
+/// where the third box is 2 m higher (the second moves on at 6 m/s), nor where it is 1 mm
+/// beyond the second (their contact was found in the first phase), nor where the third is
+/// in a collision group the others do not collide with (the second passes into it, as the
+/// filter says: 50 mm).
+fn a_step_looks_again_only_where_a_body_is_sent_into_a_new_shape<T: Real>() -> Result<(), Error> {
+    let (report, v, ..) = strike::<T>(Struck {
+        lift: 2.0,
+        ..STRUCK
+    })?;
     assert!(!report.looked_again, "{report:?}");
+    assert!((v[1] - 6.0).abs() <= 1e-6 * 6.0, "{v:?}");
+    let (report, ..) = strike::<T>(Struck {
+        gap: 0.001,
+        ..STRUCK
+    })?;
+    assert!(!report.looked_again, "{report:?}");
+    let (report, _, depth, ..) = strike::<T>(Struck {
+        filtered: true,
+        ..STRUCK
+    })?;
+    assert!(!report.looked_again, "{report:?}");
+    assert!(depth > 0.04, "{depth}");
+    Ok(())
+}
+
+/// A body sent into a wall it had no contact with stops at it in the step: two boxes struck
+/// plastically (`e = 0`) at 6 m/s leave together at 3 m/s, 50 mm in the step, towards a
+/// wall 30 mm away; looked again, they reach it at no more than it allows, and end within
+/// the slop of it (no wall: no look). A sleeping box the second is sent into is woken by the
+/// second phase: the step woke two (the second by the first's approach, the third by the
+/// second's), and the third leaves at 6 m/s.
+fn a_body_sent_into_a_wall_or_a_sleeper<T: Real>() -> Result<(), Error> {
+    let (report, v, depth, ..) = strike::<T>(Struck {
+        restitution: 0.0,
+        gap: 0.03,
+        wall: true,
+        ..STRUCK
+    })?;
+    println!("wall: {report:?}: velocities {v:?}, deepest {depth}");
+    assert!(report.looked_again, "{report:?}");
+    assert!(depth <= SLOP, "{depth}");
+    assert!(v[1] < 3.0, "{v:?}");
+    let (report, v, _, _, awake, _) = strike::<T>(Struck {
+        first_gap: 0.15,
+        sleep: true,
+        ..STRUCK
+    })?;
+    println!("sleeper: {report:?}: velocities {v:?}");
+    assert!(report.looked_again && awake, "{report:?}");
+    assert_eq!(report.woke, 2, "{report:?}");
+    assert!((v[2] - 6.0).abs() <= 1e-6 * 6.0, "{v:?}");
     Ok(())
 }
 
@@ -941,6 +1092,8 @@ for_f32_and_f64!(
     a_clock_changes_no_bits,
     the_drift_is_swept_until_it_is_settled,
     a_body_sent_into_another_strikes_it_in_the_step,
+    a_step_looks_again_only_where_a_body_is_sent_into_a_new_shape,
+    a_body_sent_into_a_wall_or_a_sleeper,
     a_failed_step_keeps_the_warm_start,
     events_and_queries,
     a_sleeping_box_still_touches_the_floor,

@@ -623,12 +623,13 @@ where
         report.woke = self.detect(dt, None, watch, &mut profile)?;
         let free = self.velocities();
         report.guarded = self.solve();
+        let outran = self.outran(&free, dt);
         profile.solve = watch.lap();
         // A body the impulses sent where its shapes were not looked for (a limb whipped by
         // a landing) may cross a shape it has no contact with: a second phase of impacts,
         // from the velocities the first left, with the contacts looked for again as far
         // as either velocity takes a body (see `outran`).
-        if self.outran(&free, dt) {
+        if outran {
             self.first.clear();
             for c in &self.contacts {
                 // Capacity K holds every contact of the step.

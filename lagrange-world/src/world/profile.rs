@@ -19,7 +19,9 @@ pub struct Profile {
     /// The narrow phase: each pair's manifold, the half-planes', the bodies' own rows, and
     /// every contact's rows (Jacobians, mobilities through the mass solve).
     pub narrow: u64,
-    /// The impulses: the sweeps over the contacts, the energy guard.
+    /// The impulses: the sweeps over the contacts, the energy guard, and whether they sent
+    /// a body where its contacts were not looked for (a second phase's detection goes to
+    /// `broad` and `narrow`, its sweeps here).
     pub solve: u64,
     /// The drift correction and the move of the coordinates.
     pub drift: u64,
