@@ -127,6 +127,31 @@ fn a_turning_plank_does_not_pass_into_the_floor<T: Real>() -> Result<(), Error> 
     Ok(())
 }
 
+/// A hammer: a ball of 1 m radius on a body 2 m from its origin, turning at 6 rad/s in zero
+/// gravity with its ball 15 cm above the floor; in a step at 60 Hz the ball's centre drops
+/// 20 cm, to 5 cm under the floor. Its reach counts the ball's radius beyond its centre (a
+/// point of it 3 m from the origin moves 0.1 rad times that): the contact is found open and
+/// the ball stops at the floor, within the slop after every step. A reach that took the
+/// radius off (1 m times the turn) missed it.
+fn a_turning_hammer_does_not_pass_into_the_floor<T: Real>() -> Result<(), Error> {
+    let mut world = Box::new(Bodies::<T>::new(stacking::<T>()?));
+    world.add_plane(7, HalfPlane::floor())?;
+    let body = RigidBody::disk(T::one(), T::one(), T::zero())?;
+    let ball = Shape::circle(T::one())?.offset([T::from_f64(2.0), T::zero()], T::zero());
+    let q = [0.0, 1.15, 0.0].map(T::from_f64);
+    let qd = [0.0, 0.0, -6.0].map(T::from_f64);
+    world.add_body(1, body, State::new(T::zero(), q, qd))?;
+    world.add_shape(2, 1, 0, ball)?;
+    let mut deepest: f64 = 0.0;
+    for _ in 0..30 {
+        world.step(T::from_f64(1.0 / 60.0))?;
+        deepest = deepest.max(under_the_floor(&world, 1, &ball));
+    }
+    println!("hammer: {deepest:e} m");
+    assert!(deepest <= SLOP * 1.01, "{deepest:e} m");
+    Ok(())
+}
+
 /// The plank of `a_turning_plank_does_not_pass_into_the_floor` from `q`.
 fn turning_plank<T: Real>(q: [f64; 3], slab: bool) -> Result<(), Error> {
     let mut world = Box::new(Bodies::<T>::new(stacking::<T>()?));
@@ -460,11 +485,14 @@ fn strike<T: Real>(row: Struck) -> Result<Strike, Error> {
 /// to rounding, no kinetic energy gained, each impact's impulse 6 N s (the first phase's
 /// and the second's added), nothing deeper than the slop; the next step looks at nothing
 /// again. Sent 30 mm (at 1.8 m/s) towards a box 25 mm away, the same (the second outruns
-/// its reach by more than half the margin, and meets the third).
+/// its reach by more than half the margin, and meets the third); and where the first strikes
+/// from 50 mm away (found as far as its speed before the strike takes it, 100 mm: the second
+/// look looks as far, and keeps that impact's impulse).
 fn a_body_sent_into_another_strikes_it_in_the_step<T: Real>() -> Result<(), Error> {
-    for (speed, gap) in [(6.0, 0.05), (1.8, 0.025)] {
+    for (speed, first_gap, gap) in [(6.0, 0.001, 0.05), (1.8, 0.001, 0.025), (6.0, 0.05, 0.05)] {
         let (report, v, depth, impulses, _, next) = strike::<T>(Struck {
             speed,
+            first_gap,
             gap,
             ..STRUCK
         })?;
@@ -1082,6 +1110,7 @@ fn rays_and_points<T: Real>() -> Result<(), Error> {
 
 for_f32_and_f64!(
     a_turning_plank_does_not_pass_into_the_floor,
+    a_turning_hammer_does_not_pass_into_the_floor,
     a_box_struck_on_a_corner_does_not_pass_into_the_floor,
     settings_keep_what_they_were_given,
     rays_and_points,
