@@ -630,15 +630,7 @@ where
         // from the velocities the first left, with the contacts looked for again as far
         // as either velocity takes a body (see `outran`).
         if outran {
-            self.first.clear();
-            for c in &self.contacts {
-                // Capacity K holds every contact of the step.
-                let _ = self.first.push(Kept {
-                    key: c.key,
-                    normal: c.normal.lambda,
-                    tangent: c.tangent.lambda,
-                });
-            }
+            impulses_of(&self.contacts, &mut self.first);
             let solved = self.velocities();
             report.woke += self.detect(dt, Some(&free), watch, &mut profile)?;
             if self.solve() {
@@ -845,15 +837,7 @@ where
     /// The step's impulses, kept for the next step's warm start (the last step's until
     /// now: the step that ends here matched its contacts with them).
     fn keep_impulses(&mut self) {
-        self.kept.clear();
-        for c in &self.contacts {
-            // Capacity K holds every contact of the step.
-            let _ = self.kept.push(Kept {
-                key: c.key,
-                normal: c.normal.lambda,
-                tangent: c.tangent.lambda,
-            });
-        }
+        impulses_of(&self.contacts, &mut self.kept);
     }
 
     /// The events of the step: pairs that pushed now and not before, or before and not now.
@@ -1047,5 +1031,21 @@ fn full() -> Error {
     Error::InvalidParameter {
         name: "capacity",
         reason: "the world is full",
+    }
+}
+
+/// Each of `contacts`' impulses by its key, in their order, into `out` (emptied first).
+fn impulses_of<T: Real, const N: usize, const K: usize>(
+    contacts: &[Contact<T, N>],
+    out: &mut Vec<Kept<T>, K>,
+) {
+    out.clear();
+    for c in contacts {
+        // Capacity K holds every contact of a step.
+        let _ = out.push(Kept {
+            key: c.key,
+            normal: c.normal.lambda,
+            tangent: c.tangent.lambda,
+        });
     }
 }
