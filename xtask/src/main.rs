@@ -97,39 +97,45 @@ fn main() -> ExitCode {
 
 /// The work-precision bench, optimised like xtask itself (it lives in `benches/` so that its
 /// dependencies, `ode_solvers` among them, are not built by every `cargo xtask`).
-const BENCH: [&str; 9] = [
+const BENCH: [&str; 11] = [
     "run",
     "--quiet",
     "--profile",
     "xtask",
     "-p",
     "lagrange-benches",
+    "--features",
+    "bench-bins",
     "--bin",
     "work-precision",
     "--",
 ];
 
 /// The scene bench (`--scene`), run like the work-precision bench.
-const SCENE_BENCH: [&str; 9] = [
+const SCENE_BENCH: [&str; 11] = [
     "run",
     "--quiet",
     "--profile",
     "xtask",
     "-p",
     "lagrange-benches",
+    "--features",
+    "bench-bins",
     "--bin",
     "scene-cost",
     "--",
 ];
 
 /// The automatic-path bench (`--automatic`), run like the work-precision bench.
-const AUTOMATIC_BENCH: [&str; 9] = [
+const AUTOMATIC_BENCH: [&str; 11] = [
     "run",
     "--quiet",
     "--profile",
     "xtask",
     "-p",
     "lagrange-benches",
+    "--features",
+    "bench-bins",
     "--bin",
     "automatic-cost",
     "--",
@@ -183,7 +189,8 @@ fn bench(args: &[String]) -> Result<(), String> {
 const TEST: [&[&str]; 1] = [&["test", "--workspace", "--all-targets", "--quiet"]];
 
 /// Static checks run before the tests. The benches behind `bench --contacts` and `bench
-/// --world` are `bench = false` (a plain `cargo bench` runs only the criterion ones), which
+/// --world` are `bench = false` (a plain `cargo bench` runs only the criterion ones), and the
+/// bench binaries need the feature `bench-bins` (so that the tests do not build them), which
 /// `--all-targets` leaves out: they are named.
 const CHECKS: [&[&str]; 3] = [
     &["fmt", "--all", "--", "--check"],
@@ -200,6 +207,9 @@ const CHECKS: [&[&str]; 3] = [
         "clippy",
         "-p",
         "lagrange-benches",
+        "--features",
+        "bench-bins",
+        "--bins",
         "--bench",
         "contacts",
         "--bench",
