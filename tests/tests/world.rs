@@ -590,6 +590,44 @@ fn a_body_sent_into_a_wall_or_a_sleeper<T: Real>() -> Result<(), Error> {
     Ok(())
 }
 
+/// The second look never fails a step the first alone would take: with room for two
+/// contact points (the strike's face), the look that finds the second box's two with the
+/// third has no room for them, and the step is taken without it, as it was before there was
+/// one (the first phase's impulses: the second leaves at the striker's 6 m/s, the third
+/// unmoved, the report says no second look). With room for four, the same strike looks
+/// again and the third leaves at 6 m/s.
+fn a_second_look_with_no_room_is_not_taken<T: Real>() -> Result<(), Error> {
+    fn struck<T: Real, const K: usize>() -> Result<(WorldReport, [f64; 3]), Error> {
+        let model = ContactModel::new(T::one(), T::from_f64(0.1), T::one())?;
+        let settings = WorldSettings::new(model, T::from_f64(SLOP), 8)?;
+        let mut world = Box::new(Boxes::<T, 4, K>::new(settings));
+        for (key, x, v) in [(0, 0.0, 6.0), (1, 1.001, 0.0), (2, 2.051, 0.0)] {
+            let body = RigidBody::rectangle(T::one(), T::one(), T::one(), T::zero())?;
+            let q = [x, 10.0, 0.0].map(T::from_f64);
+            let qd = [v, 0.0, 0.0].map(T::from_f64);
+            world.add_body(key, body, State::new(T::zero(), q, qd))?;
+            world.add_shape(key, key, 0, Shape::rectangle(T::one(), T::one())?)?;
+        }
+        let report = world.step(T::from_f64(1.0 / 60.0))?;
+        let v = [0, 1, 2].map(|k| world.state(k).map_or(f64::NAN, |s| s.qd[0].to_f64()));
+        Ok((report, v))
+    }
+    let (report, v) = struck::<T, 2>()?;
+    assert!(!report.looked_again && report.contacts == 2, "{report:?}");
+    assert!(
+        v[0].abs() <= 1e-6 * 6.0 && (v[1] - 6.0).abs() <= 1e-6 * 6.0,
+        "{v:?}"
+    );
+    assert_eq!(v[2], 0.0, "{v:?}");
+    let (report, v) = struck::<T, 4>()?;
+    assert!(report.looked_again && report.contacts == 4, "{report:?}");
+    assert!(
+        v[1].abs() <= 1e-6 * 6.0 && (v[2] - 6.0).abs() <= 1e-6 * 6.0,
+        "{v:?}"
+    );
+    Ok(())
+}
+
 /// A pyramid of 10 rows (55 boxes) for `seconds` at 60 Hz, never asleep: the top box moves
 /// less than 1 cm (each of the 10 contacts below it rests within the 5 mm slop, and the
 /// solve leaves most of them far shallower: 8.3 mm measured over 60 s in f64), no two boxes
@@ -1140,6 +1178,7 @@ for_f32_and_f64!(
     a_body_sent_into_another_strikes_it_in_the_step,
     a_step_looks_again_only_where_a_body_is_sent_into_a_new_shape,
     a_body_sent_into_a_wall_or_a_sleeper,
+    a_second_look_with_no_room_is_not_taken,
     a_failed_step_keeps_the_warm_start,
     events_and_queries,
     a_sleeping_box_still_touches_the_floor,

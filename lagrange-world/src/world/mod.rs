@@ -77,7 +77,8 @@ pub struct WorldReport {
     /// the step took a second phase of impacts: the contacts looked for again as far as
     /// the velocities before and after the first take each body, and solved from the
     /// velocities the first left (an impact it caused struck as Newton's law says), at
-    /// most once a step.
+    /// most once a step. Not where the second look would find more contact points than the
+    /// world holds (`K`): that step is taken with the first phase alone, never failed.
     pub looked_again: bool,
     /// Whether the impulses would have added kinetic energy (rebounds of several contacts
     /// at once, or last step's impulses applied again), so that the step was solved again
@@ -600,7 +601,7 @@ where
         }
         let mut watch = Stopwatch::start(self.clock);
         let saved: Vec<Body<T, M, L, N>, B> = self.bodies.clone();
-        let result = self.advance(dt, &mut watch);
+        let result = self.advance(dt, &mut watch, &saved, true);
         if result.is_err() {
             // The impulses kept for warm starting are still the last step's: a failed step
             // keeps them only when it ends.
@@ -610,8 +611,15 @@ where
         result
     }
 
-    /// The step, unchecked, its parts timed by `watch`.
-    fn advance(&mut self, dt: T, watch: &mut Stopwatch) -> Result<WorldReport, Error> {
+    /// The step, unchecked, from the bodies `saved`, its parts timed by `watch`; with a second
+    /// phase of impacts where it is needed and `second` allows it.
+    fn advance(
+        &mut self,
+        dt: T,
+        watch: &mut Stopwatch,
+        saved: &Vec<Body<T, M, L, N>, B>,
+        second: bool,
+    ) -> Result<WorldReport, Error> {
         let mut report = WorldReport::default();
         for body in self.bodies.iter_mut().filter(|b| !b.asleep) {
             body.free(dt)?;
@@ -623,7 +631,7 @@ where
         report.woke = self.detect(dt, None, watch, &mut profile)?;
         let free = self.velocities();
         report.guarded = self.solve();
-        let outran = self.outran(&free, dt);
+        let outran = second && self.outran(&free, dt);
         profile.solve = watch.lap();
         // A body the impulses sent where its shapes were not looked for (a limb whipped by
         // a landing) may cross a shape it has no contact with: a second phase of impacts,
@@ -632,7 +640,16 @@ where
         if outran {
             impulses_of(&self.contacts, &mut self.first);
             let solved = self.velocities();
-            report.woke += self.detect(dt, Some(&free), watch, &mut profile)?;
+            match self.detect(dt, Some(&free), watch, &mut profile) {
+                Ok(woke) => report.woke += woke,
+                // No room for what the second look finds (more contact points than K, as
+                // far as either velocity takes the bodies): the step is taken again without
+                // it, so that it never fails a step the first phase alone would take.
+                Err(_) => {
+                    self.bodies.clone_from(saved);
+                    return self.advance(dt, watch, saved, false);
+                }
+            }
             if self.solve() {
                 // The second phase would have added energy (a rebound with a contact of
                 // the first held: the balls of a cradle a little apart): the first's
