@@ -7,6 +7,7 @@ mod detect;
 mod islands;
 mod limits;
 mod locks;
+mod merge;
 mod mobilities;
 mod outran;
 mod own;
@@ -26,12 +27,14 @@ use crate::query::RayHit;
 use crate::shape::Shape;
 use crate::vec2::{dot, Vec2};
 use bodies::{Attached, Body};
+use core::cmp::Ordering;
 use heapless::Vec;
 use islands::Islands;
 use lagrange_core::links::Links;
 use lagrange_core::nalgebra::SVector;
 use lagrange_core::{Error, Mechanism, Real, State};
 use locks::Locks;
+use merge::merge_pairs;
 use places::Place;
 use profile::Stopwatch;
 use rows::{Contact, Kept};
@@ -893,12 +896,6 @@ where
             }
         }
         now.sort_unstable_by_key(|e| e.shapes);
-        for e in now
-            .iter()
-            .filter(|e| self.touching.binary_search(&e.shapes).is_err())
-        {
-            let _ = self.events.push(*e);
-        }
         // A pair of a sleeping body is not solved, and still touches. (In place: a copy of
         // the pairs is the world's capacity for them, whatever the pairs.)
         let (shapes, bodies) = (&self.shapes, &self.bodies);
@@ -908,26 +905,47 @@ where
         let asleep = |(a, b): (u32, u32)| {
             some_asleep && (sleeping(shapes, bodies, a) || sleeping(shapes, bodies, b))
         };
-        for &pair in &self.touching {
-            if now.binary_search_by_key(&pair, |e| e.shapes).is_err() && !asleep(pair) {
-                let _ = self.events.push(ContactEvent {
-                    shapes: pair,
-                    began: false,
-                    impulse: T::zero(),
-                    speed: T::zero(),
-                    point: [T::zero(); 2],
-                    normal: [T::zero(); 2],
-                });
+        // The pairs pushing now and those that touched, both sorted: one walk of the two
+        // finds the pairs that began (now only) and ended (before only, awake), in order,
+        // and keeps in place the sleeping pairs that touched (a search of one list per pair
+        // of the other, and sorting the events, were a twentieth of a pyramid's step).
+        let (mut i, mut j, mut kept) = (0, 0, 0);
+        loop {
+            let (e, before) = (now.get(i), self.touching.get(j).copied());
+            let order = match (e, before) {
+                (Some(e), Some(b)) => e.shapes.cmp(&b),
+                (Some(_), None) => Ordering::Less,
+                (None, Some(_)) => Ordering::Greater,
+                (None, None) => break,
+            };
+            match (order, e, before) {
+                (Ordering::Less, Some(e), _) => {
+                    let _ = self.events.push(*e);
+                    i += 1;
+                }
+                (Ordering::Greater, _, Some(b)) => {
+                    if asleep(b) {
+                        if let Some(slot) = self.touching.get_mut(kept) {
+                            *slot = b;
+                        }
+                        kept += 1;
+                    } else {
+                        let _ = self.events.push(ContactEvent {
+                            shapes: b,
+                            began: false,
+                            impulse: T::zero(),
+                            speed: T::zero(),
+                            point: [T::zero(); 2],
+                            normal: [T::zero(); 2],
+                        });
+                    }
+                    j += 1;
+                }
+                _ => (i, j) = (i + 1, j + 1),
             }
         }
-        self.events.sort_unstable_by_key(|e| e.shapes);
-        // A pair that pushed in the step its body fell asleep in is among both: kept once.
-        self.touching
-            .retain(|&pair| asleep(pair) && now.binary_search_by_key(&pair, |e| e.shapes).is_err());
-        for e in &now {
-            let _ = self.touching.push(e.shapes);
-        }
-        self.touching.sort_unstable();
+        self.touching.truncate(kept);
+        merge_pairs(&mut self.touching, now.iter().map(|e| e.shapes));
     }
 
     /// The index of body `key`.
