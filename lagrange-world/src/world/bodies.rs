@@ -1,7 +1,7 @@
 //! A [`World`](super::World)'s bodies and the shapes on them.
 
 use crate::shape::Shape;
-use crate::vec2::{add, Vec2};
+use crate::vec2::{add, length, Vec2};
 use lagrange_core::links::{Links, Pose};
 use lagrange_core::nalgebra::SVector;
 use lagrange_core::{Error, Mechanism, Real, State};
@@ -96,17 +96,27 @@ pub(crate) struct Attached<T> {
     pub(crate) key: u32,
     pub(crate) on: Option<(usize, usize)>,
     pub(crate) shape: Shape<T>,
+    /// How far the shape reaches from its link's origin: its farthest vertex and its
+    /// radius (what a turn of the link moves its farthest point by, per radian).
+    pub(crate) extent: T,
     pub(crate) group: u32,
     pub(crate) mask: u32,
 }
 
-impl<T> Attached<T> {
+impl<T: Real> Attached<T> {
     /// In group 1, colliding with every group.
     pub(crate) fn new(key: u32, on: Option<(usize, usize)>, shape: Shape<T>) -> Self {
+        let extent = shape
+            .vertices()
+            .iter()
+            .map(|&v| length(v))
+            .fold(T::zero(), T::max)
+            + shape.radius();
         Self {
             key,
             on,
             shape,
+            extent,
             group: 1,
             mask: u32::MAX,
         }

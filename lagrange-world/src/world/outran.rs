@@ -55,7 +55,7 @@ where
                     return false;
                 };
                 let link = s.on.map_or(0, |(_, link)| link);
-                if then.reach(body, &s.shape, link, &place.pose) <= place.reach + slack {
+                if then.reach(body, s.extent, link, &place.pose) <= place.reach + slack {
                     return false;
                 }
                 let end = s.shape.placed(&then.link(body, link));

@@ -77,23 +77,18 @@ impl<T: Real, const N: usize> Posed<T, N> {
         }
     }
 
-    /// How far any point of `shape`, on link `link` at `pose`, moves to here.
+    /// How far any point of a shape reaching `extent` from the origin of link `link`, at
+    /// `pose`, moves to here.
     pub(super) fn reach<M, L>(
         &self,
         body: &Body<T, M, L, N>,
-        shape: &Shape<T>,
+        extent: T,
         link: usize,
         pose: &Pose<T>,
     ) -> T
     where
         M: Mechanism<T, N> + Links<T, N>,
     {
-        let extent = shape
-            .vertices()
-            .iter()
-            .map(|&v| length(v))
-            .fold(T::zero(), T::max)
-            + shape.radius();
         let then = self.link(body, link);
         length(sub(then.origin, pose.origin)) + (then.angle - pose.angle).abs() * extent
     }
@@ -146,7 +141,7 @@ pub(crate) fn place<T, M, L, const N: usize, const B: usize, const S: usize>(
             let reach = [&ahead, &also]
                 .into_iter()
                 .flatten()
-                .map(|then| then.reach(body, &s.shape, link, &pose))
+                .map(|then| then.reach(body, s.extent, link, &pose))
                 .fold(T::zero(), T::max);
             *place = Place {
                 shape: s.shape.placed(&pose),
