@@ -378,6 +378,8 @@ struct Struck {
     first_gap: f64,
     gap: f64,
     lift: f64,
+    /// The third's velocity along x, m/s.
+    third_speed: f64,
     restitution: f64,
     /// The third in a group the others' masks leave out.
     filtered: bool,
@@ -392,6 +394,7 @@ const STRUCK: Struck = Struck {
     first_gap: 0.001,
     gap: 0.05,
     lift: 0.0,
+    third_speed: 0.0,
     restitution: 1.0,
     filtered: false,
     wall: false,
@@ -418,7 +421,7 @@ fn strike<T: Real>(row: Struck) -> Result<Strike, Error> {
     let placed = [
         (0.0, 0.0, row.speed),
         (second, 0.0, 0.0),
-        (third, row.lift, 0.0),
+        (third, row.lift, row.third_speed),
     ];
     // The third's shape keyed below the others': its contact with the second comes first
     // in the contacts' order, before the first phase's.
@@ -532,6 +535,34 @@ fn a_body_sent_into_another_strikes_it_in_the_step<T: Real>() -> Result<(), Erro
         };
         assert_eq!(report.profile, twice, "{report:?}");
     }
+    Ok(())
+}
+
+/// A body sent towards one that comes at it is looked for as far as that one moves too. The
+/// first box strikes the second at 12 m/s plastically (`e = 0`): the two leave at 6 m/s,
+/// 100 mm in the step, towards the third, 101 mm away and coming at them at 1.2 m/s (20 mm
+/// in the step: the boxes of the second and third, grown by the margin and their reach
+/// before the strike, stay apart, so the first phase has no pair of them). Where the step
+/// ends the second would be 19 mm into the third, and 1 mm short of where the third starts:
+/// it meets the third grown by the third's reach and half the margin, and the step looks
+/// again. Nothing deeper than the slop, momentum (10.8 N s) kept to rounding, no kinetic
+/// energy gained.
+fn a_body_sent_towards_one_coming_at_it<T: Real>() -> Result<(), Error> {
+    let (report, v, depth, ..) = strike::<T>(Struck {
+        speed: 12.0,
+        restitution: 0.0,
+        gap: 0.101,
+        third_speed: -1.2,
+        ..STRUCK
+    })?;
+    println!("{report:?}: velocities {v:?}, deepest {depth}");
+    assert!(report.looked_again, "{report:?}");
+    assert!(depth <= SLOP, "{depth}");
+    let rounding = 16.0 * T::EPSILON.to_f64() * 12.0;
+    let momentum: f64 = v.iter().sum();
+    assert!((momentum - 10.8).abs() <= rounding, "{v:?}");
+    let kinetic: f64 = v.iter().map(|v| v * v / 2.0).sum();
+    assert!(kinetic <= (144.0 + 1.44) / 2.0 + rounding * 12.0, "{v:?}");
     Ok(())
 }
 
@@ -1179,6 +1210,7 @@ for_f32_and_f64!(
     a_step_looks_again_only_where_a_body_is_sent_into_a_new_shape,
     a_body_sent_into_a_wall_or_a_sleeper,
     a_second_look_with_no_room_is_not_taken,
+    a_body_sent_towards_one_coming_at_it,
     a_failed_step_keeps_the_warm_start,
     events_and_queries,
     a_sleeping_box_still_touches_the_floor,
