@@ -73,7 +73,7 @@ use step::{Memory, Setup};
 /// at most 4 solves of the impulses (plastic, twice more with speculative rows, rebound),
 ///   at most K + 3 rounds in all (the plastic solve at most K; those after it share what it
 ///   left, at least one each), each round: one exact solve of the R normal rows (the
-///   active-set method of Delassus::complementary: per pass, the Cholesky rows of the rows
+///   active-set method of Delassus::complementary: per pass, the factored rows of the rows
 ///   that joined, at most 4 C + 4 passes, one or two from the last step's rows; where they
 ///   do not end, a degenerate set that cycles, 4 C sweeps of projected Gauss-Seidel over the
 ///   R rows instead, Delassus::relaxed), then sweeps of the F tangents until one changes

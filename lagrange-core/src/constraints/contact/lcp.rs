@@ -60,7 +60,7 @@ pub struct Complementary<T: Real, const C: usize> {
     /// The rows solved for, `a = 0`: bilateral rows, unilateral rows that push, bounded rows
     /// inside their bounds.
     pub active: [bool; C],
-    /// The passes the method took, each one solve of the rows solved for (a Cholesky
+    /// The passes the method took, each one solve of the rows solved for (an `F D F^T`
     /// factorisation of the rows that changed): what this solve cost, below the cap of
     /// `4 C + 4` ([`Delassus::relaxed`]: its sweeps).
     pub passes: u32,
@@ -69,8 +69,8 @@ pub struct Complementary<T: Real, const C: usize> {
 /// The rows of a set marked as candidates, with their mobilities `Y = M^-1 J^T` (one mass
 /// solve per candidate) and `W = J Y` over the candidates, built once and solved for as many
 /// subsets as the complementarity problem asks. Work: `R` mass solves and `R^2 N` for `W`
-/// (`R` candidates), then per pass of [`Delassus::complementary`] a Cholesky factorisation
-/// of the active rows (at most `R^3 / 6`).
+/// (`R` candidates), then per pass of [`Delassus::complementary`] an `F D F^T` factorisation
+/// of the active rows that changed (at most `R^3 / 6`).
 #[derive(Debug, Clone, Copy)]
 pub struct Delassus<T: Real, const N: usize, const C: usize> {
     /// The candidates' rows of the Jacobian as columns (`J^T`; zero off the candidates):
@@ -79,8 +79,9 @@ pub struct Delassus<T: Real, const N: usize, const C: usize> {
     rows: SMatrix<T, N, C>,
     mobility: SMatrix<T, N, C>,
     w: SMatrix<T, C, C>,
-    /// The Cholesky factor of the active rows, transposed: `factor[(q, p)]` for positions `q <= p` in
-    /// the active set (scratch, kept so that a solve does not clear `C^2` numbers a pass).
+    /// The factor `F D F^T` of the active rows, transposed: `factor[(q, p)]` for positions
+    /// `q <= p` in the active set, `D` on the diagonal (scratch, kept so that a solve does
+    /// not clear `C^2` numbers a pass).
     factor: SMatrix<T, C, C>,
     /// The rows the factor holds, in its order: `factored[..factored_n]` (cleared whenever
     /// `W` changes), so that a solve of the same rows again (the next round of a contact
@@ -648,11 +649,11 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
         Ok(Some(remove(order, n, held)))
     }
 
-    /// `x = W_AA^-1 r_A` on the rows `order[..n]` (zero elsewhere), by a Cholesky
-    /// factorisation of those rows alone in that order, refusing a pivot below
-    /// `sqrt(EPSILON)` of its diagonal entry (a row dependent on the ones before it). The
-    /// factor's first `kept` rows are those of the last call's (the same rows in the same
-    /// order): only the rows after them are factored.
+    /// `x = W_AA^-1 r_A` on the rows `order[..n]` (zero elsewhere), by a factorisation `W_AA
+    /// = F D F^T` of those rows alone in that order (`F` unit lower triangular, `D`
+    /// diagonal), refusing a pivot `D` below `sqrt(EPSILON)` of its diagonal entry of `W` (a
+    /// row dependent on the ones before it). The factor's first `kept` rows are those of the
+    /// last call's (the same rows in the same order): only the rows after them are factored.
     fn solve(
         &mut self,
         order: &[usize; C],
@@ -667,36 +668,44 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
             *f = o;
         }
         self.factored_n = kept;
-        // Stored transposed, `lt[(q, p)] = L[p][q]`: row `p` of `L`, which the factor's
-        // inner products and the forward substitution walk, is a column (in storage order).
+        // Stored transposed, `lt[(q, p)] = F[p][q]` for `q < p` (row `p` of `F`, which the
+        // factor's inner products and the forward substitution walk, is a column in storage
+        // order), and `lt[(p, p)] = D[p]`. The substitutions divide by `D` once a row's sum
+        // is done, off the chain of sums the next rows wait on: Cholesky's `L L^T`, whose
+        // substitutions divide each row's sum before the next can use it, spent a third of
+        // a solve waiting on those divisions.
         let lt = &mut self.factor;
         let row = |p: usize| within::<C>(order[p]);
+        // `c[q] = F[p][q] D[q]` of the row being factored.
+        let mut c = [T::zero(); C];
         for p in kept..n {
             let row_p = row(p);
             for q in 0..p {
-                let x = (0..q).fold(self.w[(row(q), row_p)], |x, k| x - lt[(k, p)] * lt[(k, q)]);
-                lt[(q, p)] = x / lt[(q, q)];
+                c[q] = (0..q).fold(self.w[(row(q), row_p)], |x, k| x - c[k] * lt[(k, q)]);
+                lt[(q, p)] = c[q] / lt[(q, q)];
             }
             let wpp = self.w[(row_p, row_p)];
-            let d = (0..p).fold(wpp, |d, k| d - lt[(k, p)] * lt[(k, p)]);
+            let d = (0..p).fold(wpp, |d, k| d - c[k] * lt[(k, p)]);
             if !d.is_finite() {
                 return Err(Error::NonFiniteState);
             }
             if d <= wpp.abs() * threshold {
                 return Err(Error::RedundantConstraints { row: row_p });
             }
-            lt[(p, p)] = d.sqrt();
+            lt[(p, p)] = d;
             self.factored[p] = order[p];
             self.factored_n = p + 1;
         }
         let mut y = [T::zero(); C];
         for p in 0..n {
-            y[p] = (0..p).fold(r[row(p)], |s, k| s - lt[(k, p)] * y[k]) / lt[(p, p)];
+            y[p] = (0..p).fold(r[row(p)], |s, k| s - lt[(k, p)] * y[k]);
+        }
+        for (p, y) in y.iter_mut().enumerate().take(n) {
+            *y /= lt[(p, p)];
         }
         let mut x = SVector::<T, C>::zeros();
         for p in (0..n).rev() {
-            let s = (p + 1..n).fold(y[p], |s, k| s - lt[(p, k)] * x[row(k)]);
-            x[row(p)] = s / lt[(p, p)];
+            x[row(p)] = (p + 1..n).fold(y[p], |s, k| s - lt[(p, k)] * x[row(k)]);
         }
         Ok(x)
     }
