@@ -845,6 +845,7 @@ const AREAS: [Area; 29] = [
             "lagrange-world/src/world/islands.rs",
             "lagrange-world/src/world/limits.rs",
             "lagrange-world/src/world/locks.rs",
+            "lagrange-world/src/world/merge.rs",
             "lagrange-world/src/world/mobilities.rs",
             "lagrange-world/src/world/outran.rs",
             "lagrange-world/src/world/own.rs",
