@@ -926,10 +926,10 @@ fn ragdoll_cost(
     println!(
         "  bound (ImpulseStepper's docs): the inner step + position_residual + jacobian + \
          tangent_jacobian + 2 velocity_jumps (R and F columns) + a velocity_jump per \
-         speculative row + at most K + 3 rounds in all (an exact solve of the R rows: Cholesky \
-         of at most R rows a pass, at most 4 C + 4 passes; at most K sweeps of the F \
-         tangents) + at \
-         most 3 exact solves for the drift + 2 to 4 evaluations of T and V"
+         speculative row + at most K + 3 rounds in all (an exact solve of the R rows: F D F^T \
+         of at most R rows a pass, at most 4 C + 4 passes; one sweep of the F tangents, at \
+         most K in a solve's last round) + at most 3 exact solves for the drift + 2 to 4 \
+         evaluations of T and V"
     );
     let mut failures = Vec::new();
     if rows > RAGDOLL_ROWS as u64 || rounds > k + 3 {

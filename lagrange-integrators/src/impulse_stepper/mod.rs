@@ -76,8 +76,8 @@ use step::{Memory, Setup};
 ///   active-set method of Delassus::complementary: per pass, the factored rows of the rows
 ///   that joined, at most 4 C + 4 passes, one or two from the last step's rows; where they
 ///   do not end, a degenerate set that cycles, 4 C sweeps of projected Gauss-Seidel over the
-///   R rows instead, Delassus::relaxed), then sweeps of the F tangents until one changes
-///   nothing, at most K
+///   R rows instead, Delassus::relaxed), then one sweep of the F tangents (in a solve's
+///   last round: sweeps until one changes nothing, at most K)
 /// at most 3 exact solves of the R rows for the drift; 1 position_residual after it (none
 ///   where the coordinates it reached are those the last step's reached, bit for bit), and
 ///   at most 3 more exact solves and position_residuals on the gaps it left (1 more

@@ -12,7 +12,7 @@ pub struct ImpulseReport {
     pub speculative: u32,
     /// Contacts with a tangent (friction).
     pub frictional: u32,
-    /// Exact solves of the normal rows, each followed by friction sweeps: at most the
+    /// Exact solves of the normal rows, each followed by a friction sweep: at most the
     /// settings' `max_iterations` for the plastic solve, and one more for each of the three
     /// that may follow it (two with speculative rows, the rebound), which share what it left:
     /// at most `ImpulseSettings::max_rounds`.

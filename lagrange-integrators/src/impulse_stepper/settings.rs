@@ -16,10 +16,11 @@ const MAX_ITERATIONS_CAP: u32 = 1000;
 ///                 (quiet, and warm-started); none makes every resting step lift it. Choose
 ///                 it above a step's free fall, dt^2 g (0.17 mm at 240 Hz, 2.7 mm at 60 Hz)
 /// max_iterations  rounds of the plastic impulse solve, at most (each an exact solve of the
-///                 normal rows, then Gauss-Seidel sweeps of the friction tangents until one
-///                 changes nothing, at most this many); the solves after it (speculative
-///                 rows, rebounds) share what it left, at least one round each: at most
-///                 max_iterations + 3 rounds a step (max_rounds), the cap on a step's work
+///                 normal rows, then a Gauss-Seidel sweep of the friction tangents; the last
+///                 round sweeps until one changes nothing, at most this many); the solves
+///                 after it (speculative rows, rebounds) share what it left, at least one
+///                 round each: at most max_iterations + 3 rounds a step (max_rounds), the
+///                 cap on a step's work
 /// tolerance       a round whose first sweep changes no tangent's speed by more than this
 ///                 (gap units per second, plus the rounding of the speed) ends the solve
 /// max_rows        rows in contact at once, at most (default: every row of the set): the
@@ -91,7 +92,8 @@ impl<T: Real> ImpulseSettings<T> {
         self.slop
     }
 
-    /// The most rounds of a step's plastic solve, and the most friction sweeps of a round.
+    /// The most rounds of a step's plastic solve, and the most friction sweeps of a solve's
+    /// last round (the others sweep once).
     #[must_use]
     pub fn max_iterations(&self) -> u32 {
         self.max_iterations

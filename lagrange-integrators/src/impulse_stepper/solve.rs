@@ -71,17 +71,18 @@ impl<T: Real, const N: usize, const C: usize> Problem<'_, T, N, C> {
     /// The impulses that give every normal row at least its `target` speed from the
     /// velocities `v0` (exactly its target where it pushes; a bilateral row exactly), with
     /// Coulomb friction `|tangent| <= mu normal` stopping the sliding where it can: the
-    /// normal rows solved exactly with the tangents' impulses held, then projected
-    /// Gauss-Seidel sweeps of the tangents with the normals held until they settle (at most
-    /// `sweeps` sweeps), from the tangents' impulses `warm`, at most `rounds` times, ending
-    /// early once a round's first sweep changes no tangent's speed by more than `tolerance`
-    /// (plus the rounding of its speed). The cone holds exactly at
-    /// the end. The velocities returned are `v0` plus the response of the final impulses.
+    /// normal rows solved exactly with the tangents' impulses held, then a projected
+    /// Gauss-Seidel sweep of the tangents with the normals held (in the last round `rounds`
+    /// allows, sweeps until they settle, at most `sweeps`), from the tangents' impulses
+    /// `warm`, at most `rounds` times, ending early once a round's first sweep changes no
+    /// tangent's speed by more than `tolerance` (plus the rounding of its speed). The cone
+    /// holds exactly at the end. The velocities returned are `v0` plus the response of the
+    /// final impulses.
     ///
     /// Where the exact solve has no answer (targets no impulses reach: a joint's two limits
     /// asked for rebounds that would cross its range in the step) or does not end in its
-    /// passes (a degenerate set that cycles), that round's normal impulses are projected Gauss-Seidel's ([`Delassus::relaxed`]) and the
-    /// solve is not settled.
+    /// passes (a degenerate set that cycles), that round's normal impulses are projected
+    /// Gauss-Seidel's ([`Delassus::relaxed`]) and the solve is not settled.
     ///
     /// # Errors
     /// As [`Delassus::complementary`], but for [`Error::NoConvergence`].
@@ -135,11 +136,16 @@ impl<T: Real, const N: usize, const C: usize> Problem<'_, T, N, C> {
                 settled = true;
                 break;
             }
-            // The tangents swept until they settle (each sweep is cheap beside a normal
-            // solve: two dot products a tangent), at most `sweeps` sweeps; the round settles
-            // when its first sweep changed nothing.
+            // One sweep of the tangents, and the next round solves the normals again: the
+            // rounds are Gauss-Seidel over the normals (exactly) and the tangents. Sweeping
+            // the tangents until they settle against normals that the next round moves was
+            // work lost (a landing ragdoll's rounds moved its normals by 5% each, and took
+            // four sweeps a round). The last round the cap allows sweeps until they settle,
+            // at most `sweeps` sweeps: the tangents that end the solve are the best for its
+            // normals. A round settles when its first sweep changed nothing.
+            let last = taken >= rounds.max(1);
             let mut v = sliding + self.normal.response(&p.normal);
-            for sweep in 0..sweeps.max(1) {
+            for sweep in 0..if last { sweeps.max(1) } else { 1 } {
                 let (mut change, mut allowed) = (T::zero(), tolerance);
                 for &i in with_tangent.iter().take(count) {
                     // Clamped (a no-op): the optimiser does not follow a row number
