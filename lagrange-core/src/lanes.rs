@@ -376,6 +376,8 @@ impl<T: Real, const L: usize> Real for Lanes<T, L> {
     const MAX: Self = Self::splat(T::MAX);
     const MIN_POSITIVE: Self = Self::splat(T::MIN_POSITIVE);
     const CBRT_EPSILON: Self = Self::splat(T::CBRT_EPSILON);
+    const SQRT_EPSILON: Self = Self::splat(T::SQRT_EPSILON);
+    const FOURTH_ROOT_EPSILON: Self = Self::splat(T::FOURTH_ROOT_EPSILON);
 
     /// Finite in every lane (lanes that disagree count a divergence).
     fn is_finite(self) -> bool {

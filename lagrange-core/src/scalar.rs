@@ -110,6 +110,11 @@ pub trait Real:
     /// `EPSILON^(1/3)`: the relative step of central differences that balances truncation
     /// against rounding (a constant, so that a Jacobian costs no `powf`).
     const CBRT_EPSILON: Self;
+    /// `EPSILON^(1/2)`, as `EPSILON.sqrt()` rounds it: the pivot tests' share (a constant, so
+    /// that a factorisation waits on no square root).
+    const SQRT_EPSILON: Self;
+    /// `EPSILON^(1/4)`, as `EPSILON.sqrt().sqrt()` rounds it.
+    const FOURTH_ROOT_EPSILON: Self;
     /// Neither NaN nor infinite.
     fn is_finite(self) -> bool;
     /// Widen to `f64` (for reports and logs).
@@ -279,7 +284,7 @@ macro_rules! impl_real {
     ($t:ident, $sin:ident, $cos:ident, $sin_cos:ident, $tan:ident, $sqrt:ident, $exp:ident,
      $ln:ident, $fabs:ident, $atan2:ident, $floor:ident, $round:ident, $asin:ident,
      $acos:ident, $atan:ident, $pow:ident, $lanes:path, $sin_lanes:path, $cos_lanes:path,
-     $cbrt_eps:expr) => {
+     $cbrt_eps:expr, $sqrt_eps:expr, $fourth_root_eps:expr) => {
         impl Scalar for $t {
             type Real = $t;
             #[inline]
@@ -351,6 +356,10 @@ macro_rules! impl_real {
             const MIN_POSITIVE: $t = $t::MIN_POSITIVE;
             #[allow(clippy::excessive_precision)]
             const CBRT_EPSILON: $t = $cbrt_eps;
+            #[allow(clippy::excessive_precision)]
+            const SQRT_EPSILON: $t = $sqrt_eps;
+            #[allow(clippy::excessive_precision)]
+            const FOURTH_ROOT_EPSILON: $t = $fourth_root_eps;
             #[inline]
             fn is_finite(self) -> bool {
                 $t::is_finite(self)
@@ -444,7 +453,9 @@ impl_real!(
     sin_cos_each,
     sin_each,
     cos_each,
-    6.055_454_452_393_343e-6 // 2^(-52/3)
+    6.055_454_452_393_343e-6,   // 2^(-52/3)
+    1.490_116_119_384_765_6e-8, // 2^-26
+    1.220_703_125e-4            // 2^-13
 );
 impl_real!(
     f32,
@@ -466,12 +477,31 @@ impl_real!(
     scalar_trig::sin_cos_lanesf,
     scalar_trig::sin_lanesf,
     scalar_trig::cos_lanesf,
-    4.921_566_4e-3 // 2^(-23/3)
+    4.921_566_4e-3, // 2^(-23/3)
+    3.452_669_8e-4, // 2^-11.5, rounded
+    1.858_136e-2    // its square root, rounded
 );
 
 #[cfg(test)]
 mod tests {
-    use super::split_dot;
+    use super::{split_dot, Real};
+
+    /// The roots of `EPSILON` are the ones the square root gives, bit for bit: a pivot test
+    /// with the constant refuses the rows the computed root did.
+    #[test]
+    fn roots_of_epsilon_are_the_computed_ones() {
+        fn check<T: Real>() {
+            let root = T::EPSILON.sqrt();
+            assert_eq!(T::SQRT_EPSILON.to_f64().to_bits(), root.to_f64().to_bits());
+            let fourth = root.sqrt();
+            assert_eq!(
+                T::FOURTH_ROOT_EPSILON.to_f64().to_bits(),
+                fourth.to_f64().to_bits()
+            );
+        }
+        check::<f32>();
+        check::<f64>();
+    }
 
     /// The partial sums are the documented ones: terms `0, 4, ...` in the first, and so on,
     /// then `(first + second) + (third + fourth)`. With `1e16` against `-1e16` four terms

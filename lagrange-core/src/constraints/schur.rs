@@ -151,7 +151,7 @@ pub(crate) fn cholesky_solve<T: Real, const C: usize>(
 pub(crate) fn cholesky<T: Real, const C: usize>(
     s: &SMatrix<T, C, C>,
 ) -> Result<SMatrix<T, C, C>, Error> {
-    let threshold = T::EPSILON.sqrt();
+    let threshold = T::SQRT_EPSILON;
     let mut l = SMatrix::<T, C, C>::zeros();
     for j in 0..C {
         let mut d = s[(j, j)];

@@ -408,6 +408,9 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
         // beyond what a dependence the pivot test cannot tell from near-dependence explains.
         let mut joined: Option<(usize, T, bool)> = None;
         let passes = 4 * C + 4;
+        // The solution of each pass's rows, written in place: returned by value, its copy
+        // waited on the stores of the substitution (a tenth of a one-row solve).
+        let mut x = SVector::<T, C>::zeros();
         for pass in 1..=passes {
             // The rows held at a bound push on the rows solved for.
             let mut rhs = SVector::<T, C>::zeros();
@@ -417,8 +420,8 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
                     .filter(|&k| !free[k] && lambda[k] != T::zero())
                     .fold(-b[i], |r, k| r - self.w[(i, k)] * lambda[k]);
             }
-            let x = match self.solve(&order, n, kept, &rhs) {
-                Ok(x) => x,
+            match self.solve(&order, n, kept, &rhs, &mut x) {
+                Ok(()) => {}
                 // A joining row that depends on the rows solved for: along the ray that moves
                 // it off its bound and them so that W lambda is unchanged, the program falls
                 // at the rate of its pull; as far as the first bound, where that row is held.
@@ -567,7 +570,7 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
                     // share of its terms is what such a part can leave, not a pull to follow
                     // along a ray (which assumes W lambda unchanged, and moved by 1 / that
                     // part, cycled: the next solve left the row out again at zero).
-                    let beyond = pull > T::EPSILON.sqrt().sqrt() * size;
+                    let beyond = pull > T::FOURTH_ROOT_EPSILON * size;
                     joined = Some((row, way, beyond));
                 }
                 None if all_finite(lambda.as_slice()) => {
@@ -613,7 +616,8 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
         for k in partners.clone() {
             column[k] = self.w[(k, row)];
         }
-        let c = self.solve(order, before, before, &column)?;
+        let mut c = SVector::<T, C>::zeros();
+        self.solve(order, before, before, &column, &mut c)?;
         let (lo, hi) = bounds[row];
         let own = if way > T::zero() {
             hi - lambda[row]
@@ -649,7 +653,7 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
         Ok(Some(remove(order, n, held)))
     }
 
-    /// `x = W_AA^-1 r_A` on the rows `order[..n]` (zero elsewhere), by a factorisation `W_AA
+    /// `x = W_AA^-1 r_A` on the rows `order[..n]` (`x` zero elsewhere), by a factorisation `W_AA
     /// = F D F^T` of those rows alone in that order (`F` unit lower triangular, `D`
     /// diagonal), refusing a pivot `D` below `sqrt(EPSILON)` of its diagonal entry of `W` (a
     /// row dependent on the ones before it). The factor's first `kept` rows are those of the
@@ -660,10 +664,11 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
         n: usize,
         kept: usize,
         r: &SVector<T, C>,
-    ) -> Result<SVector<T, C>, Error> {
+        x: &mut SVector<T, C>,
+    ) -> Result<(), Error> {
         let n = n.min(C);
         let kept = kept.min(n);
-        let threshold = T::EPSILON.sqrt();
+        let threshold = T::SQRT_EPSILON;
         for (f, &o) in self.factored.iter_mut().zip(order).take(kept) {
             *f = o;
         }
@@ -703,11 +708,11 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
         for (p, y) in y.iter_mut().enumerate().take(n) {
             *y /= lt[(p, p)];
         }
-        let mut x = SVector::<T, C>::zeros();
+        x.fill(T::zero());
         for p in (0..n).rev() {
             x[row(p)] = (p + 1..n).fold(y[p], |s, k| s - lt[(p, k)] * x[row(k)]);
         }
-        Ok(x)
+        Ok(())
     }
 }
 
