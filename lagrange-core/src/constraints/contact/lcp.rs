@@ -411,14 +411,18 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
         // The solution of each pass's rows, written in place: returned by value, its copy
         // waited on the stores of the substitution (a tenth of a one-row solve).
         let mut x = SVector::<T, C>::zeros();
+        // The rows whose multipliers push, listed anew where a sum runs over them.
+        let mut pushing = [0usize; C];
         for pass in 1..=passes {
-            // The rows held at a bound push on the rows solved for.
+            // The rows held at a bound push on the rows solved for (listed first, in order:
+            // the same sums, without a test per pair of rows).
+            let held = nonzero(listed.clone().filter(|&k| !free[k]), &lambda, &mut pushing);
             let mut rhs = SVector::<T, C>::zeros();
             for i in listed.clone().filter(|&i| free[i]) {
-                rhs[i] = listed
-                    .clone()
-                    .filter(|&k| !free[k] && lambda[k] != T::zero())
-                    .fold(-b[i], |r, k| r - self.w[(i, k)] * lambda[k]);
+                rhs[i] = pushing
+                    .iter()
+                    .take(held)
+                    .fold(-b[i], |r, &k| r - self.w[(i, k)] * lambda[k]);
             }
             match self.solve(&order, n, kept, &rhs, &mut x) {
                 Ok(()) => {}
@@ -516,18 +520,19 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
             // Every multiplier within its bounds: the held row whose a would lower the
             // program most by moving off its bound is solved for.
             let mut join: Option<(usize, T, T)> = None;
+            let all = nonzero(listed.clone(), &lambda, &mut pushing);
             for i in listed.clone().filter(|&i| !free[i] && !blocked[i]) {
                 let (lo, hi) = bounds[i];
                 if lo == hi {
                     continue;
                 }
-                let (a, size) = listed.clone().filter(|&k| lambda[k] != T::zero()).fold(
-                    (b[i], b[i].abs()),
-                    |(a, s), k| {
+                let (a, size) = pushing
+                    .iter()
+                    .take(all)
+                    .fold((b[i], b[i].abs()), |(a, s), &k| {
                         let term = self.w[(i, k)] * lambda[k];
                         (a + term, s + term.abs())
-                    },
-                );
+                    });
                 // Off the lower bound where a < 0, off the upper where a > 0 (a row left
                 // out at zero inside its bounds: either way). Rounding (64 ulps of the sum's
                 // terms) is no pull: a row held at a bound does not leave it on the sign of
@@ -714,6 +719,24 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
         }
         Ok(())
     }
+}
+
+/// The rows of `rows` whose multiplier is not zero, in order, written to the front of
+/// `out`: how many.
+fn nonzero<T: Real, const C: usize>(
+    rows: impl Iterator<Item = usize>,
+    lambda: &SVector<T, C>,
+    out: &mut [usize; C],
+) -> usize {
+    let mut n = 0;
+    for (slot, k) in out
+        .iter_mut()
+        .zip(rows.map(within::<C>).filter(|&k| lambda[k] != T::zero()))
+    {
+        *slot = k;
+        n += 1;
+    }
+    n
 }
 
 /// The rows and columns of `w` marked in `rows` set to zero.
