@@ -118,7 +118,8 @@ impl<T: Real, const C: usize, K> Setup<T, C, K> {
             }
         });
         for _ in 0..=SPECULATIVE_ROUNDS {
-            let after = jacobian * dq + off;
+            // No product for the first look (no displacement yet).
+            let after = if corrected { jacobian * dq + off } else { off };
             let joining: [bool; C] = core::array::from_fn(|i| {
                 !normal.candidates()[i] && !self.bilateral[i] && after[i] < T::zero()
             });
@@ -309,8 +310,12 @@ impl<T: Real, const C: usize, K> Setup<T, C, K> {
         };
         let mut plastic = solve(normal, &target, &warm, &guess, rounds)?;
         let (mut taken, mut speculative) = (plastic.rounds, 0u32);
+        // The gaps where the plastic impulses' shift of the coordinates takes the rows.
+        let reach_of = |plastic: &Solved<T, N, C>| {
+            jacobian * ((plastic.velocity - free.qd) * share) + gaps
+        };
+        let mut reach = reach_of(&plastic);
         for _ in 0..SPECULATIVE_ROUNDS {
-            let reach = jacobian * ((plastic.velocity - free.qd) * share) + gaps;
             let joining: [bool; C] =
                 core::array::from_fn(|i| !normal.candidates()[i] && reach[i] < -slop);
             if share <= T::zero() || !joining.iter().any(|&j| j) {
@@ -329,6 +334,7 @@ impl<T: Real, const C: usize, K> Setup<T, C, K> {
                 left(taken),
             )?;
             taken += plastic.rounds;
+            reach = reach_of(&plastic);
         }
         let rebound = self.rebounds(&gaps, &w);
         let solved = if rebound.iter().any(|&r| r > T::zero()) {
@@ -349,8 +355,7 @@ impl<T: Real, const C: usize, K> Setup<T, C, K> {
             plastic
         };
         let shift = (plastic.velocity - free.qd) * share;
-        let (dq, corrected) =
-            self.drift(normal, jacobian, jacobian * shift + gaps, &kinds, jump)?;
+        let (dq, corrected) = self.drift(normal, jacobian, reach, &kinds, jump)?;
         let (q, drift_rounds, held_back) = self.settle(
             normal,
             jacobian,
