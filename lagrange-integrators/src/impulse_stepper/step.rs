@@ -311,9 +311,8 @@ impl<T: Real, const C: usize, K> Setup<T, C, K> {
         let mut plastic = solve(normal, &target, &warm, &guess, rounds)?;
         let (mut taken, mut speculative) = (plastic.rounds, 0u32);
         // The gaps where the plastic impulses' shift of the coordinates takes the rows.
-        let reach_of = |plastic: &Solved<T, N, C>| {
-            jacobian * ((plastic.velocity - free.qd) * share) + gaps
-        };
+        let reach_of =
+            |plastic: &Solved<T, N, C>| jacobian * ((plastic.velocity - free.qd) * share) + gaps;
         let mut reach = reach_of(&plastic);
         for _ in 0..SPECULATIVE_ROUNDS {
             let joining: [bool; C] =
