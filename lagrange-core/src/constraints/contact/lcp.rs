@@ -422,7 +422,8 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
                 rhs[i] = pushing
                     .iter()
                     .take(held)
-                    .fold(-b[i], |r, &k| r - self.w[(i, k)] * lambda[k]);
+                    .map(|&k| within::<C>(k))
+                    .fold(-b[i], |r, k| r - self.w[(i, k)] * lambda[k]);
             }
             match self.solve(&order, n, kept, &rhs, &mut x) {
                 Ok(()) => {}
@@ -526,13 +527,13 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
                 if lo == hi {
                     continue;
                 }
-                let (a, size) = pushing
-                    .iter()
-                    .take(all)
-                    .fold((b[i], b[i].abs()), |(a, s), &k| {
+                let (a, size) = pushing.iter().take(all).map(|&k| within::<C>(k)).fold(
+                    (b[i], b[i].abs()),
+                    |(a, s), k| {
                         let term = self.w[(i, k)] * lambda[k];
                         (a + term, s + term.abs())
-                    });
+                    },
+                );
                 // Off the lower bound where a < 0, off the upper where a > 0 (a row left
                 // out at zero inside its bounds: either way). Rounding (64 ulps of the sum's
                 // terms) is no pull: a row held at a bound does not leave it on the sign of
@@ -722,7 +723,8 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
 }
 
 /// The rows of `rows` whose multiplier is not zero, in order, written to the front of
-/// `out`: how many.
+/// `out`: how many. (Read back through [`within`]: the optimiser does not follow a row
+/// number through an array, and an index it cannot bound is a panic path.)
 fn nonzero<T: Real, const C: usize>(
     rows: impl Iterator<Item = usize>,
     lambda: &SVector<T, C>,
