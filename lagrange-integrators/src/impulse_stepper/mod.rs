@@ -116,10 +116,11 @@ use step::{Memory, Setup};
 /// **Which contact stepper.** This one for real time: bounded work, no hitch when a ragdoll
 /// lands, resting bodies quiet (they fall asleep in a scene), first order through contacts.
 /// The ragdoll thrown onto the floor at 240 Hz (`cargo xtask bench --contacts`, `f32`): a
-/// mean step 1.9 times a free RK4 step, the slowest 6.8 times, 2 mm deep at most.
+/// mean step 1.55 times a free RK4 step, the slowest 4.7 to 4.9 times, 2 mm deep at most.
 /// [`ContactStepper`](crate::ContactStepper) for accuracy: it locates every contact inside
 /// the step and keeps the inner method's order between them, at a cost that grows with the
-/// events (the same throw: about 90 times a free step on average, thousands in a landing).
+/// events (the same throw in `f64`: about 60 times a free step on average, thousands in a
+/// landing).
 ///
 /// The same rows and [`ContactModel`] as [`ContactStepper`](crate::ContactStepper): a
 /// mechanism switches by changing one line. The model's time tolerance is not used.
