@@ -230,10 +230,11 @@ const DOC_TEST: [&[&str]; 1] = [&["test", "--workspace", "--doc", "--quiet"]];
 /// Long runs (10^6 steps and more) are `#[ignore]`d in the quick debug test run and run here,
 /// optimised (profile `long-test`: the release build without its link-time optimisation and
 /// in parallel codegen units, since each of the dozen test binaries is built for one run of a
-/// few seconds; the bits are the same, IEEE-754 operations only). They live in the `tests` crate (so the bench crate's heavy dependencies are not
-/// built in release for them) and, for `fast_trig`'s exhaustive sweep, in `lagrange-core`'s
-/// own tests; only the test targets that hold an `#[ignore]`d test are built in release
-/// (found by reading the test directories), not all seventy.
+/// few seconds; the bits are the same, IEEE-754 operations only). They live in the `tests`
+/// crate (so the bench crate's heavy dependencies are not built optimised for them) and, for
+/// `fast_trig`'s exhaustive sweep, in `lagrange-core`'s own tests; only the test targets that
+/// hold an `#[ignore]`d test are built optimised (found by reading the test directories), not
+/// all seventy.
 fn long_test() -> Result<(), String> {
     for (package, dir) in LONG_TEST_DIRS {
         let mut args: Vec<String> = ["test", "-p", package, "--profile", "long-test", "--quiet"]
