@@ -360,11 +360,7 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
         }
         // The candidates, listed: every loop below runs over them alone.
         let mut cand = [0usize; C];
-        let mut m = 0;
-        for (slot, i) in cand.iter_mut().zip((0..C).filter(|&i| self.candidate[i])) {
-            *slot = i;
-            m += 1;
-        }
+        let m = list((0..C).filter(|&i| self.candidate[i]), &mut cand);
         let listed = cand.iter().take(m).map(|&i| within::<C>(i));
         let mut bounds = [(T::zero(), T::zero()); C];
         for i in listed.clone() {
@@ -723,18 +719,24 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
 }
 
 /// The rows of `rows` whose multiplier is not zero, in order, written to the front of
-/// `out`: how many. (Read back through [`within`]: the optimiser does not follow a row
-/// number through an array, and an index it cannot bound is a panic path.)
+/// `out`: how many.
 fn nonzero<T: Real, const C: usize>(
     rows: impl Iterator<Item = usize>,
     lambda: &SVector<T, C>,
     out: &mut [usize; C],
 ) -> usize {
+    list(
+        rows.map(within::<C>).filter(|&k| lambda[k] != T::zero()),
+        out,
+    )
+}
+
+/// The rows of `rows` (at most `C`), in order, written to the front of `out`: how many.
+/// (Read back through [`within`]: the optimiser does not follow a row number through an
+/// array, and an index it cannot bound is a panic path.)
+fn list<const C: usize>(rows: impl Iterator<Item = usize>, out: &mut [usize; C]) -> usize {
     let mut n = 0;
-    for (slot, k) in out
-        .iter_mut()
-        .zip(rows.map(within::<C>).filter(|&k| lambda[k] != T::zero()))
-    {
+    for (slot, k) in out.iter_mut().zip(rows) {
         *slot = k;
         n += 1;
     }
