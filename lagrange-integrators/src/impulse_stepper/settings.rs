@@ -16,8 +16,7 @@ const MAX_ITERATIONS_CAP: u32 = 1000;
 ///                 (quiet, and warm-started); none makes every resting step lift it. Choose
 ///                 it above a step's free fall, dt^2 g (0.17 mm at 240 Hz, 2.7 mm at 60 Hz)
 /// max_iterations  rounds of the plastic impulse solve, at most (each an exact solve of the
-///                 normal rows, then a Gauss-Seidel sweep of the friction tangents, each
-///                 round after the second from a secant step on the two before; the last
+///                 normal rows, then a Gauss-Seidel sweep of the friction tangents; the last
 ///                 round sweeps until one changes nothing, at most this many); the solves
 ///                 after it (speculative rows, rebounds) share what it left, at least one
 ///                 round each: at most max_iterations + 3 rounds a step (max_rounds), the

@@ -2,7 +2,6 @@
 //! ([`Delassus::complementary`]), alternated with Coulomb friction sweeps, at most a capped
 //! number of times.
 
-use super::mixing::Mixing;
 use super::rows::{within, Direction};
 use lagrange_core::constraints::contact::{Delassus, Row};
 use lagrange_core::nalgebra::SVector;
@@ -116,10 +115,8 @@ impl<T: Real, const N: usize, const C: usize> Problem<'_, T, N, C> {
         let rounding = T::from_f64(16.0) * T::EPSILON;
         let (mut taken, mut settled, mut exact) = (0, false, true);
         let mut guess = *self.pushed;
-        let mut mixing = Mixing::new();
         while taken < rounds.max(1) && !settled {
             taken += 1;
-            let start = p.tangent;
             let sliding = self.tangent_response(v0, &p.tangent, &with_tangent[..count.min(C)]);
             let b = self.normal.speeds(&sliding) - target;
             let solved = match self.normal.complementary_from(&b, self.kinds, &guess) {
@@ -173,18 +170,6 @@ impl<T: Real, const N: usize, const C: usize> Problem<'_, T, N, C> {
                 if quiet {
                     break;
                 }
-            }
-            // The next round from the secant step on this round's change and the last's
-            // (see `mixing`).
-            if !settled && !last {
-                let normal = &p.normal;
-                mixing.step(
-                    &start,
-                    &mut p.tangent,
-                    &with_tangent[..count.min(C)],
-                    self.tangent,
-                    |i| self.friction * normal[i],
-                );
             }
         }
         if !frictional {
