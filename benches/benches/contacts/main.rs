@@ -11,6 +11,10 @@
 //!   +-2.5 rad, e = 0.8, no friction), dt = 1e-3 s, 10 s.
 //! - `ball`: a 1 kg `FallingParticle` dropped from 1 m, e = 0.5, rest speed 0.05 m/s,
 //!   dt = 1e-3 s, 5 s (it is at rest well before).
+//! - `ragdoll_throws`: the same ragdoll thrown sixteen other ways ([`throws`]), the
+//!   time-stepping stepper only: each figure over the throws (the mean step averaged, the
+//!   worst the worst of any; the note gives the throws' range). No goal reads it; it says
+//!   how far one throw's figures carry.
 //!
 //! Steppers: `time_stepping` is `ImpulseStepper` with `SemiImplicitEuler` inside, slop 2 mm
 //! and at most 4 rounds for a step's plastic solve ([`scenes::SLOP`], [`scenes::MAX_ITERATIONS`]: a game's
@@ -69,6 +73,7 @@ mod rapier_ragdoll;
 mod report;
 mod run;
 mod scenes;
+mod throws;
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -301,6 +306,18 @@ fn scenes_in<T: lagrange_core::Real>(plan: Plan, rows: &mut Vec<Row>) -> Result<
     }
     println!("== ragdoll, {scalar}: {steps} steps");
     rows.extend(measure("ragdoll", scalar, steps, c, plan));
+
+    let starts = scenes::other_throws();
+    println!("== {}, {scalar}: {} throws", throws::SCENE, starts.len());
+    let mut each = Vec::new();
+    for start in &starts {
+        let scene = scenes::ragdoll_from::<T>(ragdoll_s, start).map_err(e)?;
+        let steps = scene.steps;
+        let mut c = scenes::candidates(scene).map_err(e)?;
+        c.retain(|c| c.stepper != "event");
+        each.extend(measure(throws::SCENE, scalar, steps, c, plan));
+    }
+    rows.extend(throws::spread(&each));
 
     let scene = scenes::double_pendulum::<T>(pendulum_s).map_err(e)?;
     let steps = scene.steps;

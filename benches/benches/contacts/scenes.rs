@@ -68,6 +68,29 @@ pub fn thrown() -> State<f64, N> {
     State::new(0.0, q, qd)
 }
 
+/// Sixteen other throws of the same ragdoll (`ragdoll_throws`): the example's turned by
+/// -1.0 to +0.74 rad, its limbs spread 34% to 90% as far, thrown at -0.5 to 3.4 m/s
+/// sideways and 0.6 to 2.5 m/s up, spun at -1.0 to 5.2 rad/s (throw `v`, 1 to 16, moves
+/// each by `v mod 6` steps of one size and `v / 6` of another). Each lands otherwise (the
+/// solves' rounds depend on how the limbs meet the floor), so the spread of their costs
+/// says what one throw's figures do not.
+pub fn other_throws() -> Vec<State<f64, N>> {
+    (1..=16)
+        .map(|v: u32| {
+            let (a, b) = (f64::from(v % 6), f64::from(v / 6));
+            let mut s = thrown();
+            s.q[2] += -0.2 * a + 0.37 * b;
+            for k in [4, 6, 8, 9, 10, 11] {
+                s.q[k] *= 1.0 - 0.1 * a - 0.13 * b;
+            }
+            s.qd[0] += -0.5 * a + 0.7 * b;
+            s.qd[1] += 0.3 * a - 0.2 * b;
+            s.qd[2] += -0.8 * a + 1.1 * b;
+            s
+        })
+        .collect()
+}
+
 /// The scene of one mechanism: what its steppers share.
 pub struct Scene<T: Real, M, K, const N: usize> {
     /// The mechanism.
@@ -97,8 +120,18 @@ pub struct Scene<T: Real, M, K, const N: usize> {
 pub fn ragdoll<T: Real>(
     seconds: f64,
 ) -> Result<Scene<T, Ragdoll<T>, RagdollContacts<T>, N>, Error> {
+    ragdoll_from(seconds, &thrown())
+}
+
+/// The ragdoll of [`ragdoll`] thrown from `s`.
+///
+/// # Errors
+/// Never, for these parameters.
+pub fn ragdoll_from<T: Real>(
+    seconds: f64,
+    s: &State<f64, N>,
+) -> Result<Scene<T, Ragdoll<T>, RagdollContacts<T>, N>, Error> {
     let doll = Ragdoll::new(RagdollBody::<T>::adult())?;
-    let s = thrown();
     Ok(Scene {
         mechanism: doll,
         contacts: RagdollContacts::adult(&doll, T::zero())?,
