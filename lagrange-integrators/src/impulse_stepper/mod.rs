@@ -477,15 +477,7 @@ mod tests {
     #[test]
     fn rows_are_taken_again_within_a_unit_of_the_last_place() -> Result<(), Error> {
         let ball = FallingParticle::new(1.0, 9.81)?;
-        let model = ContactModel::new(0.0, 0.05, 1e-10)?;
-        let settings = ImpulseSettings::new(1e-3, 4)?;
-        let mut stepper =
-            ImpulseStepper::new(SemiImplicitEuler, Holonomic::new(Ground), model, settings);
-        let dt = 1e-2;
-        let mut s = State::at_rest([0.0]);
-        for _ in 0..3 {
-            s = stepper.step(&ball, &s, dt)?;
-        }
+        let (mut stepper, s) = at_rest(&ball)?;
         assert_eq!(s.q[0], 0.0);
         let mut taken = |lift: f64| -> Result<bool, Error> {
             let before = stepper.work.reused;
@@ -493,7 +485,7 @@ mod tests {
                 q: s.q.add_scalar(lift * f64::EPSILON),
                 ..s
             };
-            stepper.step(&ball, &from, dt)?;
+            stepper.step(&ball, &from, DT)?;
             Ok(stepper.work.reused > before)
         };
         assert!(taken(0.0)?);
@@ -512,6 +504,26 @@ mod tests {
         }
     }
 
+    /// The step of the resting balls, s.
+    const DT: f64 = 1e-2;
+
+    /// The stepper of a ball on the ground.
+    type OnGround = ImpulseStepper<f64, 1, 1, SemiImplicitEuler, Holonomic<Ground>>;
+
+    /// A stepper that has held `ball` at rest on the ground for three steps (plastic, slop
+    /// 1 mm), and the state it holds.
+    fn at_rest(ball: &FallingParticle<f64>) -> Result<(OnGround, State<f64, 1>), Error> {
+        let model = ContactModel::new(0.0, 0.05, 1e-10)?;
+        let settings = ImpulseSettings::new(1e-3, 4)?;
+        let mut stepper =
+            ImpulseStepper::new(SemiImplicitEuler, Holonomic::new(Ground), model, settings);
+        let mut s = State::at_rest([0.0]);
+        for _ in 0..3 {
+            s = stepper.step(ball, &s, DT)?;
+        }
+        Ok((stepper, s))
+    }
+
     /// A stepper handed another mechanism at the same coordinates (a ball of twice the mass
     /// resting where the first rested) fills its rows anew: the resting impulse is the new
     /// ball's weight over the step, not the old one's.
@@ -521,20 +533,12 @@ mod tests {
             FallingParticle::new(1.0, 9.81)?,
             FallingParticle::new(2.0, 9.81)?,
         );
-        let model = ContactModel::new(0.0, 0.05, 1e-10)?;
-        let settings = ImpulseSettings::new(1e-3, 4)?;
-        let mut stepper =
-            ImpulseStepper::new(SemiImplicitEuler, Holonomic::new(Ground), model, settings);
-        let dt = 1e-2;
-        let mut s = State::at_rest([0.0]);
-        for _ in 0..3 {
-            s = stepper.step(&light, &s, dt)?;
-        }
+        let (mut stepper, s) = at_rest(&light)?;
         // At rest, its rows taken again.
         assert!(stepper.work.filled.is_some_and(|f| f.mass_known));
-        let weight = |m: f64| m * 9.81 * dt;
+        let weight = |m: f64| m * 9.81 * DT;
         assert!((stepper.impulses().0[0] - weight(1.0)).abs() < 1e-12);
-        stepper.step(&heavy, &s, dt)?;
+        stepper.step(&heavy, &s, DT)?;
         assert!((stepper.impulses().0[0] - weight(2.0)).abs() < 1e-12);
         Ok(())
     }
