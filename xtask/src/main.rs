@@ -12,8 +12,8 @@
 //!   acceleration against the hand-derived and generated ones (`automatic.csv`, `automatic.md`).
 //!   `--contacts`: ns per step of the contact steppers (thrown ragdoll, the same thrown
 //!   sixteen other ways, double pendulum on the floor, bouncing ball) against a free RK4
-//!   step and against rapier2d, with depth and
-//!   energy gain (`contacts.csv`, `contacts.md`). `--world`: ns per step of
+//!   step and against rapier2d, with depth and energy gain (`contacts.csv`,
+//!   `contacts.md`). `--world`: ns per step of
 //!   `lagrange_world::World` (pyramids of boxes, a pit of 1,000 balls, piles of ragdolls awake
 //!   and asleep) against rapier2d on the same scenes, with bodies awake and depth
 //!   (`world.csv`, `world.md`).

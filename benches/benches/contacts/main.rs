@@ -83,6 +83,9 @@ use lagrange_benches::timing::median;
 /// The free step's name among the candidates (it is not a row of the CSV).
 pub const FREE: &str = "free_rk4";
 
+/// The event-driven stepper's name (`ContactStepper`).
+pub const EVENT: &str = "event";
+
 /// One way of stepping a scene.
 pub struct Candidate {
     /// `free_rk4`, `time_stepping`, `event` or `rapier2d`.
@@ -314,7 +317,7 @@ fn scenes_in<T: lagrange_core::Real>(plan: Plan, rows: &mut Vec<Row>) -> Result<
         let scene = scenes::ragdoll_from::<T>(ragdoll_s, start).map_err(e)?;
         let steps = scene.steps;
         let mut c = scenes::candidates(scene).map_err(e)?;
-        c.retain(|c| c.stepper != "event");
+        c.retain(|c| c.stepper != EVENT);
         each.extend(measure(throws::SCENE, scalar, steps, c, plan));
     }
     rows.extend(throws::spread(&each));

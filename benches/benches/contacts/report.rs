@@ -57,7 +57,7 @@ fn verdict(x: Option<f64>, bound: f64) -> &'static str {
 fn goals(rows: &[Row]) -> Vec<(String, String, &'static str)> {
     let mut out = Vec::new();
     for scene in ["ragdoll", "double_pendulum"] {
-        for stepper in ["time_stepping", "event"] {
+        for stepper in ["time_stepping", crate::EVENT] {
             for scalar in ["f32", "f64"] {
                 let Some(r) = find(rows, scene, stepper, scalar) else {
                     continue;
@@ -83,7 +83,7 @@ fn goals(rows: &[Row]) -> Vec<(String, String, &'static str)> {
     }
     let peer = find(rows, "ragdoll", "rapier2d", "f32");
     let sleeping = find(rows, "ragdoll", crate::RAPIER_SLEEPING, "f32");
-    for stepper in ["time_stepping", "event"] {
+    for stepper in ["time_stepping", crate::EVENT] {
         let ours = find(rows, "ragdoll", stepper, "f32");
         let ratio = |theirs: Option<&Row>, pick: fn(&Row) -> Option<f64>| {
             ours.and_then(pick)

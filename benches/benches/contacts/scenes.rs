@@ -313,7 +313,7 @@ where
             })),
         },
         Candidate {
-            stepper: "event",
+            stepper: crate::EVENT,
             run: Box::new(move |per_step| {
                 timed_run(&mechanism, &start, dt, steps, event(), per_step)
             }),
