@@ -15,7 +15,7 @@ use crate::tools::CargoTool;
 /// mdBook, pinned. Without its default features (`serve` and `watch`: a web server and a file
 /// watcher that a build does not use) it installs in a fraction of the time; unoptimised,
 /// as the book is small.
-const MDBOOK: CargoTool = CargoTool {
+pub(crate) const MDBOOK: CargoTool = CargoTool {
     name: "mdbook",
     version: "0.5.4",
     install_args: &["--debug", "--no-default-features", "--features", "search"],

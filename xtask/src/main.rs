@@ -291,28 +291,48 @@ fn targets_with_ignored(dir: &std::path::Path) -> Result<Vec<String>, String> {
     Ok(targets)
 }
 
-/// A step of CI: what it is called in the log, and what it runs.
-type Step<'a> = (&'a str, &'a dyn Fn() -> Result<(), String>);
+/// A step of CI: what it is called in the log, whether it needs the tools [`ci`] installs
+/// in the background, and what it runs.
+type Step<'a> = (&'a str, bool, &'a dyn Fn() -> Result<(), String>);
+
+/// The Debian packages of CI's steps: the emulators (`qemu`) and the browser (`web`).
+static CI_PACKAGES: [tools::AptTool; 3] = [qemu::QEMU_ARM, qemu::QEMU_RISCV, web::CHROMIUM];
+
+/// The crates.io tools of CI's steps: the firmware log's decoder (`qemu`) and mdBook
+/// (`guide`).
+static CI_CRATES: [&tools::CargoTool; 2] = [&qemu::DEFMT_PRINT, &guide::MDBOOK];
 
 /// Everything CI checks; every step runs and every failure is reported at the end, with
-/// each step's wall time (CI's budget is 20 minutes on an idle 2-core machine).
+/// each step's wall time (CI's budget is 20 minutes on an idle 2-core machine). The tools
+/// the later steps need are installed in the background from the start
+/// ([`tools::prefetch`]); the first step that needs one waits for them.
 fn ci() -> Result<(), String> {
+    let mut prefetch = Some(tools::prefetch(&CI_PACKAGES, &CI_CRATES));
     let steps: [Step; 10] = [
-        ("checks", &|| cmd::run_all(&CHECKS)),
-        ("publish", &publish::run),
-        ("tests", &|| cmd::run_all(&TEST)),
-        ("doc tests", &|| cmd::run_all(&DOC_TEST)),
-        ("long tests", &long_test),
-        ("derive", &derive::check),
-        ("cross", &cross::run),
-        ("qemu", &qemu::run),
-        ("web", &|| web::run(&["--test".to_string()])),
-        ("guide", &|| guide::run(&[])),
+        ("checks", false, &|| cmd::run_all(&CHECKS)),
+        ("publish", false, &publish::run),
+        ("tests", false, &|| cmd::run_all(&TEST)),
+        ("doc tests", false, &|| cmd::run_all(&DOC_TEST)),
+        ("long tests", false, &long_test),
+        ("derive", false, &derive::check),
+        ("cross", false, &cross::run),
+        ("qemu", true, &qemu::run),
+        ("web", true, &|| web::run(&["--test".to_string()])),
+        ("guide", true, &|| guide::run(&[])),
     ];
     let mut failures = Vec::new();
     let mut times = Vec::new();
-    for (name, step) in steps {
+    for (name, needs_tools, step) in steps {
         let start = std::time::Instant::now();
+        if needs_tools {
+            // A failed install is only reported: the step installs what is still missing.
+            match prefetch.take().map(std::thread::JoinHandle::join) {
+                Some(Ok(Ok(done))) => println!("xtask ci: tools in the background: {done}"),
+                Some(Ok(Err(e))) => println!("xtask ci: tools in the background: {e}"),
+                Some(Err(_)) => println!("xtask ci: the tools' thread panicked"),
+                None => {}
+            }
+        }
         if let Err(e) = step() {
             failures.push(e);
         }

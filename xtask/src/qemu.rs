@@ -34,6 +34,7 @@ use lagrange_cases::{
 
 use crate::cmd;
 use crate::cross;
+use crate::tools::{AptTool, CargoTool};
 
 /// The firmware crate, relative to the project root.
 const FIRMWARE_DIR: &str = "embedded/firmware";
@@ -44,10 +45,8 @@ pub(crate) struct Core {
     name: &'static str,
     /// The Rust target the firmware is built for.
     target: &'static str,
-    /// The emulator.
-    qemu: &'static str,
-    /// The Debian package the emulator is in.
-    package: &'static str,
+    /// The emulator, and the Debian package it is in.
+    emulator: AptTool,
     /// The board's arguments (machine, CPU, memory).
     machine: &'static [&'static str],
     /// The board and counter, for the tables' headings.
@@ -62,11 +61,22 @@ pub(crate) struct Core {
 const M4F: Core = Core {
     name: "M4F",
     target: cross::TARGET,
-    qemu: "qemu-system-arm",
-    package: "qemu-system-arm",
+    emulator: QEMU_ARM,
     machine: &["-machine", "mps2-an386", "-cpu", "cortex-m4"],
     board: "QEMU mps2-an386, SysTick at 25 MHz",
     panic_free: true,
+};
+
+/// The Arm cores' emulator.
+pub(crate) const QEMU_ARM: AptTool = AptTool {
+    program: "qemu-system-arm",
+    package: "qemu-system-arm",
+};
+
+/// The RISC-V cores' emulator.
+pub(crate) const QEMU_RISCV: AptTool = AptTool {
+    program: "qemu-system-riscv32",
+    package: "qemu-system-misc",
 };
 
 /// Every core `cargo xtask qemu` runs, the M4F first.
@@ -84,8 +94,7 @@ pub(crate) const CORES: [Core; 5] = [
     Core {
         name: "M33",
         target: "thumbv8m.main-none-eabihf",
-        qemu: "qemu-system-arm",
-        package: "qemu-system-arm",
+        emulator: QEMU_ARM,
         machine: &["-machine", "mps2-an505", "-cpu", "cortex-m33"],
         board: "QEMU mps2-an505, SysTick at 20 MHz",
         panic_free: true,
@@ -93,8 +102,7 @@ pub(crate) const CORES: [Core; 5] = [
     Core {
         name: "M0",
         target: "thumbv6m-none-eabi",
-        qemu: "qemu-system-arm",
-        package: "qemu-system-arm",
+        emulator: QEMU_ARM,
         machine: &[
             "-machine",
             "microbit",
@@ -109,8 +117,7 @@ pub(crate) const CORES: [Core; 5] = [
     Core {
         name: "RV32IMAC",
         target: "riscv32imac-unknown-none-elf",
-        qemu: "qemu-system-riscv32",
-        package: "qemu-system-misc",
+        emulator: QEMU_RISCV,
         machine: &["-machine", "virt", "-bios", "none"],
         board: "QEMU virt, minstret",
         panic_free: true,
@@ -118,8 +125,7 @@ pub(crate) const CORES: [Core; 5] = [
     Core {
         name: "RV32IMAFC",
         target: "riscv32imafc-unknown-none-elf",
-        qemu: "qemu-system-riscv32",
-        package: "qemu-system-misc",
+        emulator: QEMU_RISCV,
         machine: &["-machine", "virt", "-bios", "none"],
         board: "QEMU virt, minstret",
         panic_free: false,
@@ -142,11 +148,14 @@ const QEMU_ARGS: [&str; 10] = [
     "shift=0,align=off,sleep=off",
 ];
 
-/// The decoder, installed from crates.io when missing.
-const DEFMT_PRINT: &str = "defmt-print";
-
-/// The decoder's pinned version (it decodes defmt 1.x's wire format).
-const DEFMT_PRINT_VERSION: &str = "1.2.0";
+/// The decoder, installed from crates.io when missing, pinned (1.2.0 decodes defmt 1.x's
+/// wire format). Unoptimised (`--debug`): that halves the build (measured here: 1.5 against
+/// 2.7 CPU minutes), and decoding a log of a few kilobytes takes no time either way.
+pub(crate) const DEFMT_PRINT: CargoTool = CargoTool {
+    name: "defmt-print",
+    version: "1.2.0",
+    install_args: &["--debug"],
+};
 
 /// CPU time a QEMU run or a decode may use ([`cmd::overdue`]). The lockstep image runs in
 /// under a second of host time here; the limit only turns a hang (a fault loop, a lost exit)
@@ -171,10 +180,9 @@ pub fn run() -> Result<(), String> {
         .iter()
         .map(|core| cross::ensure_rustup_target(core.target))
         .collect();
-    tools.extend(CORES.iter().map(ensure_qemu));
-    tools.push(ensure_defmt_print());
+    tools.extend(CORES.iter().map(|core| core.emulator.ensure()));
     let tools: Result<Vec<()>, String> = tools.into_iter().collect();
-    let decoder = match tools.and_then(|_| defmt_print()) {
+    let decoder = match tools.and_then(|_| DEFMT_PRINT.ensure()) {
         Ok(decoder) => decoder,
         Err(e) => return Err(format!("xtask qemu: missing tools: {e}")),
     };
@@ -296,13 +304,9 @@ fn run_core(core: &Core, decoder: &Path) -> Result<(Row, Vec<String>), String> {
 /// by case id (`None`: the case returned an error): the lockstep image built (a no-op when
 /// `qemu` built it already), run and its log decoded. For `cargo xtask web --test`.
 pub fn lockstep_states() -> Result<BTreeMap<usize, Option<Vec<u64>>>, String> {
-    let tools = [
-        cross::ensure_target(),
-        ensure_qemu(&M4F),
-        ensure_defmt_print(),
-    ];
-    tools.into_iter().collect::<Result<Vec<()>, String>>()?;
-    let decoder = defmt_print()?;
+    cross::ensure_target()?;
+    M4F.emulator.ensure()?;
+    let decoder = DEFMT_PRINT.ensure()?;
     let elf = build(&M4F, &["--bin", "lockstep"])?.join("lockstep");
     let log = decode(&M4F, &elf, &decoder)?;
     if !log.done {
@@ -322,99 +326,9 @@ fn decode(core: &Core, elf: &Path, decoder: &Path) -> Result<Log, String> {
         raw,
     )?;
     if !status.success() {
-        return Err(format!("{DEFMT_PRINT} failed ({status})"));
+        return Err(format!("{} failed ({status})", DEFMT_PRINT.name));
     }
     parse_log(&String::from_utf8_lossy(&decoded))
-}
-
-/// Runs `program --version`-like `args` quietly; `true` when it starts and succeeds.
-pub(crate) fn works(program: &Path, args: &[&str]) -> bool {
-    Command::new(program)
-        .args(args)
-        .stdout(Stdio::null())
-        .stderr(Stdio::null())
-        .status()
-        .is_ok_and(|s| s.success())
-}
-
-/// Installs the core's emulator with `apt-get` when it is not on `PATH`.
-fn ensure_qemu(core: &Core) -> Result<(), String> {
-    let qemu = core.qemu;
-    if works(Path::new(qemu), &["--version"]) {
-        return Ok(());
-    }
-    println!(
-        "{qemu} is missing: installing Debian's package {}",
-        core.package
-    );
-    let clock = Instant::now();
-    cmd::run(Command::new("apt-get").args(["update", "-qq"]))?;
-    cmd::run(
-        Command::new("apt-get")
-            .env("DEBIAN_FRONTEND", "noninteractive")
-            .args([
-                "install",
-                "-y",
-                "-qq",
-                "--no-install-recommends",
-                core.package,
-            ]),
-    )?;
-    if works(Path::new(qemu), &["--version"]) {
-        println!("{qemu} installed in {:.0} s", clock.elapsed().as_secs_f64());
-        Ok(())
-    } else {
-        Err(format!("{qemu} still does not run after apt-get install"))
-    }
-}
-
-/// The directory `cargo install` puts binaries in.
-fn cargo_bin_dir() -> Option<PathBuf> {
-    std::env::var_os("CARGO_HOME")
-        .map(PathBuf::from)
-        .or_else(|| std::env::var_os("HOME").map(|home| Path::new(&home).join(".cargo")))
-        .map(|home| home.join("bin"))
-}
-
-/// `defmt-print`: on `PATH`, else in cargo's bin directory, else `None`.
-fn find_defmt_print() -> Option<PathBuf> {
-    let on_path = PathBuf::from(DEFMT_PRINT);
-    if works(&on_path, &["--version"]) {
-        return Some(on_path);
-    }
-    cargo_bin_dir()
-        .map(|dir| dir.join(DEFMT_PRINT))
-        .filter(|path| works(path, &["--version"]))
-}
-
-/// Installs `defmt-print` at [`DEFMT_PRINT_VERSION`] with its lock file when it is missing.
-///
-/// Unoptimised (`--debug`): that halves the build (measured here: 1.5 against 2.7 CPU
-/// minutes), and decoding a log of a few kilobytes takes no time either way.
-fn ensure_defmt_print() -> Result<(), String> {
-    if find_defmt_print().is_some() {
-        return Ok(());
-    }
-    println!("{DEFMT_PRINT} is missing: installing it from crates.io");
-    let clock = Instant::now();
-    cmd::run(cmd::cargo().args([
-        "install",
-        "--locked",
-        "--debug",
-        "--version",
-        DEFMT_PRINT_VERSION,
-        DEFMT_PRINT,
-    ]))?;
-    println!(
-        "{DEFMT_PRINT} installed in {:.0} s",
-        clock.elapsed().as_secs_f64()
-    );
-    Ok(())
-}
-
-/// The `defmt-print` to run.
-fn defmt_print() -> Result<PathBuf, String> {
-    find_defmt_print().ok_or_else(|| format!("{DEFMT_PRINT} is not installed"))
 }
 
 /// The firmware crate is outside the host workspace, so `cargo xtask ci`'s fmt and clippy do
@@ -520,7 +434,7 @@ fn run_captured(command: &mut Command, input: Vec<u8>) -> Result<(ExitStatus, Ve
 /// Runs `elf` under QEMU; its stdout (the semihosting output) when it exits with success.
 fn run_in_qemu(core: &Core, elf: &Path) -> Result<Vec<u8>, String> {
     let (status, out) = run_captured(
-        Command::new(core.qemu)
+        Command::new(core.emulator.program)
             .args(core.machine)
             .args(QEMU_ARGS)
             .arg("-kernel")

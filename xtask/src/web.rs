@@ -30,7 +30,6 @@ use std::collections::BTreeMap;
 use std::io::{Read, Write};
 use std::net::{TcpListener, TcpStream};
 use std::path::{Path, PathBuf};
-use std::process::Command;
 use std::time::{Duration, Instant};
 
 use lagrange_cases::{scripted, world_in_a_box, Outcome, CASES, STEPS};
@@ -39,12 +38,16 @@ use crate::cdp::{base64, Browser, Evaluated, Json};
 use crate::cmd;
 use crate::cross;
 use crate::qemu;
+use crate::tools::AptTool;
 
 /// The WebAssembly target.
 const WASM: &str = "wasm32-unknown-unknown";
 
 /// The browser, from Debian's package of the same name.
-const CHROMIUM: &str = "chromium";
+pub(crate) const CHROMIUM: AptTool = AptTool {
+    program: "chromium",
+    package: "chromium",
+};
 
 /// The port `cargo xtask web` serves on when it is free (else any free one).
 const PORT: u16 = 8018;
@@ -219,32 +222,6 @@ fn respond(mut stream: TcpStream, site: &Path, hold: Duration) -> std::io::Resul
     stream.write_all(&body)
 }
 
-/// Installs Debian's `chromium` with apt-get when it does not run.
-fn ensure_chromium() -> Result<(), String> {
-    if qemu::works(Path::new(CHROMIUM), &["--version"]) {
-        return Ok(());
-    }
-    println!("{CHROMIUM} is missing: installing Debian's package");
-    let clock = Instant::now();
-    cmd::run(Command::new("apt-get").args(["update", "-qq"]))?;
-    cmd::run(
-        Command::new("apt-get")
-            .env("DEBIAN_FRONTEND", "noninteractive")
-            .args(["install", "-y", "-qq", "--no-install-recommends", CHROMIUM]),
-    )?;
-    if qemu::works(Path::new(CHROMIUM), &["--version"]) {
-        println!(
-            "{CHROMIUM} installed in {:.0} s",
-            clock.elapsed().as_secs_f64()
-        );
-        Ok(())
-    } else {
-        Err(format!(
-            "{CHROMIUM} still does not run after apt-get install"
-        ))
-    }
-}
-
 /// FNV-1a over 64-bit words: the page's digest (`lagrange_web::scenario::digest`).
 fn digest(words: &[u64]) -> u64 {
     words.iter().fold(0xcbf2_9ce4_8422_2325, |hash, &w| {
@@ -275,7 +252,7 @@ fn parse_scenario(line: &str) -> Result<(Vec<u64>, u64), String> {
 /// Serves the site, drives the page in headless Chromium, checks it, saves the screenshot.
 fn test(site: &Path) -> Result<(), String> {
     let clock = Instant::now();
-    ensure_chromium()?;
+    CHROMIUM.ensure()?;
     // The firmware's words first: its build (when `qemu` has not built it) is the long part.
     let firmware = qemu::lockstep_states();
     let listener = TcpListener::bind(("127.0.0.1", 0)).map_err(|e| e.to_string())?;
@@ -285,7 +262,7 @@ fn test(site: &Path) -> Result<(), String> {
     let url = format!("http://127.0.0.1:{port}/");
     let profile = site.join("chromium-profile");
     let _ = std::fs::remove_dir_all(&profile);
-    let mut browser = Browser::start(CHROMIUM, &profile, &site.join("chromium.log"))?;
+    let mut browser = Browser::start(CHROMIUM.program, &profile, &site.join("chromium.log"))?;
     let checked = drive(&mut browser, &url, site).and_then(|(failures, simd)| {
         let scalar = scalar_scenario(&mut browser, &url)?;
         Ok((failures, simd, scalar))
