@@ -117,9 +117,10 @@ fn apt_install(packages: &[&str]) -> [Command; 2] {
 
 /// Installs, on a thread of its own, the tools of `apt` and `cargo` that are missing: the
 /// packages in one `apt-get` run, then the crates one after another, their output in
-/// `target/xtask-tools.log` (a step's own output is not interleaved with theirs). The
-/// thread's result says what it did, or the first failure and where its log is; the tasks
-/// that need a tool still `ensure` it, and install it themselves if this failed.
+/// `target/xtask-tools.log` (a step's own output is not interleaved with theirs). A failure
+/// (no root for `apt-get`, no network) stops its own install alone; the thread's result
+/// says what it did, or what failed and where the log is. The tasks that need a tool still
+/// `ensure` it, and install it themselves where this failed.
 ///
 /// Why: on a fresh machine the installs took 105 s of a CI run's 1,219 (`defmt-print` 40 s
 /// and mdBook 36 s to build, QEMU and Chromium 29 s to fetch), one after another, each
@@ -149,26 +150,40 @@ pub fn prefetch(
             std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
         }
         let log = File::create(&log_path).map_err(|e| format!("{}: {e}", log_path.display()))?;
-        let mut commands: Vec<Command> = Vec::new();
+        // The packages' commands in order (no install without the update), each crate on
+        // its own: a failure stops its group only.
+        let mut groups: Vec<Vec<Command>> = Vec::new();
         if !packages.is_empty() {
-            commands.extend(apt_install(&packages));
+            groups.push(apt_install(&packages).into());
         }
-        commands.extend(crates.iter().map(|t| t.install()));
-        for mut command in commands {
-            let shown = format!("{command:?}").replace('"', "");
-            let (out, err) = (clone(&log, &log_path)?, clone(&log, &log_path)?);
-            let status = command
-                .stdin(Stdio::null())
-                .stdout(out)
-                .stderr(err)
-                .status()
-                .map_err(|e| format!("could not start ({e}): {shown}"))?;
-            if !status.success() {
-                return Err(format!(
-                    "failed ({status}): {shown}; its output is in {}",
-                    log_path.display()
-                ));
+        groups.extend(crates.iter().map(|t| vec![t.install()]));
+        let mut failures = Vec::new();
+        for group in groups {
+            for mut command in group {
+                let shown = format!("{command:?}").replace('"', "");
+                let (out, err) = (clone(&log, &log_path)?, clone(&log, &log_path)?);
+                let failed = match command
+                    .stdin(Stdio::null())
+                    .stdout(out)
+                    .stderr(err)
+                    .status()
+                {
+                    Ok(status) if status.success() => None,
+                    Ok(status) => Some(format!("failed ({status}): {shown}")),
+                    Err(e) => Some(format!("could not start ({e}): {shown}")),
+                };
+                if let Some(failure) = failed {
+                    failures.push(failure);
+                    break;
+                }
             }
+        }
+        if !failures.is_empty() {
+            return Err(format!(
+                "{}; the output is in {}",
+                failures.join("; "),
+                log_path.display()
+            ));
         }
         let names: Vec<&str> = packages
             .iter()
