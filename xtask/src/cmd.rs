@@ -50,9 +50,14 @@ pub fn cargo() -> Command {
     c
 }
 
+/// A command as [`run`] echoes it (without the quotes `Debug` puts around each word).
+pub fn shown(command: &Command) -> String {
+    format!("{command:?}").replace('"', "")
+}
+
 /// Echoes and runs `command`; `Err` names it when it fails or cannot start.
 pub fn run(command: &mut Command) -> Result<(), String> {
-    let shown = format!("{command:?}").replace('"', "");
+    let shown = shown(command);
     println!("$ {shown}");
     let start = std::time::Instant::now();
     let status = command.status();

@@ -133,7 +133,7 @@ pub(crate) fn ensure_target() -> Result<(), String> {
 pub(crate) fn ensure_rustup_target(target: &str) -> Result<(), String> {
     let mut list = Command::new("rustup");
     list.args(["target", "list", "--installed"]);
-    println!("$ {}", shown(&list));
+    println!("$ {}", cmd::shown(&list));
     let installed = match list.output() {
         Ok(out) if out.status.success() => String::from_utf8_lossy(&out.stdout).into_owned(),
         Ok(out) => {
@@ -153,11 +153,6 @@ pub(crate) fn ensure_rustup_target(target: &str) -> Result<(), String> {
     } else {
         cmd::run(Command::new("rustup").args(["target", "add", target]))
     }
-}
-
-/// A command as `cmd::run` echoes it.
-pub(crate) fn shown(command: &Command) -> String {
-    format!("{command:?}").replace('"', "")
 }
 
 /// Builds the smoke firmware in release and returns the path of its ELF.

@@ -377,7 +377,7 @@ fn build(core: &Core, extra: &[&str]) -> Result<PathBuf, String> {
 /// Runs `command` with `input` on its stdin (none when empty), collecting stdout, and kills it
 /// after [`RUN_TIMEOUT`].
 fn run_captured(command: &mut Command, input: Vec<u8>) -> Result<(ExitStatus, Vec<u8>), String> {
-    let shown = cross::shown(command);
+    let shown = cmd::shown(command);
     println!("$ {shown}");
     let mut child = command
         .stdin(if input.is_empty() {

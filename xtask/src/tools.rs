@@ -160,7 +160,7 @@ pub fn prefetch(
         let mut failures = Vec::new();
         for group in groups {
             for mut command in group {
-                let shown = format!("{command:?}").replace('"', "");
+                let shown = cmd::shown(&command);
                 let (out, err) = (clone(&log, &log_path)?, clone(&log, &log_path)?);
                 let failed = match command
                     .stdin(Stdio::null())
