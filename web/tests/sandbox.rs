@@ -5,21 +5,27 @@
 use lagrange_core::Error;
 use lagrange_web::sandbox::{script_step, scripted, Sandbox, CONTACT_CAP, SCRIPT_STEPS};
 
-/// The scripted run gives the same digest each time, in `f64` and in `f32` (each its own).
+/// The scripted run gives the same digest each time in `f64`.
 #[test]
-fn the_scripted_pile_is_deterministic() -> Result<(), Error> {
+fn the_scripted_pile_is_deterministic_in_f64() -> Result<(), Error> {
     assert_eq!(
         scripted::<f64>(SCRIPT_STEPS)?,
         scripted::<f64>(SCRIPT_STEPS)?
     );
+    Ok(())
+}
+
+/// The scripted run gives the same digest each time in `f32`, and its own: not the `f64`
+/// run's (compared over the script's first tenth, where the two precisions' bits already
+/// part; the whole script in both is the test above's and this one's work again).
+#[test]
+fn the_scripted_pile_is_deterministic_in_f32() -> Result<(), Error> {
     assert_eq!(
         scripted::<f32>(SCRIPT_STEPS)?,
         scripted::<f32>(SCRIPT_STEPS)?
     );
-    assert_ne!(
-        scripted::<f64>(SCRIPT_STEPS)?,
-        scripted::<f32>(SCRIPT_STEPS)?
-    );
+    let part = SCRIPT_STEPS / 10;
+    assert_ne!(scripted::<f64>(part)?, scripted::<f32>(part)?);
     Ok(())
 }
 

@@ -71,7 +71,7 @@ fn main() -> ExitCode {
         "test" => cmd::run_all(&TEST).and(long_test()),
         "cross" => cross::run(),
         "bench" => bench(&std::env::args().skip(2).collect::<Vec<_>>()),
-        "qemu" => qemu::run(),
+        "qemu" => qemu::run(&std::env::args().skip(2).collect::<Vec<_>>()),
         "mutants" => mutants::run(&std::env::args().skip(2).collect::<Vec<_>>()),
         "derive" => derive::run(&std::env::args().skip(2).collect::<Vec<_>>()),
         "fuzz" => fuzz::run(&std::env::args().skip(2).collect::<Vec<_>>()),
@@ -316,7 +316,7 @@ fn ci() -> Result<(), String> {
         ("long tests", false, &long_test),
         ("derive", false, &derive::check),
         ("cross", false, &cross::run),
-        ("qemu", true, &qemu::run),
+        ("qemu", true, &|| qemu::run(&["--short".to_string()])),
         ("web", true, &|| web::run(&["--test".to_string()])),
         ("guide", true, &|| guide::run(&[])),
     ];
