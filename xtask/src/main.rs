@@ -69,7 +69,7 @@ fn main() -> ExitCode {
     let result = match task.as_str() {
         "demo" => demo::run(),
         "test" => cmd::run_all(&TEST).and(long_test()),
-        "cross" => cross::run(),
+        "cross" => cross::run(&std::env::args().skip(2).collect::<Vec<_>>()),
         "bench" => bench(&std::env::args().skip(2).collect::<Vec<_>>()),
         "qemu" => qemu::run(&std::env::args().skip(2).collect::<Vec<_>>()),
         "mutants" => mutants::run(&std::env::args().skip(2).collect::<Vec<_>>()),
@@ -315,7 +315,7 @@ fn ci() -> Result<(), String> {
         ("doc tests", false, &|| cmd::run_all(&DOC_TEST)),
         ("long tests", false, &long_test),
         ("derive", false, &derive::check),
-        ("cross", false, &cross::run),
+        ("cross", false, &|| cross::run(&["--short".to_string()])),
         ("qemu", true, &|| qemu::run(&["--short".to_string()])),
         ("web", true, &|| web::run(&["--test".to_string()])),
         ("guide", true, &|| guide::run(&[])),
