@@ -10,6 +10,16 @@ pub fn project_root() -> PathBuf {
         .map_or_else(|| PathBuf::from("."), Path::to_path_buf)
 }
 
+/// Whether a task's arguments ask for its short form (`--short`, `cargo xtask ci`'s); an
+/// error naming the task for anything else.
+pub fn short_form(task: &str, args: &[String]) -> Result<bool, String> {
+    match args {
+        [] => Ok(false),
+        [flag] if flag == "--short" => Ok(true),
+        _ => Err(format!("usage: cargo xtask {task} [--short], not {args:?}")),
+    }
+}
+
 /// A child that is waited for with a limit ([`overdue`]) may take this many times the limit
 /// in wall time when its CPU time cannot be read or it is blocked.
 pub const WALL_FACTOR: u64 = 10;

@@ -69,11 +69,7 @@ const SECTIONS: [&str; 4] = [".text", ".rodata", ".data", ".bss"];
 /// three of the cores), and the embassy example formatted and linted but not built (its
 /// release build links embassy-nrf with fat LTO: a fifth of the step).
 pub fn run(args: &[String]) -> Result<(), String> {
-    let short = match args {
-        [] => false,
-        [flag] if flag == "--short" => true,
-        _ => return Err(format!("usage: cargo xtask cross [--short], not {args:?}")),
-    };
+    let short = cmd::short_form("cross", args)?;
     let verb = if short { "check" } else { "build" };
     let mut failures = Vec::new();
     for target in TARGETS {

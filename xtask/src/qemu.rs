@@ -9,7 +9,8 @@
 //!    the one-mechanism image, the panic-free image (whose link fails if any panic path is left
 //!    in the stepping code on that core; on every core but RV32IMAFC, which `cargo xtask cross`
 //!    does not build for); on the M4F also the one-mechanism image with `libm-trig` and the
-//!    size images (scene, loop, ragdoll).
+//!    size images (scene, loop, ragdoll). `--short` (`cargo xtask ci`'s form): the cores of
+//!    [`SHORT`], and none of the M4F's images that are only measured.
 //! 3. Runs each under QEMU with `-icount shift=0` (one instruction, one nanosecond of virtual
 //!    time), semihosting on, inside a timeout: a hang, a panic or a fault fails the run.
 //! 4. Decodes the lockstep image's defmt log with `defmt-print`, runs the same
@@ -172,21 +173,18 @@ const ASLEEP_BUDGET: f64 = 30.0;
 const ONE_MECHANISM_TEXT_BUDGET: u32 = 8 * 1024;
 
 /// The cores of `cargo xtask ci`'s short form (`cargo xtask qemu --short`): the M4F (the
-/// issue's budgets, the page's bits), the M0 (no FPU: every float in software) and RV32IMAC
-/// (another instruction set, no FPU). The M33 and RV32IMAFC add an FPU to cores of those
-/// instruction sets; `cargo xtask cross` still builds the library for the M33 in CI, and the
-/// full command runs both (68 s of a 230 s run on a two-core machine). The short form also
-/// leaves out the M4F's images that are only measured ([`SIZE_IMAGES`], `libm-trig`).
-const SHORT: [&str; 3] = ["M4F", "M0", "RV32IMAC"];
+/// issue's budgets, the page's bits; `f64` in software) and the M0 (no FPU: `f32` in
+/// software too, and ARMv6-M's instructions). The others run the same library code through
+/// the same compiler's software floats or FPUs: the full command runs them (RV32IMAC 63 s,
+/// M33 and RV32IMAFC 68 s together of a run of five on a two-core machine), and `cargo xtask
+/// cross --short` checks the library for each in CI. The short form also leaves out the
+/// M4F's images that are only measured ([`SIZE_IMAGES`], `libm-trig`).
+const SHORT: [&str; 2] = ["M4F", "M0"];
 
 /// Builds, runs, compares and reports on every core of [`CORES`], or with `--short` on those
 /// of [`SHORT`]; every step runs and every failure is reported at the end.
 pub fn run(args: &[String]) -> Result<(), String> {
-    let short = match args {
-        [] => false,
-        [flag] if flag == "--short" => true,
-        _ => return Err(format!("usage: cargo xtask qemu [--short], not {args:?}")),
-    };
+    let short = cmd::short_form("qemu", args)?;
     let cores: Vec<&Core> = CORES
         .iter()
         .filter(|core| !short || SHORT.contains(&core.name))
