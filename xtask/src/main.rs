@@ -58,6 +58,7 @@ mod guide;
 mod mutants;
 mod publish;
 mod qemu;
+mod test_binaries;
 mod tools;
 mod trig_fit;
 mod web;
@@ -68,7 +69,7 @@ fn main() -> ExitCode {
     let task = std::env::args().nth(1).unwrap_or_default();
     let result = match task.as_str() {
         "demo" => demo::run(),
-        "test" => cmd::run_all(&TEST).and(long_test()),
+        "test" => test().and(long_test()),
         "cross" => cross::run(&std::env::args().skip(2).collect::<Vec<_>>()),
         "bench" => bench(&std::env::args().skip(2).collect::<Vec<_>>()),
         "qemu" => qemu::run(&std::env::args().skip(2).collect::<Vec<_>>()),
@@ -192,16 +193,15 @@ fn bench(args: &[String]) -> Result<(), String> {
 /// tests and doc tests steps took 1 min longer loaded). Every target but the benches: the
 /// criterion bench's run in test mode (each benchmark once) built it and the peers that are
 /// dev-dependencies of the bench crate (rapier2d and its own nalgebra: 40 s of a core, a
-/// tenth of the step's build) to check what the checks' clippy already compiles.
-const TEST: [&[&str]; 1] = [&[
-    "test",
-    "--workspace",
-    "--lib",
-    "--bins",
-    "--tests",
-    "--examples",
-    "--quiet",
-]];
+/// tenth of the step's build) to check what the checks' clippy already compiles. `--tests`
+/// rather than `--lib --bins --tests`: it keeps to the targets whose `test` flag is set (the
+/// page's and the bench crate's libraries have none to run), which `--lib` would build.
+const TEST: [&str; 4] = ["--workspace", "--tests", "--examples", "--quiet"];
+
+/// `cargo test` of [`TEST`], its binaries run two at a time ([`test_binaries`]).
+fn test() -> Result<(), String> {
+    test_binaries::run(&TEST, &["--quiet"])
+}
 
 /// Static checks run before the tests. The benches behind `bench --contacts` and `bench
 /// --world` are `bench = false` (a plain `cargo bench` runs only the criterion ones), and the
@@ -247,19 +247,19 @@ const DOC_TEST: [&[&str]; 1] = [&["test", "--workspace", "--doc", "--quiet"]];
 /// `fast_trig`'s exhaustive sweep, in `lagrange-core`'s own tests; only the test targets that
 /// hold an `#[ignore]`d test are built optimised (found by reading the test directories), not
 /// all seventy.
+/// One build of both packages' targets, their binaries run two at a time.
 fn long_test() -> Result<(), String> {
+    let mut args: Vec<String> = ["--profile", "long-test", "--quiet"]
+        .map(String::from)
+        .to_vec();
     for (package, dir) in LONG_TEST_DIRS {
-        let mut args: Vec<String> = ["test", "-p", package, "--profile", "long-test", "--quiet"]
-            .map(String::from)
-            .to_vec();
+        args.extend(["-p".to_string(), package.to_string()]);
         for target in targets_with_ignored(&cmd::project_root().join(dir))? {
-            args.push("--test".into());
-            args.push(target);
+            args.extend(["--test".to_string(), target]);
         }
-        args.extend(["--", "--ignored"].map(String::from));
-        cmd::run(cmd::cargo().args(&args))?;
     }
-    Ok(())
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    test_binaries::run(&args, &["--quiet", "--ignored"])
 }
 
 /// The packages whose integration tests hold long runs, and their test directories.
@@ -323,7 +323,7 @@ fn ci() -> Result<(), String> {
     let steps: [Step; 10] = [
         ("checks", false, &|| cmd::run_all(&CHECKS)),
         ("publish", false, &publish::run),
-        ("tests", false, &|| cmd::run_all(&TEST)),
+        ("tests", false, &test),
         ("doc tests", false, &|| cmd::run_all(&DOC_TEST)),
         ("long tests", false, &long_test),
         ("derive", false, &derive::check),
