@@ -65,8 +65,8 @@ const SECTIONS: [&str; 4] = [".text", ".rodata", ".data", ".bss"];
 /// every step runs and every failure is reported at the end.
 ///
 /// `--short` (`cargo xtask ci`'s form): the matrix checked (`cargo check`: the same errors
-/// for a library, without its code generation, which `cargo xtask qemu`'s firmware does on
-/// three of the cores), and the embassy example formatted and linted but not built (its
+/// for a library, without its code generation, which `cargo xtask qemu --short`'s firmware
+/// does on the M4F and the M0), and the embassy example formatted and linted but not built (its
 /// release build links embassy-nrf with fat LTO: a fifth of the step).
 pub fn run(args: &[String]) -> Result<(), String> {
     let short = cmd::short_form("cross", args)?;

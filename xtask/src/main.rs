@@ -255,8 +255,7 @@ const DOC_TEST: [&[&str]; 1] = [&[
 /// crate (so the bench crate's heavy dependencies are not built optimised for them) and, for
 /// `fast_trig`'s exhaustive sweep, in `lagrange-core`'s own tests; only the test targets that
 /// hold an `#[ignore]`d test are built optimised (found by reading the test directories), not
-/// all seventy.
-/// One build of both packages' targets, their binaries run two at a time.
+/// all seventy. One build of both packages' targets, their binaries run two at a time.
 fn long_test() -> Result<(), String> {
     let mut args: Vec<String> = ["--profile", "long-test", "--quiet"]
         .map(String::from)
