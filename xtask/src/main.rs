@@ -236,17 +236,11 @@ const CHECKS: [&[&str]; 3] = [
     ],
 ];
 
-/// Doc tests are not part of `--tests`. Not the bench crate's (it has none, `doctest =
-/// false`): a package's doc tests build its dev-dependencies, and the bench crate's are the
-/// peers (rapier2d: 24 s of this step once the tests step no longer built them).
-const DOC_TEST: [&[&str]; 1] = [&[
-    "test",
-    "--workspace",
-    "--doc",
-    "--exclude",
-    "lagrange-benches",
-    "--quiet",
-]];
+/// Doc tests are not part of `--tests`. The whole workspace, as the tests: a package's doc
+/// tests build its dev-dependencies (the bench crate's peers, 24 s here once the tests step
+/// no longer built them), but leaving the bench crate out unified its dependencies' features
+/// otherwise (ode_solvers' nalgebra) and built every crate again (109 s loaded).
+const DOC_TEST: [&[&str]; 1] = [&["test", "--workspace", "--doc", "--quiet"]];
 
 /// Long runs (10^6 steps and more) are `#[ignore]`d in the quick debug test run and run here,
 /// optimised (profile `long-test`: the release build without its link-time optimisation and
