@@ -365,30 +365,37 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
         kinds: &[Row<T>; C],
         guess: &[bool; C],
     ) -> Result<Complementary<T, C>, Error> {
-        if (0..C).any(|i| {
-            self.candidate[i]
-                && matches!(kinds[i], Row::Bounded(x) if !(x >= T::zero() && x.is_finite()))
+        // The candidates, listed: the method runs on their positions in the list (in the
+        // rows' order, so the same sums in the same order as over the rows), and every loop
+        // and array below holds the candidates alone, not the set's `C` rows (each pass
+        // walked all `C` rows' flags and an index list through them: most of a landing
+        // ragdoll's solve, 6 of its 31 rows candidates).
+        let listed = Listed::of(&self.candidate);
+        let m = listed.len();
+        // The positions, clamped (no-ops: the optimiser does not carry `m <= C` into a loop's
+        // index, and a bounds check is a panic path).
+        let positions = || (0..m).map(within::<C>);
+        if positions().any(|p| {
+            matches!(kinds[listed.row(p)], Row::Bounded(x) if !(x >= T::zero() && x.is_finite()))
         }) {
             return Err(Error::InvalidParameter {
                 name: "bound",
                 reason: "a bounded row's bound must be finite and not negative",
             });
         }
-        // The candidates, listed: every loop below runs over them alone.
-        let mut cand = [0usize; C];
-        let m = list((0..C).filter(|&i| self.candidate[i]), &mut cand);
-        let listed = cand.iter().take(m).map(|&i| within::<C>(i));
+        // Each position's bounds and `b`, and whether it is solved for (a = 0 between its
+        // bounds), in the order they joined (so that a row that depends on the others is
+        // always the one joining, at its bound: leaving it out changes no multiplier); the
+        // other candidates are held at a bound, or left out at zero while they depend on the
+        // rows solved for (`blocked`).
         let mut bounds = [(T::zero(), T::zero()); C];
-        for i in listed.clone() {
-            bounds[i] = kinds[i].bounds();
-        }
-        // Solved for (a = 0 between its bounds), in the order they joined (so that a row
-        // that depends on the others is always the one joining, at its bound: leaving it out
-        // changes no multiplier); the other candidates are held at a bound, or left out at
-        // zero while they depend on the rows solved for (`blocked`).
+        let mut b_at = [T::zero(); C];
         let mut free = [false; C];
-        for i in listed.clone() {
-            free[i] = match kinds[i] {
+        for p in positions() {
+            let i = listed.row(p);
+            bounds[p] = kinds[i].bounds();
+            b_at[p] = b[i];
+            free[p] = match kinds[i] {
                 Row::Unilateral => guess[i],
                 Row::Bounded(x) => x > T::zero(),
                 Row::Bilateral | Row::Held => true,
@@ -401,69 +408,77 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
         let (mut order, mut n) = ([0usize; C], 0usize);
         let mut placed = [false; C];
         for &r in self.factored.iter().take(self.factored_n) {
-            let r = within::<C>(r);
-            if !(self.candidate[r] && free[r]) {
+            let Some(p) = listed.position(r).filter(|&p| free[p]) else {
                 break;
-            }
-            order[within::<C>(n)] = r;
-            placed[r] = true;
+            };
+            order[within::<C>(n)] = p;
+            placed[p] = true;
             n += 1;
         }
         let mut kept = n;
-        for i in listed.clone().filter(|&i| free[i] && !placed[i]) {
-            order[within::<C>(n)] = i;
+        for p in positions().filter(|&p| free[p] && !placed[p]) {
+            order[within::<C>(n)] = p;
             n += 1;
         }
         let mut blocked = [false; C];
-        let mut lambda = SVector::<T, C>::zeros();
+        let mut lambda = [T::zero(); C];
         // The row that joined last, the way it moves off its bound, and whether its pull was
         // beyond what a dependence the pivot test cannot tell from near-dependence explains.
         let mut joined: Option<(usize, T, bool)> = None;
         let passes = 4 * C + 4;
         // The solution of each pass's rows, written in place: returned by value, its copy
         // waited on the stores of the substitution (a tenth of a one-row solve).
-        let mut x = SVector::<T, C>::zeros();
+        let mut x = [T::zero(); C];
         // The rows whose multipliers push, listed anew where a sum runs over them.
         let mut pushing = [0usize; C];
         for pass in 1..=passes {
             // The rows held at a bound push on the rows solved for (listed first, in order:
             // the same sums, without a test per pair of rows).
-            let held = nonzero(listed.clone().filter(|&k| !free[k]), &lambda, &mut pushing);
-            let mut rhs = SVector::<T, C>::zeros();
-            for i in listed.clone().filter(|&i| free[i]) {
+            let held = nonzero(positions().filter(|&k| !free[k]), &lambda, &mut pushing);
+            let mut rhs = [T::zero(); C];
+            for i in positions().filter(|&i| free[i]) {
                 rhs[i] = pushing
                     .iter()
                     .take(held)
                     .map(|&k| within::<C>(k))
-                    .fold(-b[i], |r, k| r - self.w[(i, k)] * lambda[k]);
+                    .fold(-b_at[i], |r, k| r - self.w_at(&listed, i, k) * lambda[k]);
             }
-            match self.solve(&order, n, kept, &rhs, &mut x) {
-                Ok(()) => {}
+            let dependent = match self.solve(&listed, &order, n, kept, &rhs, &mut x) {
+                Ok(()) => None,
+                Err(Error::RedundantConstraints { row }) => match listed.position(row) {
+                    Some(p) => Some((row, p)),
+                    None => return Err(Error::RedundantConstraints { row }),
+                },
+                Err(e) => return Err(e),
+            };
+            // (Clamped, no-ops: the optimiser does not follow a row number through the
+            // `Option`, and a bounds check is a panic path.)
+            match dependent.map(|(row, p)| (within::<C>(row), within::<C>(p))) {
+                None => {}
                 // A joining row that depends on the rows solved for: along the ray that moves
                 // it off its bound and them so that W lambda is unchanged, the program falls
                 // at the rate of its pull; as far as the first bound, where that row is held.
-                Err(Error::RedundantConstraints { row })
-                    if joined.is_some_and(|(j, _, _)| j == row) =>
-                {
-                    let row = within::<C>(row);
-                    let (way, pulls) = joined.map_or((T::zero(), false), |(_, w, p)| (w, p));
+                Some((row, p)) if joined.is_some_and(|(j, _, _)| j == p) => {
+                    let (way, pulls) =
+                        joined.map_or((T::zero(), false), |(_, w, pulls)| (w, pulls));
                     joined = None;
                     let ray = if pulls {
                         self.ray(
+                            &listed,
                             &mut order,
                             &mut n,
                             &mut free,
                             &mut lambda,
                             &bounds,
-                            row,
+                            p,
                             way,
                         )?
                     } else {
                         None
                     };
                     match ray {
-                        Some(at) => {
-                            kept = at;
+                        Some(from) => {
+                            kept = from;
                             blocked = [false; C];
                         }
                         // No bound ends the ray of a contact that pulls beyond rounding: the
@@ -477,32 +492,29 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
                         }
                         // Else the row is left out at its bound.
                         None => {
-                            kept = remove(&mut order, &mut n, row);
-                            free[row] = false;
-                            blocked[row] = true;
+                            kept = remove(&mut order, &mut n, p);
+                            free[p] = false;
+                            blocked[p] = true;
                         }
                     }
                     continue;
                 }
                 // A row of the first set that depends on the ones before it, at zero: left
                 // out, free to join later (along a ray).
-                Err(Error::RedundantConstraints { row })
-                    if kinds.get(row).is_some_and(|&k| k != Row::Bilateral) =>
-                {
-                    let row = within::<C>(row);
-                    kept = remove(&mut order, &mut n, row);
-                    free[row] = false;
-                    lambda[row] = T::zero();
+                Some((row, p)) if kinds[row] != Row::Bilateral => {
+                    kept = remove(&mut order, &mut n, p);
+                    free[p] = false;
+                    lambda[p] = T::zero();
                     continue;
                 }
-                Err(e) => return Err(e),
-            };
+                Some((row, _)) => return Err(Error::RedundantConstraints { row }),
+            }
             kept = n;
             joined = None;
             // The step from lambda towards x, as far as every multiplier stays within its
             // bounds; the row that stops it is held at the bound it reached.
             let mut stop: Option<(usize, T, T)> = None;
-            for i in listed.clone().filter(|&i| free[i]) {
+            for i in positions().filter(|&i| free[i]) {
                 let (lo, hi) = bounds[i];
                 let (reach, at) = if x[i] < lo {
                     ((lambda[i] - lo) / (lambda[i] - x[i]), lo)
@@ -517,7 +529,7 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
             }
             if let Some((row, reach, at)) = stop {
                 let row = within::<C>(row);
-                for i in listed.clone().filter(|&i| free[i]) {
+                for i in positions().filter(|&i| free[i]) {
                     let l = lambda[i];
                     lambda[i] = l + (x[i] - l) * reach;
                 }
@@ -527,22 +539,22 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
                 blocked = [false; C];
                 continue;
             }
-            for i in listed.clone().filter(|&i| free[i]) {
+            for i in positions().filter(|&i| free[i]) {
                 lambda[i] = x[i];
             }
             // Every multiplier within its bounds: the held row whose a would lower the
             // program most by moving off its bound is solved for.
             let mut join: Option<(usize, T, T)> = None;
-            let all = nonzero(listed.clone(), &lambda, &mut pushing);
-            for i in listed.clone().filter(|&i| !free[i] && !blocked[i]) {
+            let all = nonzero(0..m, &lambda, &mut pushing);
+            for i in positions().filter(|&i| !free[i] && !blocked[i]) {
                 let (lo, hi) = bounds[i];
                 if lo == hi {
                     continue;
                 }
                 let (a, size) = pushing.iter().take(all).map(|&k| within::<C>(k)).fold(
-                    (b[i], b[i].abs()),
+                    (b_at[i], b_at[i].abs()),
                     |(a, s), k| {
-                        let term = self.w[(i, k)] * lambda[k];
+                        let term = self.w_at(&listed, i, k) * lambda[k];
                         (a + term, s + term.abs())
                     },
                 );
@@ -572,10 +584,9 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
                     // The way it moves off its bound: up from the lower, down from the upper,
                     // against a from inside.
                     let (lo, hi) = bounds[row];
-                    let a = listed
-                        .clone()
-                        .fold(T::zero(), |a, k| a + self.w[(row, k)] * lambda[k])
-                        + b[row];
+                    let a = positions()
+                        .fold(T::zero(), |a, k| a + self.w_at(&listed, row, k) * lambda[k])
+                        + b_at[row];
                     let way = if lambda[row] <= lo {
                         T::one()
                     } else if lambda[row] >= hi || a > T::zero() {
@@ -591,12 +602,8 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
                     let beyond = pull > T::FOURTH_ROOT_EPSILON * size;
                     joined = Some((row, way, beyond));
                 }
-                None if all_finite(lambda.as_slice()) => {
-                    return Ok(Complementary {
-                        lambda,
-                        active: free,
-                        passes: u32::try_from(pass).unwrap_or(u32::MAX),
-                    });
+                None if all_finite(&lambda) => {
+                    return Ok(listed.scatter(&lambda, &free, pass));
                 }
                 _ => return Err(Error::NonFiniteState),
             }
@@ -606,23 +613,31 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
         })
     }
 
-    /// The ray step of [`Delassus::complementary_from`] for `row`, last of `order[..n]` and
-    /// dependent on the rows before it, moving `way` (+1 up, -1 down) off its bound: `c =
-    /// W_FF^-1 W_F,row` on those rows, then `lambda_row += way t` and `lambda_F -= way c t`
-    /// (which leaves `W lambda` unchanged) as far as the first bound; the row that reaches
-    /// it is held there (`row` itself, or one of the others, which `row` then replaces).
-    /// The position from which the order changed; `None`, with nothing changed, where no
-    /// bound ends the ray (rows with no bounds that depend on each other and do not agree).
+    /// `W` between the candidates at positions `p` and `q` of `listed`.
+    #[inline(always)]
+    fn w_at(&self, listed: &Listed<C>, p: usize, q: usize) -> T {
+        self.w[(listed.row(p), listed.row(q))]
+    }
+
+    /// The ray step of [`Delassus::complementary_from`] for the candidate at position `row`
+    /// of `listed`, last of `order[..n]` and dependent on the rows before it, moving `way` (+1
+    /// up, -1 down) off its bound: `c = W_FF^-1 W_F,row` on those rows, then `lambda_row +=
+    /// way t` and `lambda_F -= way c t` (which leaves `W lambda` unchanged) as far as the
+    /// first bound; the row that reaches it is held there (`row` itself, or one of the
+    /// others, which `row` then replaces). The position in the order from which it changed;
+    /// `None`, with nothing changed, where no bound ends the ray (rows with no bounds that
+    /// depend on each other and do not agree). Positions throughout, as the method's.
     ///
     /// # Errors
     /// As the solve of the rows before `row`.
     #[allow(clippy::too_many_arguments)]
     fn ray(
         &mut self,
+        listed: &Listed<C>,
         order: &mut [usize; C],
         n: &mut usize,
         free: &mut [bool; C],
-        lambda: &mut SVector<T, C>,
+        lambda: &mut [T; C],
         bounds: &[(T, T); C],
         row: usize,
         way: T,
@@ -630,12 +645,12 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
         let row = within::<C>(row);
         let before = (*n).min(C).saturating_sub(1);
         let partners = order.iter().take(before).map(|&k| within::<C>(k));
-        let mut column = SVector::<T, C>::zeros();
+        let mut column = [T::zero(); C];
         for k in partners.clone() {
-            column[k] = self.w[(k, row)];
+            column[k] = self.w_at(listed, k, row);
         }
-        let mut c = SVector::<T, C>::zeros();
-        self.solve(order, before, before, &column, &mut c)?;
+        let mut c = [T::zero(); C];
+        self.solve(listed, order, before, before, &column, &mut c)?;
         let (lo, hi) = bounds[row];
         let own = if way > T::zero() {
             hi - lambda[row]
@@ -671,24 +686,27 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
         Ok(Some(remove(order, n, held)))
     }
 
-    /// `x = W_AA^-1 r_A` on the rows `order[..n]` (`x` zero elsewhere), by a factorisation `W_AA
-    /// = F D F^T` of those rows alone in that order (`F` unit lower triangular, `D`
-    /// diagonal), refusing a pivot `D` below `sqrt(EPSILON)` of its diagonal entry of `W` (a
-    /// row dependent on the ones before it). The factor's first `kept` rows are those of the
-    /// last call's (the same rows in the same order): only the rows after them are factored.
+    /// `x = W_AA^-1 r_A` on the candidates at the positions `order[..n]` of `listed` (`x` and
+    /// `r` by position, `x` zero elsewhere), by a factorisation `W_AA = F D F^T` of those
+    /// rows alone in that order (`F` unit lower triangular, `D` diagonal), refusing a pivot
+    /// `D` below `sqrt(EPSILON)` of its diagonal entry of `W` (a row dependent on the ones
+    /// before it: [`Error::RedundantConstraints`] names its row). The factor's first `kept`
+    /// rows are those of the last call's (the same rows in the same order): only the rows
+    /// after them are factored.
     fn solve(
         &mut self,
+        listed: &Listed<C>,
         order: &[usize; C],
         n: usize,
         kept: usize,
-        r: &SVector<T, C>,
-        x: &mut SVector<T, C>,
+        r: &[T; C],
+        x: &mut [T; C],
     ) -> Result<(), Error> {
         let n = n.min(C);
         let kept = kept.min(n);
         let threshold = T::SQRT_EPSILON;
         for (f, &o) in self.factored.iter_mut().zip(order).take(kept) {
-            *f = o;
+            *f = listed.row(o);
         }
         self.factored_n = kept;
         // Stored transposed, `lt[(q, p)] = F[p][q]` for `q < p` (row `p` of `F`, which the
@@ -698,7 +716,8 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
         // substitutions divide each row's sum before the next can use it, spent a third of
         // a solve waiting on those divisions.
         let lt = &mut self.factor;
-        let row = |p: usize| within::<C>(order[p]);
+        let place = |p: usize| within::<C>(order[p]);
+        let row = |p: usize| listed.row(place(p));
         // `c[q] = F[p][q] D[q]` of the row being factored.
         let mut c = [T::zero(); C];
         for p in kept..n {
@@ -716,29 +735,89 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
                 return Err(Error::RedundantConstraints { row: row_p });
             }
             lt[(p, p)] = d;
-            self.factored[p] = order[p];
+            self.factored[p] = row_p;
             self.factored_n = p + 1;
         }
         let mut y = [T::zero(); C];
         for p in 0..n {
-            y[p] = (0..p).fold(r[row(p)], |s, k| s - lt[(k, p)] * y[k]);
+            y[p] = (0..p).fold(r[place(p)], |s, k| s - lt[(k, p)] * y[k]);
         }
         for (p, y) in y.iter_mut().enumerate().take(n) {
             *y /= lt[(p, p)];
         }
         x.fill(T::zero());
         for p in (0..n).rev() {
-            x[row(p)] = (p + 1..n).fold(y[p], |s, k| s - lt[(p, k)] * x[row(k)]);
+            x[place(p)] = (p + 1..n).fold(y[p], |s, k| s - lt[(p, k)] * x[place(k)]);
         }
         Ok(())
     }
 }
 
-/// The rows of `rows` whose multiplier is not zero, in order, written to the front of
+/// The candidates of one solve, listed: `rows[p]` the row at position `p` (in the rows'
+/// order), `position[i]` the position of row `i` (`C` where it is no candidate).
+struct Listed<const C: usize> {
+    rows: [usize; C],
+    position: [usize; C],
+    m: usize,
+}
+
+impl<const C: usize> Listed<C> {
+    /// The rows marked in `candidate`.
+    fn of(candidate: &[bool; C]) -> Self {
+        let mut rows = [0; C];
+        let m = list((0..C).filter(|&i| candidate[i]), &mut rows);
+        let mut position = [C; C];
+        for (p, &i) in rows.iter().enumerate().take(m) {
+            if let Some(slot) = position.get_mut(i) {
+                *slot = p;
+            }
+        }
+        Self { rows, position, m }
+    }
+
+    /// How many (at most `C`: what the optimiser reads to drop the bounds checks of the
+    /// arrays indexed by position).
+    fn len(&self) -> usize {
+        self.m.min(C)
+    }
+
+    /// The row at position `p` (clamped: see [`within`]).
+    #[inline(always)]
+    fn row(&self, p: usize) -> usize {
+        within::<C>(self.rows[within::<C>(p)])
+    }
+
+    /// The position of row `row`, if it is a candidate.
+    fn position(&self, row: usize) -> Option<usize> {
+        self.position.get(row).copied().filter(|&p| p < C)
+    }
+
+    /// The solution of positions `lambda` and `free`, by row, after `passes` passes.
+    fn scatter<T: Real>(
+        &self,
+        lambda: &[T; C],
+        free: &[bool; C],
+        passes: usize,
+    ) -> Complementary<T, C> {
+        let mut out = Complementary {
+            lambda: SVector::zeros(),
+            active: [false; C],
+            passes: u32::try_from(passes).unwrap_or(u32::MAX),
+        };
+        for p in (0..self.len()).map(within::<C>) {
+            let i = self.row(p);
+            out.lambda[i] = lambda[p];
+            out.active[i] = free[p];
+        }
+        out
+    }
+}
+
+/// The positions of `rows` whose multiplier is not zero, in order, written to the front of
 /// `out`: how many.
 fn nonzero<T: Real, const C: usize>(
     rows: impl Iterator<Item = usize>,
-    lambda: &SVector<T, C>,
+    lambda: &[T; C],
     out: &mut [usize; C],
 ) -> usize {
     list(
