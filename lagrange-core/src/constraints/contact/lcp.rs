@@ -89,6 +89,9 @@ pub struct Delassus<T: Real, const N: usize, const C: usize> {
     factored: [usize; C],
     factored_n: usize,
     candidate: [bool; C],
+    /// The candidates listed (made again whenever they change), for the loops over them
+    /// alone: a step's solve reads them a few dozen times, and they change a few times.
+    listed: Listed<C>,
 }
 
 impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
@@ -125,6 +128,7 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
             factored: [0; C],
             factored_n: 0,
             candidate: [false; C],
+            listed: Listed::of(&[false; C]),
         }
     }
 
@@ -135,6 +139,7 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
         self.mobility.fill(T::zero());
         self.w.fill(T::zero());
         self.candidate = [false; C];
+        self.listed = Listed::of(&self.candidate);
         self.factored_n = 0;
     }
 
@@ -203,6 +208,7 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
             return Err(Error::NonFiniteState);
         }
         self.candidate = *candidate;
+        self.listed = Listed::of(candidate);
         Ok(())
     }
 
@@ -260,11 +266,13 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
                 self.mobility.column_mut(i).fill(T::zero());
                 self.w.row_mut(i).fill(T::zero());
                 self.w.column_mut(i).fill(T::zero());
+                self.listed = Listed::of(&self.candidate);
                 return Err(Error::NonFiniteState);
             }
             self.w[(i, k)] = x;
             self.w[(k, i)] = x;
         }
+        self.listed = Listed::of(&self.candidate);
         Ok(())
     }
 
@@ -292,10 +300,12 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
         // The candidates' columns alone, in order (the same sum as the whole product: the
         // others are zero), so that a step's few rows of a large set cost a few columns.
         let mut out = SVector::<T, N>::zeros();
-        for (i, column) in self.mobility.column_iter().enumerate() {
-            let l = lambda[within::<C>(i)];
-            if self.candidate[within::<C>(i)] && l != T::zero() {
-                out += column * l;
+        for i in self.listed.rows() {
+            let l = lambda[i];
+            if l != T::zero() {
+                for (o, m) in out.iter_mut().zip(column_of(&self.mobility, i)) {
+                    *o += *m * l;
+                }
             }
         }
         out
@@ -305,7 +315,7 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
     #[must_use]
     pub fn speeds(&self, v: &SVector<T, N>) -> SVector<T, C> {
         let mut out = SVector::<T, C>::zeros();
-        for i in (0..C).filter(|&i| self.candidate[i]).map(within::<C>) {
+        for i in self.listed.rows() {
             out[i] = split_dot(column_of(&self.rows, i), v.as_slice());
         }
         out
@@ -370,7 +380,7 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
         // and array below holds the candidates alone, not the set's `C` rows (each pass
         // walked all `C` rows' flags and an index list through them: most of a landing
         // ragdoll's solve, 6 of its 31 rows candidates).
-        let listed = Listed::of(&self.candidate);
+        let listed = self.listed;
         let m = listed.len();
         // The positions, clamped (no-ops: the optimiser does not carry `m <= C` into a loop's
         // index, and a bounds check is a panic path).
@@ -753,8 +763,9 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
     }
 }
 
-/// The candidates of one solve, listed: `rows[p]` the row at position `p` (in the rows'
-/// order), `position[i]` the position of row `i` (`C` where it is no candidate).
+/// Candidate rows, listed: `rows[p]` the row at position `p` (in the rows' order),
+/// `position[i]` the position of row `i` (`C` where it is no candidate).
+#[derive(Debug, Clone, Copy)]
 struct Listed<const C: usize> {
     rows: [usize; C],
     position: [usize; C],
@@ -779,6 +790,11 @@ impl<const C: usize> Listed<C> {
     /// arrays indexed by position).
     fn len(&self) -> usize {
         self.m.min(C)
+    }
+
+    /// The rows, in order (clamped: see [`within`]).
+    fn rows(&self) -> impl Iterator<Item = usize> + '_ {
+        self.rows.iter().take(self.len()).map(|&i| within::<C>(i))
     }
 
     /// The row at position `p` (clamped: see [`within`]).
