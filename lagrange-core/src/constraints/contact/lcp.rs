@@ -916,7 +916,7 @@ where
 
 #[cfg(test)]
 mod tests {
-    use super::{Delassus, Row};
+    use super::{Delassus, Listed, Row};
     use crate::nalgebra::{SMatrix, SVector};
     use crate::Error;
 
@@ -995,6 +995,30 @@ mod tests {
         assert!(s.lambda[0] < 0.0 && a[0].abs() < 1e-15, "{s:?}");
         assert!(a[1].abs() < 1e-15 && s.lambda[1] > 0.0, "{s:?}");
         Ok(())
+    }
+
+    /// A listing of candidates: rows by position in the rows' order, positions by row (none
+    /// for a row that is no candidate), and a solution by position scattered back by row.
+    #[test]
+    fn listed_candidates_map_rows_and_positions() {
+        let listed = Listed::of(&[false, true, false, true, true]);
+        assert_eq!(listed.len(), 3);
+        let mut rows = listed.rows();
+        let listed_rows: [Option<usize>; 4] = core::array::from_fn(|_| rows.next());
+        assert_eq!(listed_rows, [Some(1), Some(3), Some(4), None]);
+        let by_position: [usize; 3] = core::array::from_fn(|p| listed.row(p));
+        assert_eq!(by_position, [1, 3, 4]);
+        let positions: [Option<usize>; 6] = core::array::from_fn(|r| listed.position(r));
+        assert_eq!(positions, [None, Some(0), None, Some(1), Some(2), None]);
+        let out = listed.scatter(
+            &[0.5, 0.0, 2.0, 0.0, 0.0],
+            &[true, false, true, false, false],
+            7,
+        );
+        assert_eq!(out.lambda.as_slice(), &[0.0, 0.5, 0.0, 0.0, 2.0]);
+        assert_eq!(out.active, [false, true, false, false, true]);
+        assert_eq!(out.passes, 7);
+        assert_eq!(Listed::of(&[false; 4]).rows().count(), 0);
     }
 
     /// The candidates' speeds and the response of their multipliers, the other rows left
