@@ -1,7 +1,7 @@
 //! [`Delassus::relaxed`]: projected Gauss-Seidel on the candidate rows, the answer that
 //! always comes where the exact method may not (a degenerate set it cycles on).
 
-use super::{within, Complementary, Delassus, Row};
+use super::{Complementary, Delassus, Row};
 use crate::nalgebra::SVector;
 use crate::Real;
 
@@ -24,15 +24,19 @@ impl<T: Real, const N: usize, const C: usize> Delassus<T, N, C> {
         sweeps: u32,
     ) -> Complementary<T, C> {
         let mut lambda = SVector::<T, C>::zeros();
-        let rows = || (0..C).filter(|&i| self.candidate[i]).map(within::<C>);
+        // The candidates as listed (as the exact solve reads them), not a scan of all `C`
+        // rows' flags in each sum of each sweep.
         for _ in 0..sweeps {
-            for i in rows() {
+            for i in self.listed.rows() {
                 let diagonal = self.w[(i, i)];
                 // Not positive (or NaN): a row that no impulse moves.
                 if diagonal.partial_cmp(&T::zero()) != Some(core::cmp::Ordering::Greater) {
                     continue;
                 }
-                let a = rows().fold(b[i], |a, k| a + self.w[(i, k)] * lambda[k]);
+                let a = self
+                    .listed
+                    .rows()
+                    .fold(b[i], |a, k| a + self.w[(i, k)] * lambda[k]);
                 let (lo, hi) = kinds[i].bounds();
                 lambda[i] = (lambda[i] - a / diagonal).max(lo).min(hi);
             }
