@@ -260,13 +260,20 @@ where
 /// A ball bouncing with `e = 0.5`: apex `n` follows `e^(2n) h0` (the first three) with an
 /// error the step size sets, first order: the rebound leaves from where the step caught the
 /// contact, up to `v dt` from the ground, so the error is at most `2 g dt` (asserted at every
-/// step size; measured 0.0143 m at 1/120 s, 0.0028 m at 1/960 s) but not monotone in `dt`
-/// (it depends on where a step catches each impact); the slope fitted over 1/120 to 1/960 s
-/// is at least 0.75 (measured 1.02). It comes to rest before 2 s (the exact rest time with a
+/// step size; measured 0.0054 m at 1/120 s, 0.00013 m at 1/3840 s) but not monotone in `dt`
+/// (it depends on where a step catches each impact: 1/120 and 1/240 s read alike); the slope
+/// fitted over 1/120 to 1/3840 s is at least 0.75 (measured 1.14). It comes to rest before 2 s (the exact rest time with a
 /// rest speed of 0.05 m/s is 1.35 s) and stays: speed exactly zero, height at most `dt^2 g`
 /// above the ground and never below the slop, at 6 s.
 fn ball_bounces_to_rest<T: Real>() -> Result<(), Error> {
-    let dts = [1.0 / 120.0, 1.0 / 240.0, 1.0 / 480.0, 1.0 / 960.0];
+    let dts = [
+        1.0 / 120.0,
+        1.0 / 240.0,
+        1.0 / 480.0,
+        1.0 / 960.0,
+        1.0 / 1920.0,
+        1.0 / 3840.0,
+    ];
     let mut errors = Vec::new();
     for &dt in &dts {
         let b = bounce::<T, _>(SemiImplicitEuler, dt)?;
@@ -968,6 +975,7 @@ fn by_hand(peak: ImpulseReport, r: ImpulseReport) -> ImpulseReport {
     ImpulseReport {
         rows: peak.rows.max(r.rows),
         speculative: peak.speculative.max(r.speculative),
+        left_out: peak.left_out.max(r.left_out),
         frictional: peak.frictional.max(r.frictional),
         rounds: peak.rounds.max(r.rounds),
         settled: peak.settled && r.settled,
@@ -1479,49 +1487,49 @@ fn max_iterations_caps_the_rounds<T: Real>() -> Result<(), Error> {
     Ok(())
 }
 
-/// A landing whose exact solve of the normal rows cycles (found among 200 frictionless
-/// random drops of the hostile campaign's kind at 60 Hz: seed 7, throw 74, step 90, a hand
-/// and two joint limits struck at up to 138 m/s or rad/s): that solve's impulses are
-/// projected Gauss-Seidel's (4 C sweeps), the report says not settled (in `f64`; `f32`
-/// rounds the set differently). Either way no row in contact at the free step's end leaves
+/// A landing whose exact solve of the normal rows has no end (found among frictionless
+/// random drops of the hostile campaign's kind at 60 Hz, 4 rounds, by a search outside the
+/// repository: throw 1256 of 4,000, step 16, four rows, one of them speculative, a limb
+/// turning at 96 rad/s): that solve's impulses are projected Gauss-Seidel's (4 C sweeps),
+/// the report says not settled (in `f64`; `f32` rounds the set differently). Either way no row in contact at the free step's end leaves
 /// the step approaching, `J(q_free) q'+ >= 0` (to 64 ulps of the approach speed: the
 /// sweeps push the rows apart; with none, the hand left at -100 m/s), and no energy is
 /// gained (to 16 ulps of the energies).
 fn a_cycling_solve_still_pushes_apart<T: Real>() -> Result<(), Error> {
     let q = [
-        2.15572659753459,
-        0.4552711726028654,
-        -0.9560332500463292,
-        -0.39712661112847164,
-        0.2154864691650582,
-        0.9942478056221651,
-        0.44200930590230514,
-        -1.177161305649365,
-        -0.39728857277840973,
-        0.006000709773942289,
-        -0.08766822650020195,
-        -2.329194638757311,
+        -0.8615102178040381,
+        0.3339587692518063,
+        -1.0430261864570995,
+        -0.6539643736858544,
+        -2.852631825237155,
+        0.8075426664912438,
+        0.09763032359488999,
+        -2.326058953442452,
+        -0.997971544163201,
+        0.16433846053294004,
+        -0.29999999999999993,
+        -1.793037943000669,
     ];
     let qd = [
-        0.14443534032364572,
-        0.40037938375565435,
-        -2.164813921834734,
-        7.130939179864841,
-        -7.674397209041332,
-        21.41730728391204,
-        -53.91515284823406,
-        -39.9291673024614,
-        2.0791335587262534,
-        2.129310615149076,
-        3.00693992570737,
-        -4.875960521744452,
+        -2.499056607799262,
+        -3.8241205848999837,
+        -7.9561298870710715,
+        -5.670827665547517,
+        2.1967802587643375,
+        11.922602282031535,
+        -96.47824875753057,
+        15.709848034329397,
+        17.10151125794868,
+        -13.175220563961027,
+        1.4654943925052066e-14,
+        -6.41906287887012,
     ];
     let doll = Ragdoll::new(RagdollBody {
         joint_damping: T::zero(),
         ..RagdollBody::adult()
     })?;
     let contacts = RagdollContacts::adult(&doll, T::zero())?;
-    let model = ContactModel::new(T::from_f64(0.8103326362526472), T::from_f64(0.3), T::one())?;
+    let model = ContactModel::new(T::from_f64(0.4100410944631506), T::from_f64(0.3), T::one())?;
     let mut stepper = ImpulseStepper::new(
         SemiImplicitEuler,
         contacts,
@@ -1607,7 +1615,9 @@ impl<T: Real> HolonomicConstraints<T, 2, 2> for InclineAndWall {
 /// impulse turns it down the slope, a move of `dt` times 0.9 m/s to the left: 7.5 mm, past the
 /// wall. The wall's row joins with the speed that closes its 2 mm over the step, and the
 /// solve is done again: two rows, one speculative, two rounds (one each: no friction), and
-/// the step ends with neither row deeper than the slop.
+/// the step ends with neither row deeper than the slop. With `max_rows` 1 the wall's row
+/// finds no room: it is left out (the report says so), the solve holds one row, and the
+/// step is not an error.
 fn a_contact_the_move_would_close_joins<T: Real>() -> Result<(), Error> {
     let point = EulerLagrange::new(Point);
     let model = ContactModel::new(T::zero(), T::from_f64(0.1), T::one())?;
@@ -1628,6 +1638,16 @@ fn a_contact_the_move_would_close_joins<T: Real>() -> Result<(), Error> {
     let end = stepper.step(&point, &start, T::from_f64(1.0 / 120.0))?;
     let r = stepper.last_report();
     assert_eq!((r.rows, r.speculative, r.rounds), (2, 1, 2), "{r:?}");
+    assert_eq!(r.left_out, 0, "{r:?}");
+    let mut capped = ImpulseStepper::new(
+        SemiImplicitEuler,
+        Holonomic::new(InclineAndWall),
+        model,
+        settings.with_max_rows(1)?,
+    );
+    capped.step(&point, &start, T::from_f64(1.0 / 120.0))?;
+    let r = capped.last_report();
+    assert_eq!((r.rows, r.speculative, r.left_out), (1, 0, 1), "{r:?}");
     let gaps = Holonomic::new(InclineAndWall).position_residual(&end.q);
     for g in gaps.iter() {
         assert!(g.to_f64() >= -slop * (1.0 + 1.0 / 1024.0), "{gaps:?}");
@@ -1681,7 +1701,24 @@ fn the_drift_correction_takes_in_what_it_closes<T: Real>() -> Result<(), Error> 
         T::from_f64(1.0 / 120.0),
     )?;
     let r = stepper.last_report();
-    assert!(r.corrected && !r.held_back && r.rows == 2, "{r:?}");
+    assert!(
+        r.corrected && !r.held_back && r.rows == 2 && r.left_out == 0,
+        "{r:?}"
+    );
+    // With `max_rows` 1, the wall's row is left out of the correction too: one row solved.
+    let mut capped = ImpulseStepper::new(
+        SemiImplicitEuler,
+        Holonomic::new(InclineAndWall),
+        model,
+        settings.with_max_rows(1)?,
+    );
+    capped.step(
+        &EulerLagrange::new(Drifting),
+        &start,
+        T::from_f64(1.0 / 120.0),
+    )?;
+    let r = capped.last_report();
+    assert!(r.corrected && r.rows == 1 && r.left_out == 1, "{r:?}");
     let gaps = contacts.position_residual(&end.q);
     for g in gaps.iter() {
         let g = g.to_f64();
@@ -2140,15 +2177,16 @@ impl<T: Real> HolonomicConstraints<T, 1, 2> for Slot {
 
 /// Targets no impulses reach fall back to projected Gauss-Seidel, `4 C` sweeps. A unit ball
 /// jammed in [`Slot`], halfway (both contacts 5 mm deep, within the 1 cm slop), moving down
-/// at 0.1 m/s, restitution 0.5: at the free step's end it approaches the floor at
-/// `u = 0.1 + g dt` and both contacts touch. The plastic solve stops it; the rebound asks the
-/// floor for `e u` upwards while the ceiling, which the ball leaves at `u`, holds: no impulses
-/// reach both (the ball would have to go up and not up), so the round is projected
-/// Gauss-Seidel's and the step is not settled. Its sweeps over (floor, ceiling), by hand:
-/// each adds `e u` to both impulses after the first, which gives the floor `(1 + e) u` and the
-/// ceiling `e u`, and each ends with the ceiling's row met, the ball at rest. After `4 C = 8`
-/// sweeps: floor `(1 + 8 e) u`, ceiling `8 e u`, the ball at rest where it began (the impulses
-/// undo the free step's fall). To 64 ulps of the impulses (eight sweeps of a few roundings).
+/// at `a = 0.1` m/s, restitution 0.5: at the free step's end it approaches the floor at
+/// `u = a + g dt` and both contacts touch. The plastic solve stops it (the floor's impulse
+/// `u`); the rebound asks the floor for `e a` upwards (the slower approach: the start's)
+/// while the ceiling, which the ball leaves at that speed, holds: no impulses reach both
+/// (the ball would have to go up and not up), so the round is projected Gauss-Seidel's and
+/// the step is not settled. Its sweeps over (floor, ceiling), by hand: each adds `e a` to
+/// both impulses, and each ends with the ceiling's row met, the ball at rest. After
+/// `4 C = 8` sweeps: floor `u + 8 e a`, ceiling `8 e a`, the ball at rest where it began (the
+/// impulses undo the free step's fall). To 64 ulps of the impulses (eight sweeps of a few
+/// roundings).
 fn targets_no_impulses_reach_fall_back_to_gauss_seidel<T: Real>() -> Result<(), Error> {
     let (e, dt) = (0.5, 1.0 / 120.0);
     let ball = FallingParticle::new(T::one(), T::from_f64(G))?;
@@ -2159,13 +2197,13 @@ fn targets_no_impulses_reach_fall_back_to_gauss_seidel<T: Real>() -> Result<(), 
     let end = stepper.step(&ball, &start, T::from_f64(dt))?;
     let r = stepper.last_report();
     assert!(r.rows == 2 && !r.settled && !r.corrected, "{r:?}");
-    let u = 0.1 + G * dt;
+    let (a, u) = (0.1, 0.1 + G * dt);
     let sweeps = 4.0 * 2.0;
     let (normal, _) = stepper.impulses();
     let rounding = 64.0 * T::EPSILON.to_f64();
     let near = |got: T, want: f64| (got.to_f64() - want).abs() <= rounding * want.abs().max(u);
     assert!(
-        near(normal[0], (1.0 + sweeps * e) * u) && near(normal[1], sweeps * e * u),
+        near(normal[0], u + sweeps * e * a) && near(normal[1], sweeps * e * a),
         "{normal:?}"
     );
     assert!(near(end.qd[0], 0.0) && near(end.q[0], 0.095), "{end:?}");
@@ -2216,6 +2254,7 @@ fn worst_takes_each_field_at_its_worst() {
     let a = ImpulseReport {
         rows: 3,
         speculative: 0,
+        left_out: 1,
         frictional: 2,
         rounds: 1,
         settled: true,
@@ -2227,6 +2266,7 @@ fn worst_takes_each_field_at_its_worst() {
     let b = ImpulseReport {
         rows: 1,
         speculative: 2,
+        left_out: 0,
         frictional: 0,
         rounds: 4,
         settled: false,
@@ -2238,6 +2278,7 @@ fn worst_takes_each_field_at_its_worst() {
     let worst = ImpulseReport {
         rows: 3,
         speculative: 2,
+        left_out: 1,
         frictional: 2,
         rounds: 4,
         settled: false,

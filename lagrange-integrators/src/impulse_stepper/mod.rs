@@ -38,10 +38,12 @@ use step::{Memory, Setup};
 ///                   rest does not creep, on a floor or along it. A contact still open that
 ///                   this would close below the slop joins (speculative: its target the
 ///                   speed that closes it over the step), and 3 is solved again
-/// 5. rebounds       where a contact approached at w_f with e |w_f| at least the model's rest
-///                   speed, 3 again with the target w+ >= -e w_f on it: the rebound leaves
-///                   from where the contact is (it neither lifts the body nor feeds a cycle
-///                   of small bounces)
+/// 5. rebounds       where a contact approached at w = max(w_f, w_0) (the slower of its
+///                   approaches at the free step's velocities and at the start's: the free
+///                   step's hold the step's own forces, a ball's dt g) with e |w| at least
+///                   the model's rest speed, 3 again with the target w+ >= -e w on it: the
+///                   rebound leaves from where the contact is (it neither lifts the body
+///                   nor feeds a cycle of small bounces)
 /// 6. drift          split impulses, exactly, on the rows' linearised gaps: contacts below
 ///                   -slop moved back to it, bilateral rows to zero (the velocities are left
 ///                   alone, so no body leaves the floor faster than it hit it); a contact the
@@ -62,8 +64,8 @@ use step::{Memory, Setup};
 /// ```
 ///
 /// **Work of a step** (a firmware budget; `R` normal rows, at most the contact set's `C`
-/// (or the settings' `max_rows` in contact), `F <= R` of them with friction, `K` the
-/// settings' `max_iterations`):
+/// (or the settings' `max_rows`, speculative rows included), `F <= R` of them with
+/// friction, `K` the settings' `max_iterations`):
 ///
 /// ```text
 /// the inner method's step                      (Method::COST of the inner method)

@@ -10,6 +10,10 @@ pub struct ImpulseReport {
     pub rows: u32,
     /// Of those, contacts still open that joined because the step's motion would close them.
     pub speculative: u32,
+    /// Contacts still open that would have joined (speculative, or taken below the slop by
+    /// the drift correction) but for which the settings' `max_rows` left no room: `rows`
+    /// never exceeds the cap. Zero without one.
+    pub left_out: u32,
     /// Contacts with a tangent (friction).
     pub frictional: u32,
     /// Exact solves of the normal rows, each followed by a friction sweep: at most the
@@ -42,6 +46,7 @@ impl ImpulseReport {
         Self {
             rows: self.rows.max(other.rows),
             speculative: self.speculative.max(other.speculative),
+            left_out: self.left_out.max(other.left_out),
             frictional: self.frictional.max(other.frictional),
             rounds: self.rounds.max(other.rounds),
             settled: self.settled && other.settled,
@@ -59,6 +64,7 @@ impl Default for ImpulseReport {
         Self {
             rows: 0,
             speculative: 0,
+            left_out: 0,
             frictional: 0,
             rounds: 0,
             settled: true,

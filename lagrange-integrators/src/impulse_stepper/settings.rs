@@ -23,8 +23,11 @@ const MAX_ITERATIONS_CAP: u32 = 1000;
 ///                 cap on a step's work
 /// tolerance       a round whose first sweep changes no tangent's speed by more than this
 ///                 (gap units per second, plus the rounding of the speed) ends the solve
-/// max_rows        rows in contact at once, at most (default: every row of the set): the
-///                 cap on a step's work in rows; more is an error naming it
+/// max_rows        rows in a step's solve, at most (default: every row of the set): the
+///                 cap on a step's work in rows; more rows in contact is an error naming
+///                 it, and open rows that would join beyond it (speculative, or taken below
+///                 the slop by the drift correction) are left out, the deepest kept (the
+///                 report's left_out)
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -69,7 +72,8 @@ impl<T: Real> ImpulseSettings<T> {
         })
     }
 
-    /// The same settings with at most `max_rows` (at least 1) rows in contact at once.
+    /// The same settings with at most `max_rows` (at least 1) rows in a step's solve: more
+    /// in contact is an error, open rows beyond it do not join (see the type's docs).
     ///
     /// # Errors
     /// [`Error::InvalidParameter`] `max_rows` when zero.
@@ -113,7 +117,7 @@ impl<T: Real> ImpulseSettings<T> {
         self.tolerance
     }
 
-    /// The most rows in contact at once, if capped below the contact set's size.
+    /// The most rows in a step's solve, if capped below the contact set's size.
     #[must_use]
     pub fn max_rows(&self) -> Option<u32> {
         self.max_rows

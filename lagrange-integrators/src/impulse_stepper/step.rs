@@ -4,7 +4,7 @@
 
 use super::energy::guard;
 use super::report::ImpulseReport;
-use super::rows::{Filled, Measured, Workspace};
+use super::rows::{within, Filled, Measured, Workspace};
 use super::settings::ImpulseSettings;
 use super::solve::{Impulses, Problem, Solved};
 use crate::integrator::continues;
@@ -78,12 +78,25 @@ impl<T: Real, const N: usize, const C: usize> Memory<T, N, C> {
 
 impl<T: Real, const C: usize, K> Setup<T, C, K> {
     /// Each row's rebound: `-e w` for a contact touching and approaching at `w` fast enough
-    /// that it would leave at the model's rest speed or more, else zero (it rests).
-    fn rebounds(&self, gaps: &SVector<T, C>, w: &SVector<T, C>) -> SVector<T, C> {
+    /// that it would leave at the model's rest speed or more, else zero (it rests); `w` the
+    /// slower of its approaches at the free step's velocities `w_free` and at the step's
+    /// start `w_start` (see [`Setup::contacts_of`]).
+    fn rebounds(
+        &self,
+        gaps: &SVector<T, C>,
+        w_free: &SVector<T, C>,
+        w_start: impl Fn() -> SVector<T, C>,
+    ) -> SVector<T, C> {
         let e = self.model.restitution();
+        let touching = |i: usize| !self.bilateral[i] && gaps[i] <= T::zero();
+        // No row that could rebound: the start's speeds are not needed.
+        if !(0..C).any(|i| touching(i) && -e * w_free[i] >= self.model.rest_speed()) {
+            return SVector::zeros();
+        }
+        let w_start = w_start();
         SVector::from_fn(|i, _| {
-            let rebound = -e * w[i];
-            if !self.bilateral[i] && gaps[i] <= T::zero() && rebound >= self.model.rest_speed() {
+            let rebound = -e * w_free[i].max(w_start[i]);
+            if touching(i) && rebound >= self.model.rest_speed() {
                 rebound
             } else {
                 T::zero()
@@ -91,11 +104,52 @@ impl<T: Real, const C: usize, K> Setup<T, C, K> {
         })
     }
 
+    /// The rows of `joining` that the settings' `max_rows` leaves room for beside the
+    /// `candidates` (all of them without the cap): the deepest first by `depth`, the first
+    /// of equal ones; the others marked in `left_out`. The rows of a solve never exceed the
+    /// cap: a row left out is open at the step's start, and is a row in contact (counted
+    /// against the cap) at the next.
+    fn within_cap(
+        &self,
+        joining: [bool; C],
+        candidates: &[bool; C],
+        depth: &SVector<T, C>,
+        left_out: &mut [bool; C],
+    ) -> [bool; C] {
+        let Some(cap) = self.settings.max_rows() else {
+            return joining;
+        };
+        let count = |rows: &[bool; C]| rows.iter().filter(|&&r| r).count();
+        let room = usize::try_from(cap)
+            .unwrap_or(usize::MAX)
+            .saturating_sub(count(candidates));
+        if count(&joining) <= room {
+            return joining;
+        }
+        let mut kept = [false; C];
+        for _ in 0..room {
+            let mut deepest: Option<usize> = None;
+            for i in (0..C).filter(|&i| joining[i] && !kept[i]) {
+                if deepest.is_none_or(|d| depth[i] < depth[within::<C>(d)]) {
+                    deepest = Some(i);
+                }
+            }
+            if let Some(d) = deepest {
+                kept[within::<C>(d)] = true;
+            }
+        }
+        for (out, (&j, &k)) in left_out.iter_mut().zip(joining.iter().zip(&kept)) {
+            *out |= j && !k;
+        }
+        kept
+    }
+
     /// The drift correction of coordinates whose rows' gaps would be `reach`: split impulses
     /// over the normal rows, solved exactly on the linearised gaps, contacts back to `-slop`
     /// and bilateral rows to zero; a contact that the correction itself would take below the
-    /// slop joins and it is solved again (at most [`SPECULATIVE_ROUNDS`] times). The
-    /// displacement, and whether there was one.
+    /// slop joins (within the settings' `max_rows`: see [`Setup::within_cap`], which marks
+    /// the rows it leaves out in `left_out`) and it is solved again (at most
+    /// [`SPECULATIVE_ROUNDS`] times). The displacement, and whether there was one.
     fn drift<const N: usize, F>(
         &self,
         normal: &mut Delassus<T, N, C>,
@@ -103,6 +157,7 @@ impl<T: Real, const C: usize, K> Setup<T, C, K> {
         reach: SVector<T, C>,
         kinds: &[Row<T>; C],
         mut jump: F,
+        left_out: &mut [bool; C],
     ) -> Result<(SVector<T, N>, bool), Error>
     where
         F: FnMut(&SVector<T, N>) -> Result<SVector<T, N>, Error>,
@@ -123,6 +178,7 @@ impl<T: Real, const C: usize, K> Setup<T, C, K> {
             let joining: [bool; C] = core::array::from_fn(|i| {
                 !normal.candidates()[i] && !self.bilateral[i] && after[i] < T::zero()
             });
+            let joining = self.within_cap(joining, normal.candidates(), &after, left_out);
             let deep = (0..C).any(|i| {
                 (normal.candidates()[i] || joining[i])
                     && (after[i] < T::zero() || (self.bilateral[i] && after[i] != T::zero()))
@@ -157,6 +213,7 @@ impl<T: Real, const C: usize, K> Setup<T, C, K> {
         ended: &mut Measured<T, N, C>,
         start: &SVector<T, N>,
         mut q: SVector<T, N>,
+        left_out: &mut [bool; C],
     ) -> Result<(SVector<T, N>, u32, bool), Error>
     where
         K: Contacts<T, N, C>,
@@ -190,7 +247,7 @@ impl<T: Real, const C: usize, K> Setup<T, C, K> {
                     (q, rounds, false)
                 });
             }
-            let (dq, _) = self.drift(normal, jacobian, gaps, kinds, &mut jump)?;
+            let (dq, _) = self.drift(normal, jacobian, gaps, kinds, &mut jump, left_out)?;
             q += dq;
             rounds += 1;
         }
@@ -314,10 +371,16 @@ impl<T: Real, const C: usize, K> Setup<T, C, K> {
         let reach_of =
             |plastic: &Solved<T, N, C>| jacobian * ((plastic.velocity - free.qd) * share) + gaps;
         let mut reach = reach_of(&plastic);
+        // The rows that `max_rows` kept from joining.
+        let mut left_out = [false; C];
         for _ in 0..SPECULATIVE_ROUNDS {
             let joining: [bool; C] =
                 core::array::from_fn(|i| !normal.candidates()[i] && reach[i] < -slop);
             if share <= T::zero() || !joining.iter().any(|&j| j) {
+                break;
+            }
+            let joining = self.within_cap(joining, normal.candidates(), &reach, &mut left_out);
+            if !joining.iter().any(|&j| j) {
                 break;
             }
             normal.extend(jacobian, jump, &joining)?;
@@ -335,7 +398,12 @@ impl<T: Real, const C: usize, K> Setup<T, C, K> {
             taken += plastic.rounds;
             reach = reach_of(&plastic);
         }
-        let rebound = self.rebounds(&gaps, &w);
+        // Newton's law on the slower approach, at the free step's velocities or the start's:
+        // the free step's include the step's own forces (gravity's dt g), and a ball whose
+        // rebound took them left each slow impact at e |v0| + e g dt, more than it struck
+        // at for e close to 1 (the energy guard then kept it bouncing for ever at the
+        // height where the two meet: 8 cm at e = 0.95, 120 Hz).
+        let rebound = self.rebounds(&gaps, &w, || jacobian * s.qd);
         let solved = if rebound.iter().any(|&r| r > T::zero()) {
             let bounce = target.zip_map(&rebound, |t, r| t.max(r));
             let bounced = solve(
@@ -354,7 +422,7 @@ impl<T: Real, const C: usize, K> Setup<T, C, K> {
             plastic
         };
         let shift = (plastic.velocity - free.qd) * share;
-        let (dq, corrected) = self.drift(normal, jacobian, reach, &kinds, jump)?;
+        let (dq, corrected) = self.drift(normal, jacobian, reach, &kinds, jump, &mut left_out)?;
         let (q, drift_rounds, held_back) = self.settle(
             normal,
             jacobian,
@@ -363,6 +431,7 @@ impl<T: Real, const C: usize, K> Setup<T, C, K> {
             ended,
             &s.q,
             free.q + shift + dq,
+            &mut left_out,
         )?;
         let end = State {
             t: free.t,
@@ -376,6 +445,7 @@ impl<T: Real, const C: usize, K> Setup<T, C, K> {
         let report = ImpulseReport {
             rows: count(normal.candidates()),
             speculative,
+            left_out: count(&left_out),
             frictional: count(&core::array::from_fn(|i| tangent[i].is_some())),
             rounds: taken,
             settled: solved.settled,
