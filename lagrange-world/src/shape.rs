@@ -72,11 +72,13 @@ impl<T: Real> Shape<T> {
     }
 
     /// The convex polygon of `vertices` (3 to [`MAX_VERTICES`], finite, wound
-    /// counter-clockwise, every turn strictly to the left: no two vertices alike, none on
-    /// the edge of its neighbours).
+    /// counter-clockwise, every vertex strictly to the left of every edge it is not on: no
+    /// two vertices alike, none on the line of an edge, and once round, not a star whose
+    /// every turn is to the left).
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] `vertices` otherwise.
+    /// [`Error::InvalidParameter`] `vertices` otherwise, and for edges whose products
+    /// overflow or vanish in `T` (coordinates near its largest or smallest).
     pub fn polygon(vertices: &[Vec2<T>]) -> Result<Self, Error> {
         let n = vertices.len();
         let refuse = |reason| {
@@ -91,16 +93,26 @@ impl<T: Real> Shape<T> {
         if vertices.iter().flatten().any(|x| !x.is_finite()) {
             return refuse("must be finite");
         }
-        for i in 0..n {
-            let (a, b, c) = (vertices[i], vertices[(i + 1) % n], vertices[(i + 2) % n]);
-            let (e, f) = (sub(b, a), sub(c, b));
-            // Strictly left, beyond the rounding of the cross product's terms.
-            let size = length(e) * length(f);
-            // (Compared so that a NaN or an overflow refuses.)
-            let threshold = T::from_f64(64.0) * T::EPSILON * size;
-            let left = cross(e, f).partial_cmp(&threshold) == Some(core::cmp::Ordering::Greater);
-            if !(left && size.is_finite() && size > T::zero()) {
-                return refuse("must be convex and wound counter-clockwise, with no vertex on a neighbouring edge");
+        // Each edge `a -> b` against every other vertex `v`: strictly left, beyond the
+        // rounding of the cross product's terms. (Each turn to the left alone lets a star
+        // through: the pentagram turns left at every vertex, twice round.)
+        for (i, &a) in vertices.iter().enumerate() {
+            let b = vertices[(i + 1) % n];
+            let e = sub(b, a);
+            for v in (2..n).map(|k| vertices[(i + k) % n]) {
+                let f = sub(v, a);
+                let size = length(e) * length(f);
+                // Two vertices alike are refused below (a zero cross product); others whose
+                // lengths' product overflows or vanishes are at the scalar's limits.
+                let apart = |x: Vec2<T>| x[0] != T::zero() || x[1] != T::zero();
+                if apart(e) && apart(f) && !(size.is_finite() && size > T::zero()) {
+                    return refuse("edges too long or too short for the scalar: their products overflow or vanish");
+                }
+                // (Compared so that a NaN refuses.)
+                let threshold = T::from_f64(64.0) * T::EPSILON * size;
+                if cross(e, f).partial_cmp(&threshold) != Some(core::cmp::Ordering::Greater) {
+                    return refuse("must be convex and wound counter-clockwise, each vertex strictly left of every edge it is not on");
+                }
             }
         }
         Ok(Self::from_core(vertices, T::zero()))

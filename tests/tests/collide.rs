@@ -308,6 +308,25 @@ fn shapes_are_validated<T: Real>() -> Result<(), Error> {
         p(&[[0.0, 0.0], [1.0, 0.0], [1.0, 0.0], [0.0, 1.0]]),
         "vertices",
     );
+    // Stars whose every turn is to the left, twice round: the pentagram, the heptagram
+    // {7/2}, and the square wound twice.
+    let star = |n: usize, step: usize| -> Vec<[f64; 2]> {
+        (0..n)
+            .map(|k| {
+                let a = core::f64::consts::TAU * (k * step) as f64 / n as f64;
+                [a.cos(), a.sin()]
+            })
+            .collect()
+    };
+    refused(p(&star(5, 2)), "vertices");
+    refused(p(&star(7, 2)), "vertices");
+    let twice: Vec<[f64; 2]> = square.iter().chain(&square).copied().collect();
+    refused(p(&twice), "vertices");
+    // A triangle far from the unit's scale, whose products stay within the scalar: kept.
+    let scaled = |k: f64| [[0.0, 0.0], [k, 0.0], [0.0, k]];
+    let far = pick::<T>(1e15, 1e100);
+    assert_eq!(p(&scaled(far))?.vertices().len(), 3);
+    assert_eq!(p(&scaled(1.0 / far))?.vertices().len(), 3);
     refused(p(&[[0.0, 0.0], [f64::NAN, 0.0], [0.0, 1.0]]), "vertices");
     let huge = T::MAX.to_f64() / 2.0;
     refused(p(&[[-huge, -huge], [huge, -huge], [0.0, huge]]), "vertices");
