@@ -728,6 +728,51 @@ fn pyramid_falls_asleep_and_wakes<T: Real>() -> Result<(), Error> {
     Ok(())
 }
 
+/// An island is woken by what touches it, not by an island of long ago that had the same
+/// least key: boxes 1 and 5 stacked fall asleep as one island; box 1, set down 10 m away,
+/// falls asleep alone (its least key 1 again); a ball dropped on it wakes box 1 alone, and
+/// box 5, untouched, sleeps on.
+fn an_island_of_long_ago_sleeps_on<T: Real>() -> Result<(), Error> {
+    let settings = stacking::<T>()?.with_sleep(T::from_f64(0.05), T::HALF)?;
+    let mut world = Box::new(Bodies::<T>::new(settings));
+    world.add_plane(100, HalfPlane::floor())?;
+    let crate_ = RigidBody::rectangle(T::one(), T::HALF, T::HALF, T::from_f64(G))?;
+    for (key, y) in [(5, 0.25), (1, 0.75)] {
+        let q = [0.0, y, 0.0].map(T::from_f64);
+        world.add_body(key, crate_, State::new(T::zero(), q, [T::zero(); 3]))?;
+        world.add_shape(10 + key, key, 0, Shape::rectangle(T::HALF, T::HALF)?)?;
+    }
+    let dt = T::from_f64(1.0 / 60.0);
+    let steps = |world: &mut Bodies<T>, n: usize| -> Result<u32, Error> {
+        let mut woke = 0;
+        for _ in 0..n {
+            woke += world.step(dt)?.woke;
+        }
+        Ok(woke)
+    };
+    steps(&mut world, 120)?;
+    assert_eq!((world.asleep(1), world.asleep(5)), (Some(true), Some(true)));
+    let away = [10.0, 0.25, 0.0].map(T::from_f64);
+    world.set_state(1, State::new(T::zero(), away, [T::zero(); 3]))?;
+    steps(&mut world, 120)?;
+    assert_eq!((world.asleep(1), world.asleep(5)), (Some(true), Some(true)));
+    let ball = RigidBody::disk(T::one(), T::from_f64(0.1), T::from_f64(G))?;
+    let above = [10.0, 2.0, 0.0].map(T::from_f64);
+    world.add_body(9, ball, State::new(T::zero(), above, [T::zero(); 3]))?;
+    world.add_shape(19, 9, 0, Shape::circle(T::from_f64(0.1))?)?;
+    let mut five_woke = false;
+    let mut woke = 0;
+    for _ in 0..60 {
+        woke += steps(&mut world, 1)?;
+        five_woke |= world.asleep(5) == Some(false);
+    }
+    assert!(
+        woke >= 1 && !five_woke,
+        "woke {woke}, box 5 woke: {five_woke}"
+    );
+    Ok(())
+}
+
 /// The pyramid built in the opposite order (keys, bodies and shapes added from the top box
 /// down) gives the same bits, state by state, after 3 s: contacts are solved in their keys'
 /// order, islands named by their least key.
@@ -1203,6 +1248,7 @@ for_f32_and_f64!(
     momentum_and_restitution,
     pyramid_stands_ten_seconds,
     pyramid_falls_asleep_and_wakes,
+    an_island_of_long_ago_sleeps_on,
     the_order_bodies_were_added_in_does_not_matter,
     a_clock_changes_no_bits,
     the_drift_is_swept_until_it_is_settled,

@@ -6,6 +6,11 @@ use lagrange_core::links::{Links, Pose};
 use lagrange_core::nalgebra::SVector;
 use lagrange_core::{Error, Mechanism, Real, State};
 
+/// An island's name as it falls asleep: its least body key, and the count of steps in which
+/// islands fell asleep before (the key alone named a body's island of long ago as well, and
+/// a ball that struck it woke a stranger it had once slept beside).
+pub(crate) type Island = (u32, u64);
+
 /// An instance of the world's mechanism: its state and whether it sleeps.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Body<T: Real, M, L, const N: usize> {
@@ -19,8 +24,8 @@ pub(crate) struct Body<T: Real, M, L, const N: usize> {
     pub(crate) asleep: bool,
     /// How long it has moved slower than the sleep speed, s.
     pub(crate) still: T,
-    /// The island it fell asleep with (its least body key): what wakes with it.
-    pub(crate) island: u32,
+    /// The island it fell asleep with: what wakes with it (see [`Island`]).
+    pub(crate) island: Island,
 }
 
 impl<T: Real, M: Mechanism<T, N>, L, const N: usize> Body<T, M, L, N> {
@@ -40,7 +45,7 @@ impl<T: Real, M: Mechanism<T, N>, L, const N: usize> Body<T, M, L, N> {
             origin,
             asleep: false,
             still: T::zero(),
-            island: key,
+            island: (key, u64::MAX),
         }
     }
 
@@ -82,7 +87,7 @@ impl<T: Real, M: Mechanism<T, N>, L, const N: usize> Body<T, M, L, N> {
     }
 
     /// Asleep with island `island`: at rest.
-    pub(crate) fn sleep(&mut self, island: u32) {
+    pub(crate) fn sleep(&mut self, island: Island) {
         self.asleep = true;
         self.island = island;
         self.state.qd.fill(T::zero());

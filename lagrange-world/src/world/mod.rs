@@ -264,6 +264,8 @@ pub struct World<
     report: WorldReport,
     /// What the steps' profiles are read from, if anything.
     clock: Option<Clock>,
+    /// Steps in which an island fell asleep: the second part of an island's name.
+    naps: u64,
 }
 
 impl<T, M, L, const N: usize, const B: usize, const S: usize, const K: usize>
@@ -294,6 +296,7 @@ where
             broad: BroadPhase::new(),
             report: WorldReport::default(),
             clock: None,
+            naps: 0,
         }
     }
 
@@ -820,7 +823,7 @@ where
                 *s = s.min(body.still);
             }
         }
-        let mut count = 0;
+        let (mut count, mut slept) = (0, false);
         for i in 0..self.bodies.len() {
             let root = islands.root(i);
             let Some(body) = self.bodies.get_mut(i) else {
@@ -833,9 +836,11 @@ where
                 count += 1;
             }
             if still.get(root).is_some_and(|&s| s >= time) {
-                body.sleep(keys.get(root).copied().unwrap_or(body.key));
+                body.sleep((keys.get(root).copied().unwrap_or(body.key), self.naps));
+                slept = true;
             }
         }
+        self.naps = self.naps.wrapping_add(u64::from(slept));
         count
     }
 
