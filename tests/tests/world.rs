@@ -855,10 +855,11 @@ fn a_clock_changes_no_bits<T: Real>() -> Result<(), Error> {
 
 /// A step that fails leaves the world as it was, the impulses it warm-starts the next step
 /// from included: a pyramid of 10 boxes settling for 1 s, asked for a step of 1e300 s (1e30
-/// in f32: its boxes would fly past the largest number, `NonFiniteState`), then stepped on
-/// for 1 s, ends
-/// with the bits of the same pyramid never asked (a world that forgot its last impulses
-/// when a step failed took the next one from none, and its boxes ended elsewhere).
+/// in f32: its boxes would fly past the largest number, `NonFiniteState`), tells the last
+/// step's impulses, events and report as the pyramid never asked does, and stepped on for
+/// 1 s, ends with the bits of that pyramid (a world that forgot its last impulses when a
+/// step failed took the next one from none, and its boxes ended elsewhere; one that told
+/// the impulses of its working set told none).
 fn a_failed_step_keeps_the_warm_start<T: Real>() -> Result<(), Error> {
     let (mut asked, count) = pyramid(stacking::<T>()?, 4, false)?;
     let (mut never, _) = pyramid(stacking::<T>()?, 4, false)?;
@@ -872,6 +873,16 @@ fn a_failed_step_keeps_the_warm_start<T: Real>() -> Result<(), Error> {
         Err(Error::NonFiniteState),
         "a step past the largest number"
     );
+    let told = |w: &Bodies<T>| {
+        (
+            w.impulses().collect::<Vec<_>>(),
+            w.events().to_vec(),
+            w.report(),
+        )
+    };
+    let (impulses, events, report) = told(&asked);
+    assert!(impulses.len() >= 10, "{impulses:?}");
+    assert_eq!((impulses, events, report), told(&never));
     for _ in 0..60 {
         asked.step(dt)?;
         never.step(dt)?;

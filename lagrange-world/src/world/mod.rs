@@ -539,9 +539,11 @@ where
     }
 
     /// The total normal impulse on each contact of the last step, in their keys' order:
-    /// `((shape, shape, feature), impulse)`.
+    /// `((shape, shape, feature), impulse)`. A step that failed changes none of them.
     pub fn impulses(&self) -> impl Iterator<Item = ((u32, u32, u32), T)> + '_ {
-        self.contacts.iter().map(|c| (c.key, c.normal.lambda))
+        // Read from what the last step kept for warm starting: its contacts' impulses, by
+        // key (the contacts themselves are the step's working set, cleared by one that fails).
+        self.kept.iter().map(|k| (k.key, k.normal))
     }
 
     /// Where the ray `origin + t direction`, `0 <= t <= t_max`, first meets a shape or a
