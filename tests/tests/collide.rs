@@ -322,11 +322,26 @@ fn shapes_are_validated<T: Real>() -> Result<(), Error> {
     refused(p(&star(7, 2)), "vertices");
     let twice: Vec<[f64; 2]> = square.iter().chain(&square).copied().collect();
     refused(p(&twice), "vertices");
-    // A triangle far from the unit's scale, whose products stay within the scalar: kept.
+    // A triangle far from the unit's scale, whose products stay within the scalar: kept;
+    // further, refused for the scalar's limits, not as a shape that is not convex (which
+    // two vertices alike are).
     let scaled = |k: f64| [[0.0, 0.0], [k, 0.0], [0.0, k]];
     let far = pick::<T>(1e15, 1e100);
     assert_eq!(p(&scaled(far))?.vertices().len(), 3);
     assert_eq!(p(&scaled(1.0 / far))?.vertices().len(), 3);
+    let reason = |r: Result<Shape<T>, Error>| match r {
+        Err(Error::InvalidParameter { reason, .. }) => reason,
+        _ => "",
+    };
+    let beyond = pick::<T>(1e25, 1e200);
+    for k in [beyond, 1.0 / beyond] {
+        assert!(
+            reason(p(&scaled(k))).contains("too long or too short"),
+            "{k:e}"
+        );
+    }
+    let alike = [[0.0, 0.0], [1.0, 0.0], [1.0, 0.0], [0.0, 1.0]];
+    assert!(reason(p(&alike)).contains("convex"));
     refused(p(&[[0.0, 0.0], [f64::NAN, 0.0], [0.0, 1.0]]), "vertices");
     let huge = T::MAX.to_f64() / 2.0;
     refused(p(&[[-huge, -huge], [huge, -huge], [0.0, huge]]), "vertices");

@@ -1721,6 +1721,108 @@ fn a_contact_the_move_would_close_joins<T: Real>() -> Result<(), Error> {
     Ok(())
 }
 
+/// The incline of [`Incline`] (row 0) and two walls, 2 mm left of `x = X_WALL` (row 1) and
+/// at it (row 2: the nearer after the farther, so that the deeper is not the first).
+#[derive(Clone, Copy)]
+struct InclineAndWalls;
+
+impl<T: Real> HolonomicConstraints<T, 2, 3> for InclineAndWalls {
+    fn phi<S: Scalar<Real = T> + 'static>(&self, q: &SVector<S, 2>) -> SVector<S, 3> {
+        let (s, c) = (S::from_f64(ALPHA.sin()), S::from_f64(ALPHA.cos()));
+        SVector::from([
+            q[1] * c - q[0] * s,
+            q[0] - S::from_f64(X_WALL - 0.002),
+            q[0] - S::from_f64(X_WALL),
+        ])
+    }
+}
+
+/// Where `max_rows` leaves room for fewer rows than would join, the deepest join: the point
+/// of [`a_contact_the_move_would_close_joins`] beside two walls 2 and 4 mm to its left,
+/// which the step's move would both pass; with room for one of them the nearer (the deeper
+/// past it) joins and pushes, the other is left out. A speculative row rebounds from
+/// nothing: the same point moving left at 0.1 m/s, `e = 0.5`, ends the step at the wall
+/// not leaving it (the wall's row, open at the free step's end, takes the speed that closes
+/// it; a rebound would leave at 0.05 m/s), while it rebounds from the incline it struck.
+fn the_deepest_rows_join_within_the_cap<T: Real>() -> Result<(), Error> {
+    let point = EulerLagrange::new(Point);
+    let model = ContactModel::new(T::zero(), T::from_f64(0.1), T::one())?;
+    let settings = ImpulseSettings::new(T::from_f64(1e-4), 8)?;
+    let x0 = -1.0;
+    let start = State::new(
+        T::zero(),
+        [T::from_f64(x0), T::from_f64(x0 * ALPHA.tan())],
+        [T::zero(), -T::TWO],
+    );
+    let dt = T::from_f64(1.0 / 120.0);
+    let mut both = ImpulseStepper::new(
+        SemiImplicitEuler,
+        Holonomic::new(InclineAndWalls),
+        model,
+        settings,
+    );
+    both.step(&point, &start, dt)?;
+    let r = both.last_report();
+    assert_eq!((r.rows, r.speculative, r.left_out), (3, 2, 0), "{r:?}");
+    let mut one = ImpulseStepper::new(
+        SemiImplicitEuler,
+        Holonomic::new(InclineAndWalls),
+        model,
+        settings.with_max_rows(2)?,
+    );
+    one.step(&point, &start, dt)?;
+    let r = one.last_report();
+    assert_eq!((r.rows, r.speculative, r.left_out), (2, 1, 1), "{r:?}");
+    let (normal, _) = one.impulses();
+    assert!(
+        normal[2] > T::zero() && normal[1] == T::zero(),
+        "{normal:?}"
+    );
+
+    let lively = ContactModel::new(T::HALF, T::from_f64(0.01), T::one())?;
+    let mut wall = ImpulseStepper::new(
+        SemiImplicitEuler,
+        Holonomic::new(InclineAndWall),
+        lively,
+        settings,
+    );
+    let leftward = State {
+        qd: SVector::from([-T::from_f64(0.1), -T::TWO]),
+        ..start
+    };
+    let end = wall.step(&point, &leftward, dt)?;
+    let r = wall.last_report();
+    assert_eq!((r.rows, r.speculative), (2, 1), "{r:?}");
+    assert!(
+        end.qd[0].to_f64() <= 1e-6 && end.qd[1] > T::zero(),
+        "{end:?}"
+    );
+    Ok(())
+}
+
+/// A row approaching slower than the rest speed rests, and a bilateral row never
+/// rebounds: a ball on the ground moving down at 0.02 m/s (`e = 0.5`, rest speed 0.05: it
+/// would leave at 0.01) ends the step at rest; the ball held to the ground by a bilateral
+/// row, struck down at 1 m/s, ends it on the ground at rest (`e` is the contacts').
+fn slow_and_bilateral_rows_do_not_rebound<T: Real>() -> Result<(), Error> {
+    let ball = FallingParticle::new(T::one(), T::from_f64(G))?;
+    let model = ContactModel::new(T::HALF, T::from_f64(0.05), T::one())?;
+    let settings = ImpulseSettings::new(T::from_f64(1e-3), 8)?;
+    let dt = T::from_f64(1.0 / 120.0);
+    let mut resting =
+        ImpulseStepper::new(SemiImplicitEuler, Holonomic::new(Ground), model, settings);
+    let slow = State::new(T::zero(), [T::zero()], [-T::from_f64(0.02)]);
+    let end = resting.step(&ball, &slow, dt)?;
+    assert_eq!(end.qd[0], T::zero(), "{end:?}");
+    let mut held = ImpulseStepper::new(SemiImplicitEuler, Holonomic::new(Ground), model, settings)
+        .with_bilateral([true]);
+    let struck = State::new(T::zero(), [T::zero()], [-T::one()]);
+    let end = held.step(&ball, &struck, dt)?;
+    let rounding = pick::<T>(1e-6, 1e-14);
+    assert!(end.qd[0].to_f64().abs() <= rounding, "{end:?}");
+    Ok(())
+}
+
 /// A unit point mass in the plane with no forces: a drift correction costs it no energy.
 struct Drifting;
 
@@ -2306,6 +2408,8 @@ for_f32_and_f64!(
     block_on_an_incline,
     ball_bounces_to_rest,
     a_lively_ball_comes_to_rest,
+    the_deepest_rows_join_within_the_cap,
+    slow_and_bilateral_rows_do_not_rebound,
     ragdoll_thrown_for_six_seconds,
     double_pendulum_on_the_floor,
     ragdoll_rests_twenty_seconds,

@@ -126,20 +126,21 @@ impl<T: Real, const C: usize, K> Setup<T, C, K> {
         if count(&joining) <= room {
             return joining;
         }
-        let mut kept = [false; C];
+        // The rows still to place, the deepest taken from them into `kept` while room lasts.
+        let (mut left, mut kept) = (joining, [false; C]);
         for _ in 0..room {
             let mut deepest: Option<usize> = None;
-            for i in (0..C).filter(|&i| joining[i] && !kept[i]) {
+            for i in (0..C).filter(|&i| left[i]) {
                 if deepest.is_none_or(|d| depth[i] < depth[within::<C>(d)]) {
                     deepest = Some(i);
                 }
             }
-            if let Some(d) = deepest {
-                kept[within::<C>(d)] = true;
+            if let Some(d) = deepest.map(within::<C>) {
+                (kept[d], left[d]) = (true, false);
             }
         }
-        for (out, (&j, &k)) in left_out.iter_mut().zip(joining.iter().zip(&kept)) {
-            *out |= j && !k;
+        for (out, &l) in left_out.iter_mut().zip(&left) {
+            *out |= l;
         }
         kept
     }
