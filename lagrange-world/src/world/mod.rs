@@ -170,8 +170,10 @@ pub struct WorldHit<T> {
 ///
 /// The rows are taken at the step's start, so an impulse acts on both bodies at the same
 /// point, equal and opposite: linear and angular momentum are kept to rounding through
-/// every contact (no other scheme of the library's keeps them through friction off the
-/// centre). The scheme is first order; between contacts each body moves by semi-implicit
+/// every contact's impulses (no other scheme of the library's keeps them through friction
+/// off the centre); the drift correction, which moves positions alone, keeps the linear
+/// momentum but moves the angular momentum of bodies that slide across the contact it
+/// corrects. The scheme is first order; between contacts each body moves by semi-implicit
 /// Euler, whose energy error stays bounded. Impulses never add kinetic energy: where the
 /// solve would (rebounds of several contacts at once, or last step's impulses warm-starting
 /// a contact that let go), it is done again from zero impulses without rebounds
@@ -192,7 +194,8 @@ pub struct WorldHit<T> {
 /// but their shapes' place in the broad phase.
 ///
 /// **Determinism.** Contacts are solved in the order of their keys (the shapes' keys and
-/// the features that meet), islands are named by their least body key, and each body's free
+/// the features that meet), islands are named by their least body key (and, asleep, the
+/// count of steps in which islands fell asleep before), and each body's free
 /// motion is its own: the same world gives the same bits whatever order its bodies and
 /// shapes were added in.
 ///
