@@ -262,9 +262,9 @@ where
 /// contact, up to `v dt` from the ground, so the error is at most `2 g dt` (asserted at every
 /// step size; measured 0.0054 m at 1/120 s, 0.00013 m at 1/3840 s) but not monotone in `dt`
 /// (it depends on where a step catches each impact: 1/120 and 1/240 s read alike); the slope
-/// fitted over 1/120 to 1/3840 s is at least 0.75 (measured 1.14). It comes to rest before 2 s (the exact rest time with a
-/// rest speed of 0.05 m/s is 1.35 s) and stays: speed exactly zero, height at most `dt^2 g`
-/// above the ground and never below the slop, at 6 s.
+/// fitted over 1/120 to 1/3840 s is at least 0.75 (measured 1.14). It comes to rest before
+/// 2 s (the exact rest time with a rest speed of 0.05 m/s is 1.35 s) and stays: speed
+/// exactly zero, height at most `dt^2 g` above the ground and never below the slop, at 6 s.
 fn ball_bounces_to_rest<T: Real>() -> Result<(), Error> {
     let dts = [
         1.0 / 120.0,
@@ -298,7 +298,7 @@ fn ball_bounces_to_rest<T: Real>() -> Result<(), Error> {
     Ok(())
 }
 
-/// The step at which a ball from 1 m, restitution `e`, rest speed `rest`, by `inner` at
+/// The time at which a ball from 1 m, restitution `e`, rest speed `rest`, by `inner` at
 /// `dt`, comes to rest (speed zero in contact) and stays there until 30 s; `None` if it
 /// never does.
 fn rests_at<T: Real, I>(inner: I, e: f64, rest: f64, dt: f64) -> Result<Option<f64>, Error>
@@ -1557,9 +1557,9 @@ fn max_iterations_caps_the_rounds<T: Real>() -> Result<(), Error> {
 /// random drops of the hostile campaign's kind at 60 Hz, 4 rounds, by a search outside the
 /// repository: throw 1256 of 4,000, step 16, four rows, one of them speculative, a limb
 /// turning at 96 rad/s): that solve's impulses are projected Gauss-Seidel's (4 C sweeps),
-/// the report says not settled (in `f64`; `f32` rounds the set differently). Either way no row in contact at the free step's end leaves
-/// the step approaching, `J(q_free) q'+ >= 0` (to 64 ulps of the approach speed: the
-/// sweeps push the rows apart; with none, the hand left at -100 m/s), and no energy is
+/// the report says not settled (in `f64`; `f32` rounds the set differently). Either way no
+/// row in contact at the free step's end leaves the step approaching, `J(q_free) q'+ >= 0`
+/// (to 64 ulps of the approach speed: the sweeps push the rows apart), and no energy is
 /// gained (to 16 ulps of the energies).
 fn a_cycling_solve_still_pushes_apart<T: Real>() -> Result<(), Error> {
     let q = [
@@ -1740,8 +1740,8 @@ impl<T: Real> HolonomicConstraints<T, 2, 3> for InclineAndWalls {
 /// Where `max_rows` leaves room for fewer rows than would join, the deepest join: the point
 /// of [`a_contact_the_move_would_close_joins`] beside two walls 2 and 4 mm to its left,
 /// which the step's move would both pass; with room for one of them the nearer (the deeper
-/// past it) joins and pushes, the other is left out. A speculative row rebounds from
-/// nothing: the same point moving left at 0.1 m/s, `e = 0.5`, ends the step at the wall
+/// past it) joins and pushes, the other is left out. And a speculative row does not
+/// rebound: the same point moving left at 0.1 m/s, `e = 0.5`, ends the step at the wall
 /// not leaving it (the wall's row, open at the free step's end, takes the speed that closes
 /// it; a rebound would leave at 0.05 m/s), while it rebounds from the incline it struck.
 fn the_deepest_rows_join_within_the_cap<T: Real>() -> Result<(), Error> {
