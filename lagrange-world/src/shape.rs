@@ -96,15 +96,15 @@ impl<T: Real> Shape<T> {
         // Each edge `a -> b` against every other vertex `v`: strictly left, beyond the
         // rounding of the cross product's terms. (Each turn to the left alone lets a star
         // through: the pentagram turns left at every vertex, twice round.)
+        // Two vertices alike are refused below (a zero cross product); others whose lengths'
+        // product overflows or vanishes are at the scalar's limits.
+        let apart = |x: Vec2<T>| x[0] != T::zero() || x[1] != T::zero();
         for (i, &a) in vertices.iter().enumerate() {
             let b = vertices[(i + 1) % n];
             let e = sub(b, a);
             for v in (2..n).map(|k| vertices[(i + k) % n]) {
                 let f = sub(v, a);
                 let size = length(e) * length(f);
-                // Two vertices alike are refused below (a zero cross product); others whose
-                // lengths' product overflows or vanishes are at the scalar's limits.
-                let apart = |x: Vec2<T>| x[0] != T::zero() || x[1] != T::zero();
                 if apart(e) && apart(f) && !(size.is_finite() && size > T::zero()) {
                     return refuse("edges too long or too short for the scalar: their products overflow or vanish");
                 }

@@ -77,26 +77,25 @@ impl<T: Real, const N: usize, const C: usize> Memory<T, N, C> {
 }
 
 impl<T: Real, const C: usize, K> Setup<T, C, K> {
-    /// Each row's rebound: `-e w` for a contact touching and approaching at `w` fast enough
-    /// that it would leave at the model's rest speed or more, else zero (it rests); `w` the
-    /// slower of its approaches at the free step's velocities `w_free` and at the step's
-    /// start `w_start` (see [`Setup::contacts_of`]).
+    /// Each row's rebound: `-e w` for a contact `touching` (not a bilateral row) and
+    /// approaching at `w` fast enough that it would leave at the model's rest speed or more,
+    /// else zero (it rests); `w` the slower of its approaches at the free step's velocities
+    /// `w_free` and at the step's start `w_start` (see [`Setup::contacts_of`]).
     fn rebounds(
         &self,
-        gaps: &SVector<T, C>,
+        touching: &[bool; C],
         w_free: &SVector<T, C>,
         w_start: impl Fn() -> SVector<T, C>,
     ) -> SVector<T, C> {
         let e = self.model.restitution();
-        let touching = |i: usize| !self.bilateral[i] && gaps[i] <= T::zero();
         // No row that could rebound: the start's speeds are not needed.
-        if !(0..C).any(|i| touching(i) && -e * w_free[i] >= self.model.rest_speed()) {
+        if !(0..C).any(|i| touching[i] && -e * w_free[i] >= self.model.rest_speed()) {
             return SVector::zeros();
         }
         let w_start = w_start();
         SVector::from_fn(|i, _| {
             let rebound = -e * w_free[i].max(w_start[i]);
-            if touching(i) && rebound >= self.model.rest_speed() {
+            if touching[i] && rebound >= self.model.rest_speed() {
                 rebound
             } else {
                 T::zero()
@@ -404,7 +403,7 @@ impl<T: Real, const C: usize, K> Setup<T, C, K> {
         // rebound took them left each slow impact at e |v0| + e g dt, more than it struck
         // at for e close to 1 (the energy guard then kept it bouncing for ever at the
         // height where the two meet: 8 cm at e = 0.95, 120 Hz).
-        let rebound = self.rebounds(&gaps, &w, || jacobian * s.qd);
+        let rebound = self.rebounds(&frictional, &w, || jacobian * s.qd);
         let solved = if rebound.iter().any(|&r| r > T::zero()) {
             let bounce = target.zip_map(&rebound, |t, r| t.max(r));
             let bounced = solve(
