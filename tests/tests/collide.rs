@@ -367,7 +367,31 @@ fn shapes_are_validated<T: Real>() -> Result<(), Error> {
     Ok(())
 }
 
+/// A box resting flat on an equal one, 1 mm into it, tipped either way by up to a few
+/// tenths of a milliradian (a column at rest, its boxes rocking by the rounding of their
+/// impulses), names its two points by the same features whichever way it tips: the lower
+/// box's top face stays the reference, so that a solver's impulses are matched from step
+/// to step. (Each face was the reference by turns: the ids changed with the sign of the
+/// tip, and a column of five boxes, warm-started every other step, crept 0.34 m in 20 s.)
+fn resting_faces_keep_their_ids<T: Real>() -> Result<(), Error> {
+    let unit = Shape::rectangle(T::one(), T::one())?;
+    let lower = unit.placed(&pose(0.0, 0.0, 0.0));
+    let ids = |angle: f64| {
+        let m = collide(&lower, &unit.placed(&pose(0.002, 0.999, angle)), T::zero());
+        let mut ids: Vec<u32> = m.points().iter().map(|p| p.id).collect();
+        ids.sort_unstable();
+        ids
+    };
+    let flat = ids(0.0);
+    assert_eq!(flat.len(), 2, "{flat:?}");
+    for angle in [1e-7, -1e-7, 1e-5, -1e-5, 3e-4, -3e-4] {
+        assert_eq!(ids(angle), flat, "tipped by {angle}");
+    }
+    Ok(())
+}
+
 for_f32_and_f64!(
+    resting_faces_keep_their_ids,
     shapes_are_validated,
     circles,
     boxes,

@@ -368,6 +368,79 @@ fn the_drift_is_swept_until_it_is_settled<T: Real>() -> Result<(), Error> {
     Ok(())
 }
 
+/// How a column's boxes are placed: each box's lift above the one below, how far across
+/// and how far turned (see [`column_stands`]).
+type Placing = (f64, fn(u32) -> f64, fn(u32) -> f64);
+
+/// A column of `n` boxes of side `size` (density 1 kg/m^2) in the stacking tests' settings
+/// with `sweeps` sweeps, each `lift` of its side above the one below (the bottom one above
+/// the floor), moved across by `across(k)` of its side and turned by `turn(k)` rad; for
+/// `seconds` at 60 Hz. How far the top box's centre went across, m, and the largest turn
+/// of any box at the end, rad.
+fn column_stands<T: Real>(
+    n: u32,
+    size: f64,
+    sweeps: u32,
+    (lift, across, turn): Placing,
+    seconds: f64,
+) -> Result<(f64, f64), Error> {
+    let settings = WorldSettings::new(stacking::<T>()?.model(), T::from_f64(SLOP), sweeps)?;
+    let mut world = Box::new(Bodies::<T>::new(settings));
+    world.add_plane(10_000, HalfPlane::floor())?;
+    let side = T::from_f64(size);
+    for key in 0..n {
+        let k = f64::from(key);
+        let body = RigidBody::rectangle(side * side, side, side, T::from_f64(G))?;
+        let q = [
+            across(key) * size,
+            (0.5 + k) * size * (1.0 + lift),
+            turn(key),
+        ];
+        let at = State::new(T::zero(), q.map(T::from_f64), [T::zero(); 3]);
+        world.add_body(key, body, at)?;
+        world.add_shape(1000 + key, key, 0, Shape::rectangle(side, side)?)?;
+    }
+    let x0 = across(n - 1) * size;
+    for _ in 0..(seconds * 60.0) as usize {
+        world.step(T::from_f64(1.0 / 60.0))?;
+    }
+    let states: std::vec::Vec<_> = (0..n).filter_map(|k| world.state(k)).collect();
+    let turned = states
+        .iter()
+        .map(|s| s.q[2].to_f64().abs())
+        .fold(0.0, f64::max);
+    let top = states.last().map_or(f64::NAN, |s| s.q[0].to_f64() - x0);
+    Ok((top.abs(), turned))
+}
+
+/// Columns stand. Placed true, ten 1 m boxes and twenty 10 cm ones with the stacking
+/// tests' 8 sweeps stay where they were put for 20 s (to a micrometre and a microradian:
+/// measured not to move at all; solved a corner at a time, the corner taken first took
+/// more of the weight, every box turned a little each step and both columns fell within
+/// 20 s). Placed by hand (each box up to 5 mm across and 5 mrad turned from true, 1 cm
+/// above the one below), ten 1 m boxes drop into place and stand with 12 sweeps: the top
+/// box within 3 cm of where it started and no box turned past 10 mrad after 10 s (0.2 and
+/// 1.2 mm, 1.2 and 6.8 mrad measured in f64 and f32; with 8 sweeps it falls).
+fn columns_stand<T: Real>() -> Result<(), Error> {
+    let none: Placing = (0.0, |_| 0.0, |_| 0.0);
+    for (n, size) in [(10, 1.0), (20, 0.1)] {
+        let (moved, turned) = column_stands::<T>(n, size, 8, none, 20.0)?;
+        assert!(
+            moved < 1e-6 && turned < 1e-6,
+            "{n} of {size} m: {moved} m, {turned} rad"
+        );
+    }
+    let by_hand: Placing = (
+        0.01,
+        |k| 0.005 * (2.3 * f64::from(k)).sin(),
+        |k| 0.005 * (1.7 * f64::from(k)).cos(),
+    );
+    let (moved, turned) = column_stands::<T>(10, 1.0, 12, by_hand, 10.0)?;
+    println!("by hand: top moved {moved} m, turned {turned} rad");
+    assert!(moved < 0.03 && turned < 0.01, "{moved} m, {turned} rad");
+    Ok(())
+}
+
 /// A row of three 1 m boxes of 1 kg along x at y = 10, weightless: the first (key 0)
 /// `first_gap` m from the second and moving towards it at `speed`, the third `gap` m beyond
 /// the second and `lift` m higher (or, with `wall`, a wall there in its place), the floor
@@ -661,7 +734,7 @@ fn a_second_look_with_no_room_is_not_taken<T: Real>() -> Result<(), Error> {
 
 /// A pyramid of 10 rows (55 boxes) for `seconds` at 60 Hz, never asleep: the top box moves
 /// less than 1 cm (each of the 10 contacts below it rests within the 5 mm slop, and the
-/// solve leaves most of them far shallower: 8.3 mm measured over 60 s in f64), no two boxes
+/// solve leaves most of them far shallower: 4.6 mm measured over 60 s in f64), no two boxes
 /// and no box and the floor overlap by more than the slop (and 1% of it: the rounding of the
 /// last step's drift), and nothing slides or turns (the top box's angle below 1e-3 rad).
 fn pyramid_stands<T: Real>(seconds: f64) -> Result<(), Error> {
@@ -1263,6 +1336,7 @@ for_f32_and_f64!(
     the_order_bodies_were_added_in_does_not_matter,
     a_clock_changes_no_bits,
     the_drift_is_swept_until_it_is_settled,
+    columns_stand,
     a_body_sent_into_another_strikes_it_in_the_step,
     a_step_looks_again_only_where_a_body_is_sent_into_a_new_shape,
     a_body_sent_into_a_wall_or_a_sleeper,
@@ -1284,11 +1358,12 @@ fn pyramid_stands_a_minute() -> Result<(), Error> {
 }
 
 /// A pyramid of 20 rows (210 boxes) for 10 s with 12 sweeps a step: nothing past the slop
-/// (and 1%), the top box within 5 cm of where it started (35 and 38 mm measured, f32 and
-/// f64: each of the 20 contacts below it rests within the slop, and the tall pile spreads a
-/// little as it settles), turned less than 1e-2 rad (1.6e-3 measured). With the stacking tests' 8 sweeps it falls
-/// apart (its top box 1.6 m across after 5 s): a taller stack needs more sweeps, as
-/// `WorldSettings::new` says.
+/// (and 1%), the top box within 3 cm of where it started (13 mm measured in f32 and f64:
+/// each of the 20 contacts below it rests within the slop, and the tall pile spreads a
+/// little as it settles; 35 and 38 mm while a resting face's points changed their ids with
+/// the way it tipped), turned less than 1e-2 rad (8e-5 measured). With the stacking tests'
+/// 8 sweeps it falls apart (its top box 0.5 m across after 10 s): a taller stack needs more
+/// sweeps, as `WorldSettings::new` says.
 #[test]
 #[ignore = "long: cargo xtask test runs it optimised"]
 fn a_pyramid_of_twenty_rows_stands_with_twelve_sweeps() -> Result<(), Error> {
@@ -1313,7 +1388,7 @@ fn a_pyramid_of_twenty_rows_stands_with_twelve_sweeps() -> Result<(), Error> {
             core::any::type_name::<T>(),
             s[2].to_f64()
         );
-        assert!(moved < 0.05 && s[2].to_f64().abs() < 1e-2, "{moved} {s:?}");
+        assert!(moved < 0.03 && s[2].to_f64().abs() < 1e-2, "{moved} {s:?}");
         assert!(worst <= SLOP * 1.01, "{worst:e}");
         Ok(())
     }

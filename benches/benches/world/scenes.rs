@@ -32,8 +32,8 @@ pub const SWEEPS: u32 = 8;
 /// Sweeps a step for a pyramid of `rows` rows: [`SWEEPS`] up to the 10 rows of the stacking
 /// test, 12 for more. The 20-row pyramid falls apart with 8 (its top box 1.6 m across and its
 /// boxes 22 mm into each other after 5 s, costing as much a step as it does standing, from
-/// the contacts of the fall); with 12 it stands (the top box 21 to 29 mm from its start after
-/// 10 s, nothing past the 5 mm slop), and a step costs less than with 8.
+/// the contacts of the fall); with 12 it stands (the top box 13 mm from its start after 10 s,
+/// nothing past the 5 mm slop), and a step costs less than with 8.
 pub fn pyramid_sweeps(rows: usize) -> u32 {
     if rows <= 10 {
         SWEEPS

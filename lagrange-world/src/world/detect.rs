@@ -243,6 +243,7 @@ where
                     reach: T::zero(),
                     point: [T::zero(); 2],
                     direction: [T::zero(); 2],
+                    twin: None,
                 })
                 .map_err(|_| capacity())?;
         }
@@ -334,6 +335,7 @@ where
                 reach: T::zero(),
                 point: p.point,
                 direction: n,
+                twin: None,
             })
             .map_err(|_| capacity())
     }

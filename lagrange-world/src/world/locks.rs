@@ -356,6 +356,7 @@ mod tests {
             reach: 0.0,
             point: [0.0; 2],
             direction: [0.0; 2],
+            twin: None,
         }
     }
 

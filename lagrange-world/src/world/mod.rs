@@ -16,6 +16,7 @@ mod profile;
 mod rows;
 mod settings;
 mod solve;
+mod twins;
 
 pub use limits::{CoordinateLimits, Limits, NoLimits, MAX_OWN_ROWS};
 pub use profile::{Clock, Profile};
@@ -731,6 +732,7 @@ where
         let own = self.contacts.partition_point(|c| c.key.0 != OWN_ROWS);
         self.locks
             .lock::<N, K>(&mut self.contacts, own, self.bodies.len());
+        twins::mark::<T, N, B, K>(&mut self.contacts);
         // The order of the contacts' bodies decides it: a pile at rest takes the last one
         // (read where it is kept, not copied: a copy is the size of the capacity, every
         // step, asleep or not).

@@ -113,6 +113,9 @@ pub(crate) struct Contact<T: Real, const N: usize> {
     /// Where it is and the normal, world coordinates (for events and queries).
     pub(crate) point: Vec2<T>,
     pub(crate) direction: Vec2<T>,
+    /// On the first of twins (the two points of one manifold: see `twins`), `W` of their
+    /// normal rows, `[W11, W12, W22]`; else `None`.
+    pub(crate) twin: Option<[T; 3]>,
 }
 
 /// What a contact's impulses were at the end of a step, kept for the next one.

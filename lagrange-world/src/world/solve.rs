@@ -5,6 +5,7 @@
 
 use super::locks::Locks;
 use super::rows::{Contact, Part, Phase, Row};
+use super::twins;
 use heapless::Vec;
 use lagrange_core::nalgebra::SVector;
 use lagrange_core::Real;
@@ -128,8 +129,17 @@ impl<T: Real> Run<'_, T> {
     ) {
         let frictional = !DRIFT && self.friction > T::zero();
         let push = (T::zero(), T::INFINITY);
+        let twin_friction = if frictional { self.friction } else { T::zero() };
         for _ in 0..self.sweeps {
-            for &i in self.order {
+            let mut order = self.order.iter().peekable();
+            while let Some(&i) = order.next() {
+                // Twins are next to each other in an order (see `Order`): taken at once.
+                if contacts.get(i as usize).is_some_and(|c| c.twin.is_some())
+                    && order.next_if(|&&n| n == i.wrapping_add(1)).is_some()
+                {
+                    twins::twins::<T, N, DRIFT>(v, contacts, i as usize, twin_friction);
+                    continue;
+                }
                 let i = i as usize;
                 // A row with no tangent (a body's own) has no friction to sweep.
                 let tangent = contacts
@@ -313,7 +323,8 @@ const NONE: u32 = u32::MAX;
 /// first not yet taken, always ready). A row's impulse waits on its speed, and the next
 /// row's speed on that impulse where they share a body: rows of other bodies one after
 /// another let a processor work on several at once (a pyramid of 55 boxes: 78 -> 70 us a
-/// step; ten ragdolls in a pile: 0.137 -> 0.114 ms). Rows of bodies apart commute, so this
+/// step; ten ragdolls in a pile: 0.137 -> 0.114 ms). Twins (see `twins`) go one right after
+/// the other, taken as one. Rows of bodies apart commute, so this
 /// order gives the keys' order's bits: a sweep is the same Gauss-Seidel sweep, only faster.
 /// (Orders that do not keep each body's rows in the keys' order go faster still, 59 us,
 /// but change the solve: by rounds of disjoint contacts, or pairs taken ahead, a pyramid's
@@ -333,13 +344,13 @@ impl<const K: usize> Order<K> {
     }
 }
 
-/// The last [`Order`] made and what it was made of (each contact's bodies, in order): an
-/// order depends on nothing else, so contacts that join the same bodies in the same order
-/// (a pile at rest, step after step) take it again.
+/// The last [`Order`] made and what it was made of (each contact's bodies and whether it is
+/// the first of twins, in order): an order depends on nothing else, so contacts that join
+/// the same bodies in the same way (a pile at rest, step after step) take it again.
 #[derive(Debug, Clone)]
 pub(crate) struct Ordered<const K: usize> {
     order: Order<K>,
-    bodies: Vec<[u32; 2], K>,
+    bodies: Vec<[u32; 3], K>,
 }
 
 impl<const K: usize> Ordered<K> {
@@ -364,8 +375,10 @@ impl<const K: usize> Ordered<K> {
     ) -> &Order<K> {
         // A body's index as stored (bodies are fewer than u32::MAX: none is `u32::MAX`).
         let packed = |c: &Contact<T, N>| {
-            c.bodies
-                .map(|b| b.map_or(u32::MAX, |i| u32::try_from(i).unwrap_or(u32::MAX - 1)))
+            let [a, b] = c
+                .bodies
+                .map(|b| b.map_or(u32::MAX, |i| u32::try_from(i).unwrap_or(u32::MAX - 1)));
+            [a, b, u32::from(c.twin.is_some())]
         };
         let same = self.bodies.len() == contacts.len()
             && contacts
@@ -384,6 +397,56 @@ impl<const K: usize> Ordered<K> {
     }
 }
 
+/// Each body's contacts as a list, in the keys' order: `front[body]` its first, then
+/// `after[side][c]` the one after contact `c` on its side `side`'s body ([`NONE`]: no more).
+pub(crate) struct BodyLists<const B: usize, const K: usize> {
+    pub(crate) front: [u32; B],
+    pub(crate) after: [[u32; K]; 2],
+}
+
+impl<const B: usize, const K: usize> BodyLists<B, K> {
+    /// The lists of `contacts` (built from the last back).
+    pub(crate) fn of<T: Real, const N: usize>(contacts: &[Contact<T, N>]) -> Self {
+        let mut front = [NONE; B];
+        let mut after = [[NONE; K]; 2];
+        for (c, contact) in contacts.iter().enumerate().rev() {
+            for (side, body) in contact.bodies.iter().enumerate() {
+                let (Some(head), Some(next)) = (
+                    body.and_then(|b| front.get_mut(b)),
+                    after.get_mut(side).and_then(|a| a.get_mut(c)),
+                ) else {
+                    continue;
+                };
+                *next = *head;
+                *head = u32::try_from(c).unwrap_or(NONE);
+            }
+        }
+        Self { front, after }
+    }
+
+    /// The contacts of `body` (at most `K`: a contact of a body with itself is on its
+    /// first side's list once, and twice on the second's, which this does not walk).
+    pub(crate) fn contacts_of<'a, T: Real, const N: usize>(
+        &'a self,
+        contacts: &'a [Contact<T, N>],
+        body: usize,
+    ) -> impl Iterator<Item = &'a Contact<T, N>> + 'a {
+        let mut at = self.front.get(body).copied().unwrap_or(NONE);
+        core::iter::from_fn(move || {
+            let c = contacts.get(at as usize)?;
+            let side = usize::from(c.bodies[0] != Some(body));
+            at = self
+                .after
+                .get(side)
+                .and_then(|a| a.get(at as usize))
+                .copied()
+                .unwrap_or(NONE);
+            Some(c)
+        })
+        .take(K)
+    }
+}
+
 /// The contacts, interleaved (see [`Order`]).
 fn interleaved<T: Real, const N: usize, const B: usize, const K: usize>(
     contacts: &[Contact<T, N>],
@@ -391,22 +454,8 @@ fn interleaved<T: Real, const N: usize, const B: usize, const K: usize>(
     if contacts.is_empty() {
         return Vec::new();
     }
-    // Each body's contacts as a list: `front[body]` its first not yet taken, then
-    // `after[side][c]` after contact `c` on that side (built from the last back).
-    let mut front = [NONE; B];
-    let mut after = [[NONE; K]; 2];
-    for (c, contact) in contacts.iter().enumerate().rev() {
-        for (side, body) in contact.bodies.iter().enumerate() {
-            let (Some(head), Some(next)) = (
-                body.and_then(|b| front.get_mut(b)),
-                after.get_mut(side).and_then(|a| a.get_mut(c)),
-            ) else {
-                continue;
-            };
-            *next = *head;
-            *head = u32::try_from(c).unwrap_or(NONE);
-        }
-    }
+    // Each body's contacts as a list: `front[body]` its first not yet taken.
+    let BodyLists { mut front, after } = BodyLists::<B, K>::of(contacts);
     let bodies = |c: usize| contacts.get(c).map_or([None; 2], |c| c.bodies);
     let mut order = Vec::new();
     let mut window: Vec<usize, AHEAD> = Vec::new();
@@ -437,15 +486,28 @@ fn interleaved<T: Real, const N: usize, const B: usize, const K: usize>(
             break;
         };
         let c = window.remove(pick);
-        let _ = order.push(u32::try_from(c).unwrap_or(NONE));
-        for (side, body) in bodies(c).iter().enumerate() {
-            let (Some(head), Some(&next)) = (
-                body.and_then(|b| front.get_mut(b)),
-                after.get(side).and_then(|a| a.get(c)),
-            ) else {
-                continue;
-            };
-            *head = next;
+        // The first of twins brings the second (the next by key, on the same bodies: the
+        // next of each of their lists) right after it.
+        let twin = contacts.get(c).is_some_and(|t| t.twin.is_some()) && c + 1 < contacts.len();
+        if twin {
+            match window.iter().position(|&w| w == c + 1) {
+                Some(p) => {
+                    window.remove(p);
+                }
+                None => next = next.max(c + 2),
+            }
+        }
+        for c in [Some(c), twin.then_some(c + 1)].into_iter().flatten() {
+            let _ = order.push(u32::try_from(c).unwrap_or(NONE));
+            for (side, body) in bodies(c).iter().enumerate() {
+                let (Some(head), Some(&next)) = (
+                    body.and_then(|b| front.get_mut(b)),
+                    after.get(side).and_then(|a| a.get(c)),
+                ) else {
+                    continue;
+                };
+                *head = next;
+            }
         }
         last.rotate_right(1);
         last[0] = bodies(c);
@@ -455,7 +517,7 @@ fn interleaved<T: Real, const N: usize, const B: usize, const K: usize>(
 
 #[cfg(test)]
 pub(crate) mod tests {
-    use super::{sweep, Order, Ordered, Run};
+    use super::{sweep, twins, Order, Ordered, Run};
     use crate::world::locks::Locks;
     use crate::world::rows::{Contact, Part, Phase, Row};
     use lagrange_core::nalgebra::SVector;
@@ -478,6 +540,7 @@ pub(crate) mod tests {
             reach: 0.0,
             point: [0.0; 2],
             direction: [0.0; 2],
+            twin: None,
         }
     }
 
@@ -662,6 +725,15 @@ pub(crate) mod tests {
         for round in 0..200 {
             let count = 1 + round % 40;
             let mut contacts = random_contacts::<64>(count, &mut draw);
+            if round % 2 == 1 {
+                // Contacts of the same two bodies one after the other are twins here.
+                for i in 1..count {
+                    if draw() > 0.0 {
+                        contacts[i].bodies = contacts[i - 1].bodies;
+                    }
+                }
+                twins::mark::<f64, 2, 6, 64>(&mut contacts);
+            }
             let order = Order::<64>::of::<f64, 2, 6>(&contacts);
             let mut all = order.all.clone();
             all.sort_unstable();
