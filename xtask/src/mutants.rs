@@ -854,6 +854,7 @@ const AREAS: [Area; 29] = [
             "lagrange-world/src/world/rows.rs",
             "lagrange-world/src/world/settings.rs",
             "lagrange-world/src/world/solve.rs",
+            "lagrange-world/src/world/twins.rs",
         ],
         only: None,
         tests: &["--test", "world", "--test", "world_pile"],
