@@ -457,6 +457,9 @@ fn interleaved<T: Real, const N: usize, const B: usize, const K: usize>(
     // Each body's contacts as a list: `front[body]` its first not yet taken.
     let BodyLists { mut front, after } = BodyLists::<B, K>::of(contacts);
     let bodies = |c: usize| contacts.get(c).map_or([None; 2], |c| c.bodies);
+    // The first of twins stands for both in the window, and brings the second (the next by
+    // key, on the same bodies: the next of each of their lists) right after it.
+    let twin = |c: usize| contacts.get(c).is_some_and(|t| t.twin.is_some());
     let mut order = Vec::new();
     let mut window: Vec<usize, AHEAD> = Vec::new();
     let mut next = 0;
@@ -464,7 +467,7 @@ fn interleaved<T: Real, const N: usize, const B: usize, const K: usize>(
     loop {
         while !window.is_full() && next < contacts.len() {
             let _ = window.push(next);
-            next += 1;
+            next += if twin(next) { 2 } else { 1 };
         }
         let ready = |c: usize| {
             bodies(c)
@@ -486,18 +489,7 @@ fn interleaved<T: Real, const N: usize, const B: usize, const K: usize>(
             break;
         };
         let c = window.remove(pick);
-        // The first of twins brings the second (the next by key, on the same bodies: the
-        // next of each of their lists) right after it.
-        let twin = contacts.get(c).is_some_and(|t| t.twin.is_some()) && c + 1 < contacts.len();
-        if twin {
-            match window.iter().position(|&w| w == c + 1) {
-                Some(p) => {
-                    window.remove(p);
-                }
-                None => next = next.max(c + 2),
-            }
-        }
-        for c in [Some(c), twin.then_some(c + 1)].into_iter().flatten() {
+        for c in [Some(c), twin(c).then_some(c + 1)].into_iter().flatten() {
             let _ = order.push(u32::try_from(c).unwrap_or(NONE));
             for (side, body) in bodies(c).iter().enumerate() {
                 let (Some(head), Some(&next)) = (
