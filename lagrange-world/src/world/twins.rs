@@ -205,7 +205,7 @@ pub(crate) fn twins<T: Real, const N: usize, const DRIFT: bool>(
 
 #[cfg(test)]
 mod tests {
-    use super::{mark, pair_lcp};
+    use super::{mark, pair_lcp, twin_w};
     use crate::world::locks::Locks;
     use crate::world::rows::{Contact, Phase, Row};
     use crate::world::solve::{sweep, tests::draws};
@@ -274,6 +274,61 @@ mod tests {
                 assert!(x[k] >= 0.0 && s[k] >= -tol, "{w:?} {r:?}: {x:?} {s:?}");
                 assert!((x[k] * s[k]).abs() <= tol, "{w:?} {r:?}: {x:?} {s:?}");
             }
+        }
+    }
+
+    /// Two points are twins only as two points of one pair of shapes, on the same two
+    /// bodies, no row of either held, each moved by an impulse, and their rows far enough
+    /// from dependent: `W11 W22 / det W` below 1000, asserted at the bound itself with a
+    /// `W` whose products are exact (999 x 1000 = 1000 x det, det = 999000 - 999^2).
+    #[test]
+    fn twins_are_one_pair_free_and_independent() {
+        let mut draw = draws(0x7a1e_0002_2026_1202);
+        let (a, b) = (Some(0), Some(1));
+        let up = [0.0, 1.0];
+        let pair = [
+            point((3, 4), 0, [a, b], up, &mut draw),
+            point((3, 4), 1, [a, b], up, &mut draw),
+        ];
+        let twins = |[x, y]: &[Contact<f64, 2>; 2]| twin_w(x, y).is_some();
+        assert!(twins(&pair));
+        let mut other = pair;
+        other[1].key = (3, 5, 1);
+        assert!(!twins(&other), "two pairs of shapes");
+        other = pair;
+        other[1].bodies = [a, Some(2)];
+        assert!(!twins(&other), "other bodies");
+        for (i, normal) in [(0, true), (0, false), (1, true), (1, false)] {
+            other = pair;
+            let c = &mut other[i];
+            let row = if normal {
+                &mut c.normal
+            } else {
+                &mut c.tangent
+            };
+            row.held = true;
+            assert!(!twins(&other), "point {i} held, normal {normal}");
+        }
+        for i in 0..2 {
+            // A row that moves its bodies by less than the rounding: no impulse moves it.
+            other = pair;
+            let normal = &mut other[i].normal;
+            *normal = Row::new(normal.j.map(|j| j * 1e-9), normal.b.map(|b| b * 1e-9));
+            assert!(!twins(&other), "row {i} moves nothing");
+        }
+        // Two points at one place: the same rows.
+        other = pair;
+        other[1].normal = other[0].normal;
+        assert!(!twins(&other), "one point");
+        // `W = [999, 999, 1000]` at the bound, `[999, 999, 1001]` within it.
+        let e = |x: f64, y: f64| SVector::<f64, 2>::new(x, y);
+        let zero = SVector::zeros();
+        for (w22, twin) in [(1000.0, false), (1001.0, true)] {
+            other = pair;
+            other[0].normal = Row::new([e(1.0, 0.0), zero], [e(999.0, 0.0), zero]);
+            other[1].normal = Row::new([e(1.0, 1.0), zero], [e(999.0, w22 - 999.0), zero]);
+            let w = twin_w(&other[0], &other[1]);
+            assert_eq!(w.is_some(), twin, "{w22}: {w:?}");
         }
     }
 
