@@ -314,7 +314,11 @@ where
     /// [`Error::InvalidParameter`] `dt` unless positive and finite, `max_rows` when more rows
     /// are in contact than it allows; [`Error::NonFiniteState`]; [`Error::NonFiniteRow`] for a
     /// row whose gap, Jacobian or tangent is not finite; the inner integrator's errors and the
-    /// mechanism's mass solve's. A step that fails leaves the stepper as it found it.
+    /// mechanism's mass solve's. A step that fails leaves the stepper as it found it: its
+    /// warm start, its report and, where it fails before filling its rows (a row not
+    /// finite, `max_rows`), the rows it keeps for a mechanism at rest. One that fails later
+    /// (the mass solve's errors, a move that overflows) leaves no rows kept: the next step
+    /// fills them again, the same rows to rounding.
     fn step(&mut self, mechanism: &M, state: &State<T, N>, dt: T) -> Result<State<T, N>, Error> {
         let dt = check_step(state, dt)?;
         self.transaction(|c| c.advance(mechanism, state, dt))
@@ -387,6 +391,8 @@ mod tests {
     use super::*;
     use crate::SemiImplicitEuler;
     use lagrange_core::constraints::contact::ContactModel;
+    use lagrange_core::constraints::Constraints;
+    use lagrange_core::nalgebra::SMatrix;
     use lagrange_core::{Holonomic, HolonomicConstraints, Scalar};
     use lagrange_systems::{
         FallingParticle, Ragdoll, RagdollBody, RagdollContacts, RAGDOLL_COORDINATES as N,
@@ -468,6 +474,104 @@ mod tests {
     #[test]
     fn reused_rows_change_only_rounding_f64() -> Result<(), Error> {
         reused_rows_change_only_rounding::<f64>()
+    }
+
+    /// A ragdoll's contacts with two holes: no gap is finite with the torso above 100 m,
+    /// and no Jacobian with it below -100 m (bad rows a step finds before it fills them).
+    #[derive(Debug, Clone, Copy)]
+    struct Holed<K>(K);
+
+    /// NaN in every entry where `hole`, else `x`.
+    fn holed<T: Real, const R: usize, const K: usize>(
+        x: SMatrix<T, R, K>,
+        hole: bool,
+    ) -> SMatrix<T, R, K> {
+        if hole {
+            x.map(|_| T::from_f64(f64::NAN))
+        } else {
+            x
+        }
+    }
+
+    impl<T: Real, const C: usize, K: Contacts<T, N, C>> Constraints<T, N, C> for Holed<K> {
+        fn position_residual(&self, q: &SVector<T, N>) -> SVector<T, C> {
+            holed(self.0.position_residual(q), q[1] > T::from_f64(100.0))
+        }
+        fn jacobian(&self, q: &SVector<T, N>) -> SMatrix<T, C, N> {
+            holed(self.0.jacobian(q), q[1] < T::from_f64(-100.0))
+        }
+        fn velocity_product(&self, q: &SVector<T, N>, qd: &SVector<T, N>) -> SVector<T, C> {
+            self.0.velocity_product(q, qd)
+        }
+    }
+
+    impl<T: Real, const C: usize, K: Contacts<T, N, C>> Contacts<T, N, C> for Holed<K> {
+        fn tangent_jacobian(&self, q: &SVector<T, N>) -> Option<SMatrix<T, C, N>> {
+            self.0.tangent_jacobian(q)
+        }
+        fn gaps_and_jacobians(
+            &self,
+            q: &SVector<T, N>,
+            gaps: &mut SVector<T, C>,
+            normal: &mut SMatrix<T, C, N>,
+            tangent: &mut SMatrix<T, C, N>,
+        ) -> bool {
+            let tangents = self.0.gaps_and_jacobians(q, gaps, normal, tangent);
+            *gaps = self.position_residual(q);
+            *normal = holed(*normal, q[1] < T::from_f64(-100.0));
+            tangents
+        }
+    }
+
+    /// A step that fails before it fills its rows (a gap, or a Jacobian, not finite: from
+    /// a state far from the rest) leaves the rows a resting mechanism keeps as they were:
+    /// the thrown ragdoll at rest after 6 s, asked to step from 200 m above the floor and
+    /// from 200 m below it, then from its rest, takes its rows again (counted) and gives
+    /// the bits of the same stepper never asked. (It took none again before: the failed
+    /// step's Jacobians were written over the kept ones, and the record dropped.)
+    fn a_failed_step_keeps_the_resting_rows<T: Real>() -> Result<(), Error> {
+        let doll = Ragdoll::new(RagdollBody::<T>::adult())?;
+        let contacts = Holed(RagdollContacts::adult(&doll, T::zero())?);
+        let model = ContactModel::new(T::from_f64(0.3), T::from_f64(0.3), T::from_f64(1e-7))?
+            .with_friction(T::from_f64(0.8))?;
+        let settings = ImpulseSettings::new(T::from_f64(2e-3), 4)?;
+        let mut untouched = ImpulseStepper::new(SemiImplicitEuler, contacts, model, settings);
+        let dt = T::from_f64(1.0 / 240.0);
+        let mut rest = thrown::<T>();
+        for _ in 0..1440 {
+            rest = untouched.step(&doll, &rest, dt)?;
+        }
+        let next = |stepper: &mut ImpulseStepper<T, N, _, _, _>| {
+            let before = stepper.work.reused;
+            let end = stepper.step(&doll, &rest, dt);
+            (end, stepper.work.reused > before)
+        };
+        for height in [200.0, -200.0] {
+            let mut far = rest;
+            far.q[1] = T::from_f64(height);
+            let mut asked = untouched;
+            assert!(matches!(
+                asked.step(&doll, &far, dt),
+                Err(Error::NonFiniteRow { .. })
+            ));
+            let (end, taken_again) = next(&mut asked);
+            assert!(taken_again, "{height}");
+            let mut never_asked = untouched;
+            assert_eq!(end, next(&mut never_asked).0, "{height}");
+        }
+        // The rest takes its rows again: what the bits above are compared on.
+        assert!(next(&mut untouched).1);
+        Ok(())
+    }
+
+    #[test]
+    fn a_failed_step_keeps_the_resting_rows_f32() -> Result<(), Error> {
+        a_failed_step_keeps_the_resting_rows::<f32>()
+    }
+
+    #[test]
+    fn a_failed_step_keeps_the_resting_rows_f64() -> Result<(), Error> {
+        a_failed_step_keeps_the_resting_rows::<f64>()
     }
 
     /// The rule of rows taken again, on a ball resting on the ground at 0 (its mass matrix

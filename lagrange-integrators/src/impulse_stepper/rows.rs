@@ -117,7 +117,7 @@ impl<T: Real, const N: usize, const C: usize> Workspace<T, N, C> {
     /// last solve, finds them again). The normal rows keep the factor their last solve left
     /// (of the same `W`), so that the first pass of a resting step factors none of them. The
     /// record is taken: a step that fails after this leaves none ([`Workspace::keep`] makes
-    /// it again).
+    /// it again) unless it fails before it fills rows ([`Workspace::put_back`]).
     pub(super) fn reuse<M: Mechanism<T, N>>(
         &mut self,
         mechanism: &M,
@@ -167,6 +167,35 @@ impl<T: Real, const N: usize, const C: usize> Workspace<T, N, C> {
     pub(super) fn forget(&mut self) {
         self.filled = None;
         self.ended.last = None;
+    }
+
+    /// After a step that failed before it filled its rows (a gap, Jacobian or tangent not
+    /// finite, more rows in contact than `max_rows`: [`Error::NonFiniteRow`] and
+    /// [`Error::InvalidParameter`]), the record `prior` of the rows the last step left, as
+    /// if the step had never run: the step wrote only the Jacobians and tangents over
+    /// theirs, worked out here again at the record's coordinates by the record's route (the
+    /// same bits: functions of the coordinates), so that the next step from the rest takes
+    /// them again as an untouched stepper's would. Not where `reuse` wrote the mass matrix
+    /// (the record would vouch for another's mobilities).
+    pub(super) fn put_back<K: Contacts<T, N, C>>(
+        &mut self,
+        prior: Option<Filled<T, N, C>>,
+        reuse: &Reuse<T, N, C>,
+        contacts: &K,
+    ) {
+        let wrote_mass = reuse.rows.is_none() && reuse.mass_known;
+        let Some(f) = prior.filter(|_| !wrote_mass) else {
+            return;
+        };
+        let (jacobian, tangents) = (&mut self.jacobian, &mut self.tangents);
+        if f.rows_too {
+            let mut gaps = SVector::zeros();
+            contacts.gaps_and_jacobians(&f.q, &mut gaps, jacobian, tangents);
+        } else {
+            contacts.jacobians(&f.q, jacobian, tangents);
+        }
+        // As they were filled, unless the contacts answer otherwise now.
+        self.filled = finite_rows(&self.jacobian, &[true; C]).is_ok().then_some(f);
     }
 
     /// Records that the rows were filled at `filled`, when the normal rows are still the

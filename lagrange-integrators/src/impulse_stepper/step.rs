@@ -4,7 +4,7 @@
 
 use super::energy::guard;
 use super::report::ImpulseReport;
-use super::rows::{within, Filled, Measured, Workspace};
+use super::rows::{within, Filled, Measured, Reuse, Workspace};
 use super::settings::ImpulseSettings;
 use super::solve::{Impulses, Problem, Solved};
 use crate::integrator::continues;
@@ -45,6 +45,18 @@ pub(super) struct Memory<T: Real, const N: usize, const C: usize> {
     pub(super) peak: ImpulseReport,
     /// The last step's size, for the sleep test's trial step.
     pub(super) dt: Option<T>,
+}
+
+/// What a step found touching at its free step's end ([`Setup::touch`]).
+struct Touch<T: Real, const C: usize> {
+    /// The gaps there.
+    gaps: SVector<T, C>,
+    /// The rows in contact (gap at most zero) and the bilateral ones.
+    touching: [bool; C],
+    /// The rows in contact that friction acts on (not bilateral).
+    frictional: [bool; C],
+    /// Whether the tangents count.
+    tangents: bool,
 }
 
 impl<T: Real, const N: usize, const C: usize> Memory<T, N, C> {
@@ -255,6 +267,59 @@ impl<T: Real, const C: usize, K> Setup<T, C, K> {
 }
 
 impl<T: Real, const C: usize, K> Setup<T, C, K> {
+    /// The gaps at the free step's coordinates `q` (the rows' taken again, or worked out
+    /// with their Jacobians where `rows_too`), which rows touch, and the Jacobians and
+    /// tangents checked: what a step finds before it fills its rows (it writes the
+    /// workspace's Jacobians and tangents, nothing else); `None` where no row touches.
+    ///
+    /// # Errors
+    /// [`Error::NonFiniteRow`] for a gap, Jacobian or tangent that is not finite,
+    /// [`Error::InvalidParameter`] `max_rows` where more rows touch than it allows.
+    fn touch<const N: usize>(
+        &self,
+        work: &mut Workspace<T, N, C>,
+        reuse: &Reuse<T, N, C>,
+        q: &SVector<T, N>,
+        rows_too: bool,
+    ) -> Result<Option<Touch<T, C>>, Error>
+    where
+        K: Contacts<T, N, C>,
+    {
+        let (gaps, given) = match reuse.rows {
+            Some((gaps, _)) => (gaps, None),
+            None => work.gaps(&self.contacts, q, rows_too)?,
+        };
+        let touching: [bool; C] =
+            core::array::from_fn(|i| self.bilateral[i] || gaps[i] <= T::zero());
+        let in_contact = touching.iter().filter(|&&t| t).count();
+        if in_contact == 0 {
+            return Ok(None);
+        }
+        if self
+            .settings
+            .max_rows()
+            .is_some_and(|cap| in_contact > cap as usize)
+        {
+            return Err(Error::InvalidParameter {
+                name: "max_rows",
+                reason: "more rows are in contact than max_rows allows",
+            });
+        }
+        let frictional: [bool; C] = core::array::from_fn(|i| touching[i] && !self.bilateral[i]);
+        let friction = self.model.friction() > T::zero();
+        let tangents = match (reuse.rows, given) {
+            (Some((_, tangents)), _) => tangents,
+            (None, Some(tangents)) => work.checked(tangents && friction, &frictional)?,
+            (None, None) => work.jacobians(&self.contacts, q, friction, &frictional)?,
+        };
+        Ok(Some(Touch {
+            gaps,
+            touching,
+            frictional,
+            tangents,
+        }))
+    }
+
     /// The contacts' part of a step from `s` whose free step reached `free`, the coordinates
     /// moved by `share` (the inner method's position share times the step) of the plastic
     /// impulses' velocity change: the end state, `memory` updated (the caller restores it
@@ -283,36 +348,28 @@ impl<T: Real, const C: usize, K> Setup<T, C, K> {
         // ragdoll); in flight, the gaps alone. Where the free step ended where the last
         // one's did, the rows it filled (a mechanism at rest).
         let rows_too = memory.report.rows > 0;
+        // The record of the rows the last step left, put back if this one fails before it
+        // fills its own over them.
+        let prior = work.filled;
         let reuse = work.reuse(mechanism, &free, rows_too);
-        let (gaps, given) = match reuse.rows {
-            Some((gaps, _)) => (gaps, None),
-            None => work.gaps(&self.contacts, &free.q, rows_too)?,
+        let touch = match self.touch(work, &reuse, &free.q, rows_too) {
+            Ok(touch) => touch,
+            Err(e) => {
+                work.put_back(prior, &reuse, &self.contacts);
+                return Err(e);
+            }
         };
-        let touching: [bool; C] =
-            core::array::from_fn(|i| self.bilateral[i] || gaps[i] <= T::zero());
-        let in_contact = touching.iter().filter(|&&t| t).count();
-        if in_contact == 0 {
+        let Some(Touch {
+            gaps,
+            touching,
+            frictional,
+            tangents,
+        }) = touch
+        else {
             // The energy of a state no row touches is not needed: marked unknown.
             let none = ImpulseReport::default();
             memory.record(Impulses::zero(), free, T::INFINITY, [false; C], none);
             return Ok(free);
-        }
-        if self
-            .settings
-            .max_rows()
-            .is_some_and(|cap| in_contact > cap as usize)
-        {
-            return Err(Error::InvalidParameter {
-                name: "max_rows",
-                reason: "more rows are in contact than max_rows allows",
-            });
-        }
-        let frictional: [bool; C] = core::array::from_fn(|i| touching[i] && !self.bilateral[i]);
-        let friction = self.model.friction() > T::zero();
-        let tangents = match (reuse.rows, given) {
-            (Some((_, tangents)), _) => tangents,
-            (None, Some(tangents)) => work.checked(tangents && friction, &frictional)?,
-            (None, None) => work.jacobians(&self.contacts, &free.q, friction, &frictional)?,
         };
         if reuse.rows.is_none() {
             work.fill(mechanism, &free, tangents, &touching, &frictional)?;
