@@ -316,9 +316,10 @@ where
     /// row whose gap, Jacobian or tangent is not finite; the inner integrator's errors and the
     /// mechanism's mass solve's. A step that fails leaves the stepper as it found it: its
     /// warm start, its report and, where it fails before filling its rows (a row not
-    /// finite, `max_rows`), the rows it keeps for a mechanism at rest. One that fails later
-    /// (the mass solve's errors, a move that overflows) leaves no rows kept: the next step
-    /// fills them again, the same rows to rounding.
+    /// finite, `max_rows`, the mass solve of the rows' mobilities), the rows it keeps for a
+    /// mechanism at rest. One that fails later (a `W` or a move that overflows, a row
+    /// joining whose mass solve fails) leaves no rows kept: the next step fills them again,
+    /// the same rows to rounding.
     fn step(&mut self, mechanism: &M, state: &State<T, N>, dt: T) -> Result<State<T, N>, Error> {
         let dt = check_step(state, dt)?;
         self.transaction(|c| c.advance(mechanism, state, dt))
@@ -393,7 +394,7 @@ mod tests {
     use lagrange_core::constraints::contact::ContactModel;
     use lagrange_core::constraints::Constraints;
     use lagrange_core::nalgebra::SMatrix;
-    use lagrange_core::{Holonomic, HolonomicConstraints, Scalar};
+    use lagrange_core::{Holonomic, HolonomicConstraints, Lagrangian, Scalar};
     use lagrange_systems::{
         FallingParticle, Ragdoll, RagdollBody, RagdollContacts, RAGDOLL_COORDINATES as N,
     };
@@ -523,15 +524,62 @@ mod tests {
         }
     }
 
-    /// A step that fails before it fills its rows (a gap, or a Jacobian, not finite: from
-    /// a state far from the rest) leaves the rows a resting mechanism keeps as they were:
-    /// the thrown ragdoll at rest after 6 s, asked to step from 200 m above the floor and
-    /// from 200 m below it, then from its rest, takes its rows again (counted) and gives
-    /// the bits of the same stepper never asked. (It took none again before: the failed
-    /// step's Jacobians were written over the kept ones, and the record dropped.)
+    /// A ragdoll whose mass solve for impulses fails with its torso more than 100 m to the
+    /// right (its accelerations still worked out: a free step there succeeds).
+    #[derive(Debug, Clone, Copy)]
+    struct Stuck<M>(M);
+
+    impl<T: Real, M: Mechanism<T, N>> Lagrangian<T, N> for Stuck<M> {
+        fn kinetic<S: Scalar<Real = T>>(&self, t: S, q: &SVector<S, N>, qd: &SVector<S, N>) -> S {
+            self.0.kinetic(t, q, qd)
+        }
+        fn potential<S: Scalar<Real = T>>(&self, t: S, q: &SVector<S, N>) -> S {
+            self.0.potential(t, q)
+        }
+        fn non_conservative_force(&self, state: &State<T, N>) -> SVector<T, N> {
+            self.0.non_conservative_force(state)
+        }
+    }
+
+    impl<T: Real, M: Mechanism<T, N>> Mechanism<T, N> for Stuck<M> {
+        fn mass_matrix(&self, state: &State<T, N>) -> SMatrix<T, N, N> {
+            self.0.mass_matrix(state)
+        }
+        fn rhs(&self, state: &State<T, N>) -> SVector<T, N> {
+            self.0.rhs(state)
+        }
+        fn solve_mass(
+            &self,
+            state: &State<T, N>,
+            b: &SVector<T, N>,
+        ) -> Result<SVector<T, N>, Error> {
+            self.0.solve_mass(state, b)
+        }
+        fn velocity_jumps<const K: usize>(
+            &self,
+            state: &State<T, N>,
+            impulses: &mut SMatrix<T, N, K>,
+        ) -> Result<(), Error> {
+            if state.q[0] > T::from_f64(100.0) {
+                return Err(Error::Singularity {
+                    what: "the test's stuck ragdoll",
+                });
+            }
+            self.0.velocity_jumps(state, impulses)
+        }
+    }
+
+    /// A step that fails before it fills its rows (a gap or a Jacobian not finite, the mass
+    /// solve of their mobilities failing: from states far from the rest) leaves the rows a
+    /// resting mechanism keeps as they were: the thrown ragdoll at rest after 6 s, asked to
+    /// step from 200 m above the floor, 200 m below it and 200 m to the right, then from its
+    /// rest, takes its rows again (counted) and gives the bits of the same stepper never
+    /// asked. (It took none again before: the failed step's Jacobians were written over the
+    /// kept ones, and the record dropped.)
     fn a_failed_step_keeps_the_resting_rows<T: Real>() -> Result<(), Error> {
         let doll = Ragdoll::new(RagdollBody::<T>::adult())?;
         let contacts = Holed(RagdollContacts::adult(&doll, T::zero())?);
+        let doll = Stuck(doll);
         let model = ContactModel::new(T::from_f64(0.3), T::from_f64(0.3), T::from_f64(1e-7))?
             .with_friction(T::from_f64(0.8))?;
         let settings = ImpulseSettings::new(T::from_f64(2e-3), 4)?;
@@ -546,18 +594,26 @@ mod tests {
             let end = stepper.step(&doll, &rest, dt);
             (end, stepper.work.reused > before)
         };
-        for height in [200.0, -200.0] {
-            let mut far = rest;
-            far.q[1] = T::from_f64(height);
+        for (k, far, fails) in [
+            (1, 200.0, "gap"),
+            (1, -200.0, "Jacobian"),
+            (0, 200.0, "mass solve"),
+        ] {
+            let mut from = rest;
+            from.q[k] += T::from_f64(far);
             let mut asked = untouched;
-            assert!(matches!(
-                asked.step(&doll, &far, dt),
-                Err(Error::NonFiniteRow { .. })
-            ));
+            let failed = asked.step(&doll, &from, dt);
+            assert!(
+                matches!(
+                    failed,
+                    Err(Error::NonFiniteRow { .. } | Error::Singularity { .. })
+                ),
+                "{fails}: {failed:?}"
+            );
             let (end, taken_again) = next(&mut asked);
-            assert!(taken_again, "{height}");
+            assert!(taken_again, "{fails}");
             let mut never_asked = untouched;
-            assert_eq!(end, next(&mut never_asked).0, "{height}");
+            assert_eq!(end, next(&mut never_asked).0, "{fails}");
         }
         // The rest takes its rows again: what the bits above are compared on.
         assert!(next(&mut untouched).1);

@@ -92,6 +92,14 @@ pub(super) struct Reuse<T: Real, const N: usize, const C: usize> {
     pub(super) at: SVector<T, N>,
 }
 
+/// Where [`Workspace::mobilities`] put each tangent: `slot[i]`, the scratch column of
+/// contact `i`'s; `overflow` where some found none.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Columns<const C: usize> {
+    slot: [Option<usize>; C],
+    overflow: bool,
+}
+
 impl<T: Real, const N: usize, const C: usize> Workspace<T, N, C> {
     /// Nothing filled.
     pub(super) fn empty() -> Self {
@@ -170,10 +178,10 @@ impl<T: Real, const N: usize, const C: usize> Workspace<T, N, C> {
     }
 
     /// After a step that failed before it filled its rows (a gap, Jacobian or tangent not
-    /// finite, more rows in contact than `max_rows`: [`Error::NonFiniteRow`] and
-    /// [`Error::InvalidParameter`]), the record `prior` of the rows the last step left, as
-    /// if the step had never run: the step wrote only the Jacobians and tangents over
-    /// theirs, worked out here again at the record's coordinates by the record's route (the
+    /// finite, more rows in contact than `max_rows`, the mass solve of their mobilities:
+    /// see `Setup::touch`), the record `prior` of the rows the last step left, as if the
+    /// step had never run: the step wrote only the Jacobians and tangents over theirs
+    /// (and the scratch columns), worked out here again at the record's coordinates by the record's route (the
     /// same bits: functions of the coordinates), so that the next step from the rest takes
     /// them again as an untouched stepper's would. Not where `reuse` wrote the mass matrix
     /// (the record would vouch for another's mobilities).
@@ -258,21 +266,22 @@ impl<T: Real, const N: usize, const C: usize> Workspace<T, N, C> {
         Ok(tangents)
     }
 
-    /// The rows of a step at `state`: the normal rows of the Jacobian in `touching`, and the
-    /// tangents (with `tangents`) of the contacts in `frictional`, their mobilities from
-    /// one call of [`Mechanism::velocity_jumps`] where the tangents fit in the columns the
-    /// normal rows leave free (two calls where they do not).
+    /// The mobilities of a step's rows at `state` (the normal rows of the Jacobian in
+    /// `touching`, and the tangents, with `tangents`, of the contacts in `frictional`) from
+    /// one call of [`Mechanism::velocity_jumps`], into the scratch columns alone: each
+    /// normal row in its own column, each tangent in one no normal row uses, where there is
+    /// one ([`Columns`]; the others take a second call in [`Workspace::fill`]).
     ///
     /// # Errors
-    /// The mass solve's; [`Error::NonFiniteState`] when `W` is not finite.
-    pub(super) fn fill<M: Mechanism<T, N>>(
+    /// The mass solve's.
+    pub(super) fn mobilities<M: Mechanism<T, N>>(
         &mut self,
         mechanism: &M,
         state: &State<T, N>,
         tangents: bool,
         touching: &[bool; C],
         frictional: &[bool; C],
-    ) -> Result<(), Error> {
+    ) -> Result<Columns<C>, Error> {
         let jacobian = &self.jacobian;
         let tangents = tangents.then_some(&self.tangents);
         // Normal rows in their own columns; each tangent in a column no normal row uses.
@@ -306,6 +315,27 @@ impl<T: Real, const N: usize, const C: usize> Workspace<T, N, C> {
             }
         }
         mechanism.velocity_jumps(state, &mut self.jumps)?;
+        Ok(Columns { slot, overflow })
+    }
+
+    /// The rows of a step at `state` (as [`Workspace::mobilities`]'s, which it takes
+    /// `columns` from) written over the kept ones: the normal rows' `W`, the tangents'
+    /// directions, and the mobilities of the tangents that found no free column (a second
+    /// call of [`Mechanism::velocity_jumps`]).
+    ///
+    /// # Errors
+    /// The mass solve's; [`Error::NonFiniteState`] when `W` is not finite.
+    pub(super) fn fill<M: Mechanism<T, N>>(
+        &mut self,
+        mechanism: &M,
+        state: &State<T, N>,
+        tangents: bool,
+        touching: &[bool; C],
+        frictional: &[bool; C],
+        Columns { slot, overflow }: Columns<C>,
+    ) -> Result<(), Error> {
+        let jacobian = &self.jacobian;
+        let tangents = tangents.then_some(&self.tangents);
         let jumps = &self.jumps;
         self.normal.rebuild(
             jacobian,

@@ -4,7 +4,7 @@
 
 use super::energy::guard;
 use super::report::ImpulseReport;
-use super::rows::{within, Filled, Measured, Reuse, Workspace};
+use super::rows::{within, Columns, Filled, Measured, Reuse, Workspace};
 use super::settings::ImpulseSettings;
 use super::solve::{Impulses, Problem, Solved};
 use crate::integrator::continues;
@@ -49,6 +49,8 @@ pub(super) struct Memory<T: Real, const N: usize, const C: usize> {
 
 /// What a step found touching at its free step's end ([`Setup::touch`]).
 struct Touch<T: Real, const C: usize> {
+    /// Where the rows are filled anew, the scratch columns of their mobilities.
+    columns: Option<Columns<C>>,
     /// The gaps there.
     gaps: SVector<T, C>,
     /// The rows in contact (gap at most zero) and the bilateral ones.
@@ -267,24 +269,29 @@ impl<T: Real, const C: usize, K> Setup<T, C, K> {
 }
 
 impl<T: Real, const C: usize, K> Setup<T, C, K> {
-    /// The gaps at the free step's coordinates `q` (the rows' taken again, or worked out
-    /// with their Jacobians where `rows_too`), which rows touch, and the Jacobians and
-    /// tangents checked: what a step finds before it fills its rows (it writes the
-    /// workspace's Jacobians and tangents, nothing else); `None` where no row touches.
+    /// The gaps at the free step's end `free` (the rows' taken again, or worked out with
+    /// their Jacobians where `rows_too`), which rows touch, the Jacobians and tangents
+    /// checked and, where the rows are filled anew, their mobilities: what a step finds
+    /// before it fills its rows (it writes the workspace's Jacobians, tangents and scratch
+    /// columns, nothing else); `None` where no row touches.
     ///
     /// # Errors
     /// [`Error::NonFiniteRow`] for a gap, Jacobian or tangent that is not finite,
-    /// [`Error::InvalidParameter`] `max_rows` where more rows touch than it allows.
-    fn touch<const N: usize>(
+    /// [`Error::InvalidParameter`] `max_rows` where more rows touch than it allows; the
+    /// mass solve's.
+    fn touch<M, const N: usize>(
         &self,
         work: &mut Workspace<T, N, C>,
+        mechanism: &M,
         reuse: &Reuse<T, N, C>,
-        q: &SVector<T, N>,
+        free: &State<T, N>,
         rows_too: bool,
     ) -> Result<Option<Touch<T, C>>, Error>
     where
+        M: Mechanism<T, N>,
         K: Contacts<T, N, C>,
     {
+        let q = &free.q;
         let (gaps, given) = match reuse.rows {
             Some((gaps, _)) => (gaps, None),
             None => work.gaps(&self.contacts, q, rows_too)?,
@@ -312,7 +319,12 @@ impl<T: Real, const C: usize, K> Setup<T, C, K> {
             (None, Some(tangents)) => work.checked(tangents && friction, &frictional)?,
             (None, None) => work.jacobians(&self.contacts, q, friction, &frictional)?,
         };
+        let columns = match reuse.rows {
+            Some(_) => None,
+            None => Some(work.mobilities(mechanism, free, tangents, &touching, &frictional)?),
+        };
         Ok(Some(Touch {
+            columns,
             gaps,
             touching,
             frictional,
@@ -352,7 +364,7 @@ impl<T: Real, const C: usize, K> Setup<T, C, K> {
         // fills its own over them.
         let prior = work.filled;
         let reuse = work.reuse(mechanism, &free, rows_too);
-        let touch = match self.touch(work, &reuse, &free.q, rows_too) {
+        let touch = match self.touch(work, mechanism, &reuse, &free, rows_too) {
             Ok(touch) => touch,
             Err(e) => {
                 work.put_back(prior, &reuse, &self.contacts);
@@ -360,6 +372,7 @@ impl<T: Real, const C: usize, K> Setup<T, C, K> {
             }
         };
         let Some(Touch {
+            columns,
             gaps,
             touching,
             frictional,
@@ -371,8 +384,8 @@ impl<T: Real, const C: usize, K> Setup<T, C, K> {
             memory.record(Impulses::zero(), free, T::INFINITY, [false; C], none);
             return Ok(free);
         };
-        if reuse.rows.is_none() {
-            work.fill(mechanism, &free, tangents, &touching, &frictional)?;
+        if let Some(columns) = columns {
+            work.fill(mechanism, &free, tangents, &touching, &frictional, columns)?;
         }
         let Workspace {
             normal,

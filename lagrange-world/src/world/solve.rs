@@ -323,9 +323,9 @@ const NONE: u32 = u32::MAX;
 /// first not yet taken, always ready). A row's impulse waits on its speed, and the next
 /// row's speed on that impulse where they share a body: rows of other bodies one after
 /// another let a processor work on several at once (a pyramid of 55 boxes: 78 -> 70 us a
-/// step; ten ragdolls in a pile: 0.137 -> 0.114 ms). Twins (see `twins`) go one right after
-/// the other, taken as one. Rows of bodies apart commute, so this
-/// order gives the keys' order's bits: a sweep is the same Gauss-Seidel sweep, only faster.
+/// step; ten ragdolls in a pile: 0.137 -> 0.114 ms). Twins (see `twins`) go one right
+/// after the other, taken as one. Rows of bodies apart commute, so this order gives the
+/// keys' order's bits: a sweep is the same Gauss-Seidel sweep, only faster.
 /// (Orders that do not keep each body's rows in the keys' order go faster still, 59 us,
 /// but change the solve: by rounds of disjoint contacts, or pairs taken ahead, a pyramid's
 /// top crept twice as far in 10 s and a ragdoll pile sank 64 mm where it sinks 31.)
