@@ -844,6 +844,7 @@ const AREAS: [Area; 29] = [
             "lagrange-world/src/world/detect.rs",
             "lagrange-world/src/world/islands.rs",
             "lagrange-world/src/world/limits.rs",
+            "lagrange-world/src/world/lists.rs",
             "lagrange-world/src/world/locks.rs",
             "lagrange-world/src/world/merge.rs",
             "lagrange-world/src/world/mobilities.rs",

@@ -6,6 +6,7 @@ mod bodies;
 mod detect;
 mod islands;
 mod limits;
+mod lists;
 mod locks;
 mod merge;
 mod mobilities;

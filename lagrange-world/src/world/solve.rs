@@ -3,6 +3,7 @@
 //! ([`Order`]), in the bodies' generalized velocities, and the same over pseudo-velocities
 //! for the drift.
 
+use super::lists::{BodyLists, NONE};
 use super::locks::Locks;
 use super::rows::{Contact, Part, Phase, Row};
 use super::twins;
@@ -314,9 +315,6 @@ const AHEAD: usize = 32;
 /// How many of the contacts just taken the next one should share no body with.
 const APART: usize = 2;
 
-/// No contact.
-const NONE: u32 = u32::MAX;
-
 /// The order the sweeps take the contacts in: the keys' order, but each next contact the
 /// first of the next [`AHEAD`] not yet taken that is ready (every contact before it that
 /// shares a body with it taken) and shares no body with the [`APART`] taken last (else the
@@ -394,56 +392,6 @@ impl<const K: usize> Ordered<K> {
             }
         }
         &self.order
-    }
-}
-
-/// Each body's contacts as a list, in the keys' order: `front[body]` its first, then
-/// `after[side][c]` the one after contact `c` on its side `side`'s body ([`NONE`]: no more).
-pub(crate) struct BodyLists<const B: usize, const K: usize> {
-    pub(crate) front: [u32; B],
-    pub(crate) after: [[u32; K]; 2],
-}
-
-impl<const B: usize, const K: usize> BodyLists<B, K> {
-    /// The lists of `contacts` (built from the last back).
-    pub(crate) fn of<T: Real, const N: usize>(contacts: &[Contact<T, N>]) -> Self {
-        let mut front = [NONE; B];
-        let mut after = [[NONE; K]; 2];
-        for (c, contact) in contacts.iter().enumerate().rev() {
-            for (side, body) in contact.bodies.iter().enumerate() {
-                let (Some(head), Some(next)) = (
-                    body.and_then(|b| front.get_mut(b)),
-                    after.get_mut(side).and_then(|a| a.get_mut(c)),
-                ) else {
-                    continue;
-                };
-                *next = *head;
-                *head = u32::try_from(c).unwrap_or(NONE);
-            }
-        }
-        Self { front, after }
-    }
-
-    /// The contacts of `body` (at most `K`: a contact of a body with itself is on its
-    /// first side's list once, and twice on the second's, which this does not walk).
-    pub(crate) fn contacts_of<'a, T: Real, const N: usize>(
-        &'a self,
-        contacts: &'a [Contact<T, N>],
-        body: usize,
-    ) -> impl Iterator<Item = &'a Contact<T, N>> + 'a {
-        let mut at = self.front.get(body).copied().unwrap_or(NONE);
-        core::iter::from_fn(move || {
-            let c = contacts.get(at as usize)?;
-            let side = usize::from(c.bodies[0] != Some(body));
-            at = self
-                .after
-                .get(side)
-                .and_then(|a| a.get(at as usize))
-                .copied()
-                .unwrap_or(NONE);
-            Some(c)
-        })
-        .take(K)
     }
 }
 

@@ -11,8 +11,8 @@
 //! which lowers it at least as much as two updates one after the other, so that a sweep
 //! of them never raises the kinetic energy either.
 
+use super::lists::BodyLists;
 use super::rows::{Contact, Part, Phase};
-use super::solve::BodyLists;
 use super::OWN_ROWS;
 use crate::vec2::{dot, scale};
 use lagrange_core::nalgebra::SVector;
