@@ -375,15 +375,16 @@ type Placing = (f64, fn(u32) -> f64, fn(u32) -> f64);
 /// A column of `n` boxes of side `size` (density 1 kg/m^2) in the stacking tests' settings
 /// with `sweeps` sweeps, each `lift` of its side above the one below (the bottom one above
 /// the floor), moved across by `across(k)` of its side and turned by `turn(k)` rad; for
-/// `seconds` at 60 Hz. How far the top box's centre went across, m, and the largest turn
-/// of any box at the end, rad.
+/// `seconds` at 60 Hz. How far the top box's centre went across, m, the largest turn of
+/// any box at the end, rad, and the steps after the first second that the energy guard
+/// took again.
 fn column_stands<T: Real>(
     n: u32,
     size: f64,
     sweeps: u32,
     (lift, across, turn): Placing,
     seconds: f64,
-) -> Result<(f64, f64), Error> {
+) -> Result<(f64, f64, u32), Error> {
     let settings = WorldSettings::new(stacking::<T>()?.model(), T::from_f64(SLOP), sweeps)?;
     let mut world = Box::new(Bodies::<T>::new(settings));
     world.add_plane(10_000, HalfPlane::floor())?;
@@ -401,8 +402,10 @@ fn column_stands<T: Real>(
         world.add_shape(1000 + key, key, 0, Shape::rectangle(side, side)?)?;
     }
     let x0 = across(n - 1) * size;
-    for _ in 0..(seconds * 60.0) as usize {
-        world.step(T::from_f64(1.0 / 60.0))?;
+    let mut guarded = 0;
+    for step in 0..(seconds * 60.0) as usize {
+        let report = world.step(T::from_f64(1.0 / 60.0))?;
+        guarded += u32::from(report.guarded && step >= 60);
     }
     let states: std::vec::Vec<_> = (0..n).filter_map(|k| world.state(k)).collect();
     let turned = states
@@ -410,34 +413,54 @@ fn column_stands<T: Real>(
         .map(|s| s.q[2].to_f64().abs())
         .fold(0.0, f64::max);
     let top = states.last().map_or(f64::NAN, |s| s.q[0].to_f64() - x0);
-    Ok((top.abs(), turned))
+    Ok((top.abs(), turned, guarded))
 }
 
-/// Columns stand. Placed true, ten 1 m boxes and twenty 10 cm ones with the stacking
-/// tests' 8 sweeps stay where they were put for 20 s (to a micrometre and a microradian:
+/// Columns stand, with the stacking tests' 8 sweeps. Placed true, ten 1 m boxes and twenty
+/// 10 cm ones stay where they were put for 20 s (to a micrometre and a microradian:
 /// measured not to move at all; solved a corner at a time, the corner taken first took
 /// more of the weight, every box turned a little each step and both columns fell within
-/// 20 s). Placed by hand (each box up to 5 mm across and 5 mrad turned from true, 1 cm
-/// above the one below), ten 1 m boxes drop into place and stand with 12 sweeps: the top
-/// box within 3 cm of where it started and no box turned past 10 mrad after 10 s (0.2 and
-/// 1.2 mm, 1.2 and 6.8 mrad measured in f64 and f32; with 8 sweeps it falls).
+/// 20 s); the ten settle: the energy guard takes no step again after the first second (it
+/// took one in ten, each time from zero impulses, and the column sank by 6 cm and rose
+/// again every tenth step). (The twenty do not settle at 8 sweeps: the guard takes one
+/// step in sixteen again, each time scaling the impulses back to about 0.4, and the column
+/// rests 13 cm low, 6.5 mm a contact; 16 sweeps settle it.) Placed by hand (each box up to 5 mm across and 5 mrad turned
+/// from true, 1 or 2 cm above the one below; three placings), ten 1 m boxes drop into
+/// place and stand for 10 s: the top box within 10 cm of where it started and no box
+/// turned past 0.05 rad (measured at most 37 mm and 9.1 mrad in f64 and f32; a column that
+/// falls moves metres and turns by radians, and each of these fell before the guard
+/// scaled its impulses back rather than dropping them: its top moved 0.34 to 10 m).
 fn columns_stand<T: Real>() -> Result<(), Error> {
     let none: Placing = (0.0, |_| 0.0, |_| 0.0);
-    for (n, size) in [(10, 1.0), (20, 0.1)] {
-        let (moved, turned) = column_stands::<T>(n, size, 8, none, 20.0)?;
+    for (n, size, settles) in [(10, 1.0, true), (20, 0.1, false)] {
+        let (moved, turned, guarded) = column_stands::<T>(n, size, 8, none, 20.0)?;
         assert!(
-            moved < 1e-6 && turned < 1e-6,
-            "{n} of {size} m: {moved} m, {turned} rad"
+            moved < 1e-6 && turned < 1e-6 && (guarded == 0 || !settles),
+            "{n} of {size} m: {moved} m, {turned} rad, guarded {guarded}"
         );
     }
-    let by_hand: Placing = (
-        0.01,
-        |k| 0.005 * (2.3 * f64::from(k)).sin(),
-        |k| 0.005 * (1.7 * f64::from(k)).cos(),
-    );
-    let (moved, turned) = column_stands::<T>(10, 1.0, 12, by_hand, 10.0)?;
-    println!("by hand: top moved {moved} m, turned {turned} rad");
-    assert!(moved < 0.03 && turned < 0.01, "{moved} m, {turned} rad");
+    let by_hand: [Placing; 3] = [
+        (
+            0.01,
+            |k| 0.005 * (2.3 * f64::from(k)).sin(),
+            |k| 0.005 * (1.7 * f64::from(k)).cos(),
+        ),
+        (
+            0.02,
+            |k| 0.005 * (3.1 * f64::from(k)).sin(),
+            |k| -0.005 * (2.9 * f64::from(k)).cos(),
+        ),
+        (
+            0.01,
+            |k| if k % 2 == 0 { 0.005 } else { -0.005 },
+            |k| if k % 3 == 0 { 0.005 } else { -0.005 },
+        ),
+    ];
+    for (i, placing) in by_hand.into_iter().enumerate() {
+        let (moved, turned, _) = column_stands::<T>(10, 1.0, 8, placing, 10.0)?;
+        println!("by hand {i}: top moved {moved} m, turned {turned} rad");
+        assert!(moved < 0.1 && turned < 0.05, "{i}: {moved} m, {turned} rad");
+    }
     Ok(())
 }
 
