@@ -96,9 +96,8 @@ pub(crate) fn mark<T: Real, const N: usize, const B: usize, const K: usize>(
     }
     let lists = BodyLists::<B, K>::of(contacts);
     let mut i = 0;
-    while i < contacts.len() {
-        let w = candidate(contacts, i)
-            .filter(|_| contacts.get(i).is_some_and(|c| alone(contacts, &lists, c)));
+    while let Some(c) = contacts.get(i) {
+        let w = candidate(contacts, i).filter(|_| alone(contacts, &lists, c));
         if let Some(c) = contacts.get_mut(i) {
             c.twin = w;
         }
