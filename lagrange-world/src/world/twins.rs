@@ -109,31 +109,34 @@ pub(crate) fn mark<T: Real, const N: usize, const B: usize, const K: usize>(
 /// speeds `r + W x` (`r`: the speeds over their targets with no impulse) at or above zero,
 /// and zero where an impulse pushes (the complementarity problem of the pair, whose
 /// solution is the minimum of its program over `x >= 0`): of the four ways the rows can
-/// push, the first that holds; `None` where rounding leaves none (the caller then updates
-/// the rows one after the other).
-fn pair_lcp<T: Real>([w11, w12, w22]: [T; 3], [r1, r2]: [T; 2]) -> Option<[T; 2]> {
+/// push, the first that holds. Where rounding leaves none (a solution on the border of two
+/// ways, where they meet), both rows' solution with its negative part dropped: within
+/// rounding of either.
+fn pair_lcp<T: Real>([w11, w12, w22]: [T; 3], [r1, r2]: [T; 2]) -> [T; 2] {
     let zero = T::zero();
+    if r1 >= zero && r2 >= zero {
+        return [zero, zero];
+    }
     let det = w11 * w22 - w12 * w12;
     let both = [(w12 * r2 - w22 * r1) / det, (w12 * r1 - w11 * r2) / det];
     if both[0] >= zero && both[1] >= zero {
-        return Some(both);
+        return both;
     }
     let first = -r1 / w11;
     if first >= zero && w12 * first + r2 >= zero {
-        return Some([first, zero]);
+        return [first, zero];
     }
     let second = -r2 / w22;
     if second >= zero && w12 * second + r1 >= zero {
-        return Some([zero, second]);
+        return [zero, second];
     }
-    (r1 >= zero && r2 >= zero).then_some([zero, zero])
+    both.map(|x| x.max(zero))
 }
 
 /// Twins `i` and `i + 1` (contact `i`'s [`Contact::twin`] is their `W`) in the phase
-/// `DRIFT` says: both normal rows at once ([`pair_lcp`]; where rounding leaves it no
-/// solution, one after the other), then in the velocities' phase each tangent, within
+/// `DRIFT` says: both normal rows at once ([`pair_lcp`]), then each tangent within
 /// `friction` times its normal's new impulse (so that the cone holds as the update leaves
-/// it), on a copy of the two bodies' velocities written back once. Whether they were
+/// it; the caller passes zero in the drift, which moves along the normals alone), on a copy of the two bodies' velocities written back once. Whether they were
 /// twins.
 #[inline(always)]
 pub(crate) fn twins<T: Real, const N: usize, const DRIFT: bool>(
@@ -161,16 +164,7 @@ pub(crate) fn twins<T: Real, const N: usize, const DRIFT: bool>(
         speeds[1] - (w12 * old[0] + w22 * old[1]),
     ];
     let x = pair_lcp(w, r);
-    for (k, (c, old)) in [&mut *a, &mut *b].into_iter().zip(old).enumerate() {
-        // Where rounding left the pair no solution, one row after the other.
-        let next = match x {
-            Some(x) => x[k],
-            None => {
-                let residual = c.normal.speed([near[0].as_ref(), near[1].as_ref()])
-                    - phase.target(c, Part::Normal);
-                (old - residual * c.normal.inverse).max(T::zero())
-            }
-        };
+    for ((c, old), next) in [&mut *a, &mut *b].into_iter().zip(old).zip(x) {
         for (v, b) in near.iter_mut().zip(&c.normal.b) {
             if let Some(v) = v {
                 *v += b * (next - old);
@@ -178,7 +172,7 @@ pub(crate) fn twins<T: Real, const N: usize, const DRIFT: bool>(
         }
         *phase.impulse(c, Part::Normal) = next;
     }
-    if !DRIFT && friction > T::zero() {
+    if friction > T::zero() {
         for c in [&mut *a, &mut *b] {
             if c.tangent.inverse > T::zero() {
                 let bound = friction * c.normal.lambda;
@@ -206,7 +200,7 @@ pub(crate) fn twins<T: Real, const N: usize, const DRIFT: bool>(
 mod tests {
     use super::{mark, pair_lcp, twin_w};
     use crate::world::locks::Locks;
-    use crate::world::rows::{Contact, Phase, Row};
+    use crate::world::rows::{Contact, Part, Phase, Row};
     use crate::world::solve::{sweep, tests::draws};
     use lagrange_core::nalgebra::SVector;
 
@@ -263,7 +257,7 @@ mod tests {
             }
             tried += 1;
             let r = [4.0 * draw(), 4.0 * draw()];
-            let x = pair_lcp(w, r).unwrap_or_else(|| unreachable!("{w:?} {r:?}"));
+            let x = pair_lcp(w, r);
             let s = [
                 r[0] + w[0] * x[0] + w[1] * x[1],
                 r[1] + w[1] * x[0] + w[2] * x[1],
@@ -430,5 +424,61 @@ mod tests {
         // Most random pairs share a body another pushes the same way (no twins): 592 of
         // the 5,200 points are twins'.
         assert!(twins > 400, "{twins}");
+    }
+
+    /// The drift's sweeps move the bodies along the normals alone: over random twins (as
+    /// above, friction 0.4, tangent impulses drawn within the cone, pseudo-velocities drawn
+    /// closing), no tangent impulse changes, bit for bit, and some normal's drift impulse
+    /// does (the sweeps ran).
+    #[test]
+    fn twins_in_the_drift_keep_their_tangents() {
+        let mut draw = draws(0x0d71_f700_2026_1202);
+        let mut moved = 0;
+        for round in 0..100 {
+            let mut contacts: heapless::Vec<Contact<f64, 2>, 32> = heapless::Vec::new();
+            for pair in 0..1 + round % 12 {
+                let body = |x: f64| ((x + 0.5) * 4.0) as usize;
+                let (a, b) = (body(draw()), body(draw()));
+                let bodies = if a == b {
+                    [None, Some(b)]
+                } else {
+                    [Some(a), Some(b)]
+                };
+                for id in 0..2 {
+                    let mut c = point((pair, 100 + pair), id, bodies, [0.0, 1.0], &mut draw);
+                    c.normal.lambda = draw() + 0.5;
+                    c.tangent.lambda = 0.8 * draw() * c.normal.lambda;
+                    assert!(contacts.push(c).is_ok());
+                }
+            }
+            mark::<f64, 2, 4, 32>(&mut contacts);
+            let tangents: heapless::Vec<u64, 32> = contacts
+                .iter()
+                .map(|c| c.tangent.lambda.to_bits())
+                .collect();
+            let order: heapless::Vec<u32, 32> = (0..contacts.len() as u32).collect();
+            let mut pseudo = [0; 4].map(|_| SVector::<f64, 2>::new(draw(), -4.0 * draw().abs()));
+            let locks = Locks::<f64, 4>::new();
+            sweep(
+                &mut pseudo,
+                &mut contacts,
+                &locks,
+                &order,
+                0.4,
+                4,
+                Phase::Drift,
+                true,
+            );
+            let after: heapless::Vec<u64, 32> = contacts
+                .iter()
+                .map(|c| c.tangent.lambda.to_bits())
+                .collect();
+            assert_eq!(tangents, after, "round {round}");
+            moved += contacts
+                .iter()
+                .filter(|c| Phase::Drift.impulse_of(c, Part::Normal) != 0.0)
+                .count();
+        }
+        assert!(moved > 100, "{moved}");
     }
 }
