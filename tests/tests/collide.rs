@@ -384,6 +384,8 @@ fn resting_faces_keep_their_ids<T: Real>() -> Result<(), Error> {
     };
     let flat = ids(0.0);
     assert_eq!(flat.len(), 2, "{flat:?}");
+    // The first shape's face is the reference: the ids' flag of the second's (bit 24) clear.
+    assert!(flat.iter().all(|id| id >> 24 == 0), "{flat:x?}");
     for angle in [1e-7, -1e-7, 1e-5, -1e-5, 3e-4, -3e-4] {
         assert_eq!(ids(angle), flat, "tipped by {angle}");
     }
