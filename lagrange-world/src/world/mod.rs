@@ -768,17 +768,24 @@ where
         // tripped the guard as its weight came down through it, every tenth step; solved
         // again from zero impulses, it dropped most of its weight each time and sank and
         // leaned further each cycle: it fell within 10 s at 8 sweeps. Scaled back, it trips
-        // the guard once and stands.
-        let mut kept = false;
+        // the guard once and stands. Where that still adds energy (or the least is at
+        // zero), from zero impulses. Either way without rebounds, and by plain updates, no
+        // rows locked: each lowers the program (from zero impulses, its value is the
+        // kinetic energy's change).
         if guarded {
-            let scale = self.least_along(&free, &v);
-            if scale > T::zero() {
+            for scale in [self.least_along(&free, &v), T::zero()] {
+                let back = scale > T::zero();
                 for (v, free) in v.iter_mut().zip(&free) {
-                    *v = free + (*v - free) * scale;
+                    *v = if back {
+                        free + (*v - free) * scale
+                    } else {
+                        *free
+                    };
                 }
                 for c in self.contacts.iter_mut() {
-                    c.normal.lambda *= scale;
-                    c.tangent.lambda *= scale;
+                    for row in [&mut c.normal, &mut c.tangent] {
+                        row.lambda = if back { row.lambda * scale } else { T::zero() };
+                    }
                     c.lower = c.lower.min(T::zero());
                 }
                 sweep(
@@ -789,27 +796,10 @@ where
                     solve,
                     (rows::Phase::Velocity, false),
                 );
-                kept = !added(self.kinetic(&v));
+                if !back || !added(self.kinetic(&v)) {
+                    break;
+                }
             }
-        }
-        // Else from zero impulses, without rebounds.
-        if guarded && !kept {
-            v = free;
-            for c in self.contacts.iter_mut() {
-                c.normal.lambda = T::zero();
-                c.tangent.lambda = T::zero();
-                c.lower = c.lower.min(T::zero());
-            }
-            // Plain updates, no rows locked: each lowers the program, whose value from
-            // zero impulses is the kinetic energy's change.
-            sweep(
-                &mut v,
-                &mut self.contacts,
-                &self.locks,
-                order,
-                solve,
-                (rows::Phase::Velocity, false),
-            );
         }
         self.set_velocities(&v);
         guarded

@@ -240,6 +240,29 @@ mod tests {
         }
     }
 
+    /// `count` pairs of points, each pair of one pair of shapes, between two of 4 bodies
+    /// (or one and static geometry), pushing up, their rows drawn from `draw`.
+    fn random_pairs(
+        count: u32,
+        draw: &mut impl FnMut() -> f64,
+    ) -> heapless::Vec<Contact<f64, 2>, 32> {
+        let mut contacts = heapless::Vec::new();
+        for pair in 0..count {
+            let body = |x: f64| ((x + 0.5) * 4.0) as usize;
+            let (a, b) = (body(draw()), body(draw()));
+            let bodies = if a == b {
+                [None, Some(b)]
+            } else {
+                [Some(a), Some(b)]
+            };
+            for id in 0..2 {
+                let c = point((pair, 100 + pair), id, bodies, [0.0, 1.0], draw);
+                assert!(contacts.push(c).is_ok());
+            }
+        }
+        contacts
+    }
+
     /// The pair's complementarity problem solved: over 10,000 random positive definite `W`
     /// (condition below 1000) and speeds `r` (half of them on a border between two ways the
     /// rows can push, where rounding can fail the tests of both), the impulses push only
@@ -392,21 +415,7 @@ mod tests {
         let mut twins = 0;
         for round in 0..400 {
             let friction = if round % 2 == 0 { 0.0 } else { 0.4 };
-            let mut contacts: heapless::Vec<Contact<f64, 2>, 32> = heapless::Vec::new();
-            for pair in 0..1 + round % 12 {
-                let body = |x: f64| ((x + 0.5) * 4.0) as usize;
-                let (a, b) = (body(draw()), body(draw()));
-                let bodies = if a == b {
-                    [None, Some(b)]
-                } else {
-                    [Some(a), Some(b)]
-                };
-                let shapes = (pair, 100 + pair);
-                for id in 0..2 {
-                    let c = point(shapes, id, bodies, [0.0, 1.0], &mut draw);
-                    assert!(contacts.push(c).is_ok());
-                }
-            }
+            let mut contacts = random_pairs(1 + round % 12, &mut draw);
             mark::<f64, 2, 4, 32>(&mut contacts);
             let order: heapless::Vec<u32, 32> = (0..contacts.len() as u32).collect();
             let mut v = [0; 4].map(|_| SVector::<f64, 2>::new(4.0 * draw(), 4.0 * draw()));
@@ -453,21 +462,10 @@ mod tests {
         let mut draw = draws(0x0d71_f700_2026_1202);
         let mut moved = 0;
         for round in 0..100 {
-            let mut contacts: heapless::Vec<Contact<f64, 2>, 32> = heapless::Vec::new();
-            for pair in 0..1 + round % 12 {
-                let body = |x: f64| ((x + 0.5) * 4.0) as usize;
-                let (a, b) = (body(draw()), body(draw()));
-                let bodies = if a == b {
-                    [None, Some(b)]
-                } else {
-                    [Some(a), Some(b)]
-                };
-                for id in 0..2 {
-                    let mut c = point((pair, 100 + pair), id, bodies, [0.0, 1.0], &mut draw);
-                    c.normal.lambda = draw() + 0.5;
-                    c.tangent.lambda = 0.8 * draw() * c.normal.lambda;
-                    assert!(contacts.push(c).is_ok());
-                }
+            let mut contacts = random_pairs(1 + round % 12, &mut draw);
+            for c in contacts.iter_mut() {
+                c.normal.lambda = draw() + 0.5;
+                c.tangent.lambda = 0.8 * draw() * c.normal.lambda;
             }
             mark::<f64, 2, 4, 32>(&mut contacts);
             let tangents: heapless::Vec<u64, 32> = contacts
