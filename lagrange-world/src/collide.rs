@@ -91,6 +91,12 @@ pub fn collide<T: Real>(a: &Shape<T>, b: &Shape<T>, margin: T) -> Manifold<T> {
     one_point(a, b, normal, [pa, pb], d - radii, margin)
 }
 
+/// How far apart the surfaces of `a` and `b` are (negative: overlapping by up to their
+/// radii), or `None` where their cores overlap.
+pub(crate) fn separation<T: Real>(a: &Shape<T>, b: &Shape<T>) -> Option<T> {
+    core_distance(a, b).map(|(_, _, d)| d - (a.radius() + b.radius()))
+}
+
 /// A static half-plane: the points `x` with `normal . x >= offset` are free; the others are
 /// inside it (the floor: normal `(0, 1)`, offset 0).
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -55,6 +55,7 @@ mod plane_contacts;
 mod query;
 mod shape;
 mod shape_pairs;
+mod sweep;
 mod vec2;
 mod world;
 

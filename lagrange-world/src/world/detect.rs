@@ -8,8 +8,8 @@ use super::rows::{Contact, Row};
 use super::{World, OWN_ROWS};
 use crate::broad::Proxy;
 use crate::collide::{collide, half_plane_points};
-use crate::manifold::ContactPoint;
-use crate::vec2::Vec2;
+use crate::sweep::{swept, touches, Touch};
+use crate::vec2::{add, scale, Vec2};
 use heapless::Vec;
 use lagrange_core::links::{Links, Pose};
 use lagrange_core::nalgebra::{SMatrix, SVector};
@@ -127,8 +127,20 @@ where
             let (Some(pa), Some(pb)) = (self.places.get(ia), self.places.get(ib)) else {
                 continue;
             };
-            let m = collide(&pa.shape, &pb.shape, margin + pa.reach + pb.reach);
-            if m.points().is_empty() {
+            let (Some(sa), Some(sb)) = (self.shapes.get(ia), self.shapes.get(ib)) else {
+                continue;
+            };
+            // Moving farther than the thinner is half thick, they may pass the features
+            // closest now: they touch where they first meet (see `sweep`).
+            let fast = pa.reach + pb.reach > sa.half_width.min(sb.half_width);
+            let met = fast
+                .then(|| swept(&pa.moving(&sa.shape), &pb.moving(&sb.shape), margin))
+                .flatten();
+            let (normal, touches) = met.unwrap_or_else(|| {
+                let m = collide(&pa.shape, &pb.shape, margin + pa.reach + pb.reach);
+                (m.normal, touches(&m))
+            });
+            if touches.is_empty() {
                 continue;
             }
             let (Some(a), Some(b)) = (self.side(ia), self.side(ib)) else {
@@ -142,8 +154,8 @@ where
                 woken += self.wake_island(i, dt)?;
                 continue;
             }
-            for p in m.points() {
-                self.push(a, b, m.normal, p, dt)?;
+            for p in &touches {
+                self.push(a, b, normal, p, dt)?;
             }
         }
         for pi in 0..self.planes.len() {
@@ -171,7 +183,7 @@ where
                     pose: s.pose,
                 };
                 for p in &points {
-                    self.push(wall, s, plane.normal(), p, dt)?;
+                    self.push(wall, s, plane.normal(), &Touch::from(p), dt)?;
                 }
             }
         }
@@ -295,21 +307,22 @@ where
         a: Side<T>,
         b: Side<T>,
         n: Vec2<T>,
-        p: &ContactPoint<T>,
+        p: &Touch<T>,
         dt: T,
     ) -> Result<(), Error> {
         let t = [-n[1], n[0]];
         let zero = SVector::<T, N>::zeros();
         let (mut jn, mut jt) = ([zero; 2], [zero; 2]);
         let mut approach = T::zero();
-        for (s, (side, sign)) in [(a, -T::one()), (b, T::one())].into_iter().enumerate() {
+        let sides = [(a, -T::one()), (b, T::one())].into_iter().zip(p.ends);
+        for (s, ((side, sign), end)) in sides.enumerate() {
             let Some((body, link)) = side.on.and_then(|(i, l)| Some((self.bodies.get(i)?, l)))
             else {
                 continue;
             };
             let j = body
                 .mechanism
-                .jacobian_at(&body.state.q, link, &side.pose, p.point);
+                .jacobian_at(&body.state.q, link, &side.pose, end);
             let along = |d: Vec2<T>| {
                 SVector::<T, N>::from_fn(|k, _| sign * (d[0] * j[(0, k)] + d[1] * j[(1, k)]))
             };
@@ -333,7 +346,7 @@ where
                 approach,
                 drift: T::zero(),
                 reach: T::zero(),
-                point: p.point,
+                point: scale(add(p.ends[0], p.ends[1]), T::HALF),
                 direction: n,
                 twin: None,
             })

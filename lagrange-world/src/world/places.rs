@@ -10,6 +10,7 @@
 
 use super::bodies::{Attached, Body};
 use crate::shape::Shape;
+use crate::sweep::Moving;
 use crate::vec2::{length, sub};
 use heapless::Vec;
 use lagrange_core::links::{Links, Pose};
@@ -23,10 +24,26 @@ pub(crate) struct Place<T> {
     pub(crate) shape: Shape<T>,
     /// Its link's pose (the world's frame for a static shape).
     pub(crate) pose: Pose<T>,
+    /// Its link's pose at the step's end where its velocity takes it (`pose` for a static
+    /// or sleeping shape).
+    pub(crate) then: Pose<T>,
     /// How far any point of it moves in the step at its body's velocity (zero for a static
     /// or sleeping one): its link's origin's move and its turn times its reach from that
     /// origin.
     pub(crate) reach: T,
+}
+
+impl<T: Real> Place<T> {
+    /// Its shape moving through the step, `shape` the shape in its link's frame (in the
+    /// world's for a static one).
+    pub(crate) fn moving<'a>(&self, shape: &'a Shape<T>) -> Moving<'a, T> {
+        Moving {
+            shape,
+            from: self.pose,
+            to: self.then,
+            reach: self.reach,
+        }
+    }
 }
 
 /// Links posed by one call of [`Links::poses`]; a link past them is posed on its own.
@@ -114,6 +131,7 @@ pub(crate) fn place<T, M, L, const N: usize, const B: usize, const S: usize>(
         let _ = places.push(Place {
             shape: s.shape,
             pose: identity(),
+            then: identity(),
             reach: T::zero(),
         });
     }
@@ -146,6 +164,7 @@ pub(crate) fn place<T, M, L, const N: usize, const B: usize, const S: usize>(
             *place = Place {
                 shape: s.shape.placed(&pose),
                 pose,
+                then: ahead.as_ref().map_or(pose, |then| then.link(body, link)),
                 reach,
             };
         }
