@@ -9,7 +9,7 @@ use super::{World, OWN_ROWS};
 use crate::broad::Proxy;
 use crate::collide::{collide, half_plane_points};
 use crate::sweep::{swept, touches, Touch};
-use crate::vec2::{add, scale, Vec2};
+use crate::vec2::Vec2;
 use heapless::Vec;
 use lagrange_core::links::{Links, Pose};
 use lagrange_core::nalgebra::{SMatrix, SVector};
@@ -346,7 +346,7 @@ where
                 approach,
                 drift: T::zero(),
                 reach: T::zero(),
-                point: scale(add(p.ends[0], p.ends[1]), T::HALF),
+                point: p.at,
                 direction: n,
                 twin: None,
             })

@@ -110,8 +110,8 @@ pub struct ContactEvent<T> {
     /// How fast the two closed at its points when it began, the fastest (m/s, or the
     /// rows' unit): what a game plays a sound by; zero when it ended.
     pub speed: T,
-    /// Where, world coordinates (the first contact point of the pair; the origin when it
-    /// ended).
+    /// Where, world coordinates (the first contact point of the pair; for a pair met later
+    /// in the step, where they meet; the origin when it ended).
     pub point: Vec2<T>,
     /// The unit normal there, from the first shape to the second.
     pub normal: Vec2<T>,
@@ -150,7 +150,10 @@ pub struct WorldHit<T> {
 /// ```text
 /// 1. free       v* = v + dt a(q, v)                          each awake body's own law
 /// 2. detect     contacts at q: broad phase, narrow phase     rows J (normal, tangent) at q
-///               within the margin (plus how far a body moves), mobilities M^-1 J^T
+///               within the margin (plus how far a body moves), mobilities M^-1 J^T;
+///               a pair moving farther than the thinner of them is half thick: at the
+///               features where their paths first bring them within the margin
+///               (conservative advancement), or where they come closest
 /// 3. solve      impulses by projected Gauss-Seidel, `sweeps` sweeps over the contacts in
 ///               their keys' order, warm-started from the last step's: each tangent within
 ///               mu times its normal impulse, each normal row to J v >= lower:
@@ -174,7 +177,10 @@ pub struct WorldHit<T> {
 /// The rows are taken at the step's start, so an impulse acts on both bodies at the same
 /// point, equal and opposite: linear and angular momentum are kept to rounding through
 /// every contact's impulses (no other scheme of the library's keeps them through friction
-/// off the centre); the drift correction, which moves positions alone, keeps the linear
+/// off the centre). A pair met later in the step is pushed at the start, each body at the
+/// point of it that will touch: the two points are apart by the pair's move to the meeting,
+/// and the angular momentum moves by the impulse times that lever (the linear is kept); the
+/// drift correction, which moves positions alone, keeps the linear
 /// momentum but moves the angular momentum of bodies that slide across the contact it
 /// corrects. The scheme is first order; between contacts each body moves by semi-implicit
 /// Euler, whose energy error stays bounded. Impulses never add kinetic energy: where the
@@ -185,7 +191,8 @@ pub struct WorldHit<T> {
 ///
 /// **Cost.** Detection: each awake body's links posed twice (where they are and where the
 /// step takes them: [`Links::poses`]), the broad phase's sweep and prune over the shapes, one
-/// narrow phase a pair that may touch; then per contact point its rows' Jacobians, and
+/// narrow phase a pair that may touch (a pair moving farther than the thinner is half thick:
+/// up to 24 distances of their cores on the way, two to five where they strike head-on); then per contact point its rows' Jacobians, and
 /// their mobilities from each body's mass solve, eight contact points of a body to a call
 /// of [`Mechanism::velocity_jumps`] (one factorisation of a ragdoll's mass matrix for
 /// them; a constant mass matrix: a multiply a row). The solve: `sweeps` passes over the

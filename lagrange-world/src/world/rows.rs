@@ -110,7 +110,8 @@ pub(crate) struct Contact<T: Real, const N: usize> {
     pub(crate) drift: T,
     /// The drift correction's lowest pseudo-speed (see `solve::drift`).
     pub(crate) reach: T,
-    /// Where it is and the normal, world coordinates (for events and queries).
+    /// Where it is (met later in the step: where they meet) and the normal, world
+    /// coordinates (for events and queries).
     pub(crate) point: Vec2<T>,
     pub(crate) direction: Vec2<T>,
     /// On the first of twins (the two points of one manifold: see `twins`), `W` of their
