@@ -1,14 +1,15 @@
 //! Step 2 of a [`World`]'s step: where its shapes touch or may touch in the step, as contact
 //! rows in the bodies' coordinates; sleeping bodies an awake one touches are woken.
 
+use super::bodies::Attached;
 use super::limits::{Limits, MAX_OWN_ROWS};
-use super::places;
+use super::places::{self, Place};
 use super::profile::{Profile, Stopwatch};
 use super::rows::{Contact, Row};
 use super::{World, OWN_ROWS};
 use crate::broad::Proxy;
 use crate::collide::{collide, half_plane_points};
-use crate::sweep::{swept, touches, Touch};
+use crate::sweep::{closing, swept, touches, Touch};
 use crate::vec2::Vec2;
 use heapless::Vec;
 use lagrange_core::links::{Links, Pose};
@@ -130,14 +131,10 @@ where
             let (Some(sa), Some(sb)) = (self.shapes.get(ia), self.shapes.get(ib)) else {
                 continue;
             };
-            // Moving farther than the thinner is half thick, they may pass the features
-            // closest now: they touch where they first meet (see `sweep`).
-            let fast = pa.reach + pb.reach > sa.half_width.min(sb.half_width);
-            let met = fast
-                .then(|| swept(&pa.moving(&sa.shape), &pb.moving(&sb.shape), margin))
-                .flatten();
+            let cover = margin + pa.reach + pb.reach;
+            let met = fast_pair((sa, pa), (sb, pb), margin, cover);
             let (normal, touches) = met.unwrap_or_else(|| {
-                let m = collide(&pa.shape, &pb.shape, margin + pa.reach + pb.reach);
+                let m = collide(&pa.shape, &pb.shape, cover);
                 (m.normal, touches(&m))
             });
             if touches.is_empty() {
@@ -352,6 +349,27 @@ where
             })
             .map_err(|_| capacity())
     }
+}
+
+/// The contact of a pair closing in the step farther than the thinner of them is half
+/// thick, at the features where they first meet (see `sweep`), its points within `cover`;
+/// `None` where the features closest now are the contact's.
+fn fast_pair<T: Real>(
+    (sa, pa): (&Attached<T>, &Place<T>),
+    (sb, pb): (&Attached<T>, &Place<T>),
+    margin: T,
+    cover: T,
+) -> Option<(Vec2<T>, Vec<Touch<T>, 2>)> {
+    let thinner = sa.half_width.min(sb.half_width);
+    // Their reaches bound their closing: a pile at rest looks no further.
+    if pa.reach + pb.reach <= thinner {
+        return None;
+    }
+    let (a, b) = (pa.moving(sa), pb.moving(sb));
+    if closing(&a, &b) <= thinner {
+        return None;
+    }
+    swept(&a, &b, margin, cover)
 }
 
 /// More contact points than the world holds.

@@ -34,14 +34,14 @@ pub(crate) struct Place<T> {
 }
 
 impl<T: Real> Place<T> {
-    /// Its shape moving through the step, `shape` the shape in its link's frame (in the
-    /// world's for a static one).
-    pub(crate) fn moving<'a>(&self, shape: &'a Shape<T>) -> Moving<'a, T> {
+    /// Its shape moving through the step, `s` the shape as attached (in its link's frame;
+    /// in the world's for a static one).
+    pub(crate) fn moving<'a>(&self, s: &'a Attached<T>) -> Moving<'a, T> {
         Moving {
-            shape,
+            shape: &s.shape,
             from: self.pose,
             to: self.then,
-            reach: self.reach,
+            extent: s.extent,
         }
     }
 }
