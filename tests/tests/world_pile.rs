@@ -199,9 +199,10 @@ fn deepest<T: Real>(
 /// the depths' median within the slop and 2% (a resting contact rests at the slop) and the
 /// worst within 20 mm.
 ///
-/// Measured over the throws (f32, f64): the median depth 5.0 mm and 5.0 mm, the worst 7.6
-/// and 5.5 mm; a joint past its limit moving 2.4e-4 and 2.2e-13 rad/s at worst further past
-/// it (2.6e-3 when the limits were swept 32 times, not solved).
+/// Measured over the throws (f32, f64): the median depth 4.9 mm and 5.0 mm, the worst 6.4
+/// and 5.1 mm (7.6 and 5.5 before fast pairs were taken where they meet); a joint past its
+/// limit moving 2.8e-5 and 2.1e-13 rad/s at worst further past it (2.6e-3 when the limits
+/// were swept 32 times, not solved).
 /// The solve without locked limits (see `lagrange_world`'s `locks`) fails these: depths 24
 /// mm at worst, 1.4e-2 rad/s into a limit, a limit passed by 5.29 mm.
 fn three_ragdolls_land<T: Real>() -> Result<(), Error> {
@@ -290,10 +291,10 @@ for_f32_and_f64!(three_ragdolls_land);
 /// Measured over the throws (f32, f64): limits passed by 5.002 and 5.000 mm at worst, joints
 /// moving 1.2e-3 and 1.0e-12 rad/s further past them (0.015 to 0.037 when the limits were
 /// swept, not solved: the bound was 0.03, and throws not drawn here passed it); median
-/// depths 9.2 and 9.6 mm, the worst 13 and 30 mm; asleep by steps 682 and 984 (the f64
-/// pile of seed 3 slid at step 700, and a doll crept at 0.03 to 0.07 m/s, about the sleep
-/// speed, until 984; over 24 throws every other pile of either precision was asleep by
-/// 728). With the drift swept once (the settings' 8 sweeps, not again while a contact is
+/// depths 8.4 and 9.8 mm, the worst 24 and 18 mm; asleep by steps 801 and 749. (Before fast
+/// pairs were taken where they meet: 9.2 and 9.6 mm, 13 and 30 mm, asleep by 682 and 984,
+/// where the f64 pile of seed 3 slid at step 700 and a doll crept at about the sleep speed
+/// until 984.) With the drift swept once (the settings' 8 sweeps, not again while a contact is
 /// left a slop deeper than it asks), the medians were 19 to 36 mm: the pile sank into
 /// itself, its weight not carried down in 8 sweeps. Not the slop for depth: where a pile
 /// lands at 20 m/s, a limb turning fast meets another at points its contact's manifold, taken
