@@ -23,9 +23,9 @@
 //!   sequential impulses in the bodies' generalized coordinates (momentum kept, a bounded
 //!   cost a step), fast pairs taken where their paths first meet in the step (a ball at
 //!   1,000 m/s bounces off a plank 1 cm thick), islands that fall asleep and wake as a
-//!   whole, contact events, ray and point queries. A pyramid of 55 boxes stands and sleeps. [`OneOf`] makes a world of two
-//!   kinds of body (balls and the pendulums they strike; nested, more), each with its own
-//!   law and links.
+//!   whole, contact events, ray and point queries. A pyramid of 55 boxes stands and sleeps.
+//!   [`OneOf`] makes a world of two kinds of body (balls and the pendulums they strike;
+//!   nested, more), each with its own law and links.
 //! - [`PlaneContacts`]: the contact rows of a mechanism's shapes against static half-planes,
 //!   for `ImpulseStepper` and `ContactStepper` (a crate on the floor, a wheel rolling down a
 //!   slope), from its [`Links`](lagrange_core::links::Links) alone.

@@ -1,17 +1,18 @@
 //! Where two shapes moving through a step first come close: conservative advancement.
 //!
 //! A contact taken where two shapes are closest at a step's start is the wrong contact when
-//! they move farther in the step than the thinner of them is half thick: a ball 5 m from a
-//! plank 1 cm thick, coming at it slantwise at 300 m/s, is closest to the plank's end at the
-//! start, and it strikes the plank's middle. Its speculative contact at the end either stops
-//! it where there is nothing (a ghost impulse) or lets it through the middle: a 10 cm ball
-//! shot at 20 to 1,000 m/s at a free plank of 0.1 to 100 kg, bouncing, passed through or sank
-//! past the slop in 36 of 768 shots (`tests/tests/world_fast.rs`). Moved to where they first
-//! come within the margin, the two shapes meet at the features that will touch: none of the
-//! 768 fails. Where they do not meet in the step, the advance ends where they come closest,
-//! and a speculative contact there guards a path the impulses bend; taken at the start's
-//! closest features instead, a ball passing over a light plank's end struck it a ghost blow
-//! that spun it at 159 rad/s.
+//! they close on each other farther in the step than the thinner of them is half thick: a ball 5 m from a
+//! plank 1 cm thick, coming at it slantwise at 300 m/s, is closest to the plank's end at
+//! the start, and it strikes the plank's middle. Its speculative contact at the end either
+//! stops it where there is nothing (a ghost impulse) or lets it through the middle: a ball
+//! of 10 cm radius shot at 20 to 1,000 m/s at a free plank of 0.1 to 100 kg, bouncing,
+//! passed through or sank past the slop in 36 of 768 shots (`tests/tests/world_fast.rs`).
+//! Moved to where they first come within the margin, the two shapes meet at the features
+//! that will touch: none of the 768 fails. Where they do not meet in the step, the advance
+//! ends where they come closest, and a speculative contact there guards a path the impulses
+//! bend; taken at the start's closest features instead, a ball stopping 5 cm short of a
+//! light plank's middle struck the plank's end (closest at the start, 1.3 m off its path) a
+//! ghost blow that spun it at 159 rad/s.
 //!
 //! Each shape's link moves from its pose at the step's start to its pose at the step's end
 //! (its coordinates advanced by its velocities), origin and angle in proportion to the

@@ -177,14 +177,15 @@ fn aims(plank: Option<f64>, angle: f64) -> std::vec::Vec<f64> {
     }
 }
 
-/// The shots of `speeds` from 0 to 1.2 rad off the plank's normal at `planks`, arriving at
-/// three points of their steps, with `restitution`: how many, and a line for each that failed
-/// (passed through the plank, or left the ball deeper in it than the slop after a step).
-fn failures<T: Real>(
+/// Shoots the shots of `speeds` from 0 to 1.2 rad off the plank's normal at `planks`,
+/// arriving at three points of their steps, with `restitution`, and asserts that none passes
+/// through the plank or leaves the ball deeper in it than the slop after a step (listing
+/// each that does).
+fn every_shot_holds<T: Real>(
     speeds: &[f64],
     planks: &[Option<f64>],
     restitution: f64,
-) -> Result<(usize, std::vec::Vec<String>), Error> {
+) -> Result<(), Error> {
     let mut failed = std::vec::Vec::new();
     let mut shots = 0;
     for &speed in speeds {
@@ -212,16 +213,6 @@ fn failures<T: Real>(
             }
         }
     }
-    Ok((shots, failed))
-}
-
-/// A ball of 10 cm radius shot at 20 to 1,000 m/s (7 to 340 times the plank's thickness and
-/// 1 to 80 times the ball's diameter a step at 60 Hz) at a plank 4 m long and 1 cm thick,
-/// static or free (0.1 to 100 times the ball's mass), bouncing off it (restitution 0.5): it
-/// never passes through the plank, and never overlaps it deeper than the slop after a step.
-fn a_fast_ball_does_not_pass_through_a_thin_plank<T: Real>() -> Result<(), Error> {
-    let planks = [None, Some(0.1), Some(1.0), Some(10.0), Some(100.0)];
-    let (shots, failed) = failures::<T>(&[20.0, 100.0, 300.0, 1000.0], &planks, 0.5)?;
     assert!(
         failed.is_empty(),
         "{} of {shots} shots:\n{}",
@@ -229,19 +220,23 @@ fn a_fast_ball_does_not_pass_through_a_thin_plank<T: Real>() -> Result<(), Error
         failed.join("\n")
     );
     Ok(())
+}
+
+/// A ball of 10 cm radius shot at 20 to 1,000 m/s (33 to 1,700 times the plank's thickness
+/// and 1.7 to 83 times the ball's diameter a step at 60 Hz) at a plank 4 m long and 1 cm
+/// thick, static or free (0.1 to 100 times the ball's mass), bouncing off it (restitution
+/// 0.5): it never passes through the plank, and never overlaps it deeper than the slop after
+/// a step. (36 of these 768 shots failed, 35 of them through the plank, with the contacts
+/// taken at the features closest at the step's start.)
+fn a_fast_ball_does_not_pass_through_a_thin_plank<T: Real>() -> Result<(), Error> {
+    let planks = [None, Some(0.1), Some(1.0), Some(10.0), Some(100.0)];
+    every_shot_holds::<T>(&[20.0, 100.0, 300.0, 1000.0], &planks, 0.5)
 }
 
 /// A ball shot at a static plank at 20 to 300 m/s with no bounce (restitution 0), left to slide
 /// along it (up to 4.7 m a step at 1.2 rad): it stays on its side, no deeper than the slop.
 fn a_ball_struck_flat_on_a_static_plank_stays_on_its_side<T: Real>() -> Result<(), Error> {
-    let (shots, failed) = failures::<T>(&[20.0, 100.0, 300.0], &[None], 0.0)?;
-    assert!(
-        failed.is_empty(),
-        "{} of {shots} shots:\n{}",
-        failed.len(),
-        failed.join("\n")
-    );
-    Ok(())
+    every_shot_holds::<T>(&[20.0, 100.0, 300.0], &[None], 0.0)
 }
 
 for_f32_and_f64!(

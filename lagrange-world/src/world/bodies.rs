@@ -104,8 +104,8 @@ pub(crate) struct Attached<T> {
     /// How far the shape reaches from its link's origin: its farthest vertex and its
     /// radius (what a turn of the link moves its farthest point by, per radian).
     pub(crate) extent: T,
-    /// Half its thinnest width ([`Shape::half_width`]): a body moving this far in a step
-    /// may pass the features closest at the step's start (see `sweep`).
+    /// Half its thinnest width ([`Shape::half_width`]): a shape closing on it this far in a
+    /// step may pass the features closest at the step's start (see `sweep`).
     pub(crate) half_width: T,
     pub(crate) group: u32,
     pub(crate) mask: u32,

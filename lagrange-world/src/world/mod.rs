@@ -151,7 +151,7 @@ pub struct WorldHit<T> {
 /// 1. free       v* = v + dt a(q, v)                          each awake body's own law
 /// 2. detect     contacts at q: broad phase, narrow phase     rows J (normal, tangent) at q
 ///               within the margin (plus how far a body moves), mobilities M^-1 J^T;
-///               a pair moving farther than the thinner of them is half thick: at the
+///               a pair closing farther than the thinner of them is half thick: at the
 ///               features where their paths first bring them within the margin
 ///               (conservative advancement), or where they come closest
 /// 3. solve      impulses by projected Gauss-Seidel, `sweeps` sweeps over the contacts in
@@ -189,21 +189,21 @@ pub struct WorldHit<T> {
 /// impulses scaled back to where they leave the least kinetic energy, without rebounds, and
 /// where that still adds some, from zero impulses.
 ///
-/// **Cost.** Detection: each awake body's links posed twice (where they are and where the
-/// step takes them: [`Links::poses`]), the broad phase's sweep and prune over the shapes, one
-/// narrow phase a pair that may touch (a pair moving farther than the thinner is half thick:
-/// up to 24 distances of their cores on the way, two to five where they strike head-on); then per contact point its rows' Jacobians, and
-/// their mobilities from each body's mass solve, eight contact points of a body to a call
-/// of [`Mechanism::velocity_jumps`] (one factorisation of a ragdoll's mass matrix for
-/// them; a constant mass matrix: a multiply a row). The solve: `sweeps` passes over the
-/// contacts, `8 N` multiply-adds a contact a pass, in an order that lets rows of bodies
-/// apart go at once; the drift: `sweeps` passes again, up to `4 sweeps` where a pile is
-/// left deep (each time one pass more over the contacts to see whether). A body the solve
-/// changed is posed once more where its new velocity takes it; a step whose impulses send one
-/// into a shape it has no contact with (a limb whipped by a landing: 3 to 16 steps of the
-/// 900 of ten ragdolls thrown into a pile) detects and solves twice; a solve the guard
-/// takes again sweeps at most twice more. Asleep bodies cost nothing but their shapes'
-/// place in the broad phase.
+/// **Cost.** Detection: each awake body's links posed twice (where they are and where the step
+/// takes them: [`Links::poses`]), the broad phase's sweep and prune over the shapes, one narrow
+/// phase a pair that may touch (a pair closing farther than the thinner is half thick: up to 24
+/// distances of their cores on the way, two to five where they strike head-on); then per
+/// contact point its rows' Jacobians, and their mobilities from each body's mass solve, eight
+/// contact points of a body to a call of [`Mechanism::velocity_jumps`] (one factorisation of a
+/// ragdoll's mass matrix for them; a constant mass matrix: a multiply a row). The solve:
+/// `sweeps` passes over the contacts, `8 N` multiply-adds a contact a pass, in an order that
+/// lets rows of bodies apart go at once; the drift: `sweeps` passes again, up to `4 sweeps`
+/// where a pile is left deep (each time one pass more over the contacts to see whether). A body
+/// the solve changed is posed once more where its new velocity takes it; a step whose impulses
+/// send one into a shape it has no contact with (a limb whipped by a landing: 3 to 16 steps of
+/// the 900 of ten ragdolls thrown into a pile) detects and solves twice; a solve the guard
+/// takes again sweeps at most twice more. Asleep bodies cost nothing but their shapes' place in
+/// the broad phase.
 ///
 /// **Determinism.** Contacts are solved in the order of their keys (the shapes' keys and
 /// the features that meet), islands are named by their least body key (and, asleep, the
