@@ -91,12 +91,6 @@ pub fn collide<T: Real>(a: &Shape<T>, b: &Shape<T>, margin: T) -> Manifold<T> {
     one_point(a, b, normal, [pa, pb], d - radii, margin)
 }
 
-/// How far apart the surfaces of `a` and `b` are (negative: overlapping by up to their
-/// radii), or `None` where their cores overlap.
-pub(crate) fn separation<T: Real>(a: &Shape<T>, b: &Shape<T>) -> Option<T> {
-    core_distance(a, b).map(|(_, _, d)| d - (a.radius() + b.radius()))
-}
-
 /// A static half-plane: the points `x` with `normal . x >= offset` are free; the others are
 /// inside it (the floor: normal `(0, 1)`, offset 0).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -261,7 +255,7 @@ fn edges<T: Real>(s: &Shape<T>) -> impl Iterator<Item = (Vec2<T>, Vec2<T>)> + '_
 
 /// The closest points of the cores of `a` and `b` and their distance, or `None` where the
 /// cores overlap (they cross, or one holds the other).
-fn core_distance<T: Real>(a: &Shape<T>, b: &Shape<T>) -> Option<(Vec2<T>, Vec2<T>, T)> {
+pub(crate) fn core_distance<T: Real>(a: &Shape<T>, b: &Shape<T>) -> Option<(Vec2<T>, Vec2<T>, T)> {
     let mut best: Option<(Vec2<T>, Vec2<T>, T)> = None;
     for (p0, p1) in edges(a) {
         for (q0, q1) in edges(b) {

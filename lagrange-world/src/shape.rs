@@ -175,27 +175,6 @@ impl<T: Real> Shape<T> {
         self.radius
     }
 
-    /// Half its thinnest width: its radius and, for a polygon, half the least depth of its
-    /// core behind any of its edges (a box's half height where it is wider than high).
-    pub(crate) fn half_width(&self) -> T {
-        let depth = |(&w, &n): (&Vec2<T>, &Vec2<T>)| {
-            self.vertices()
-                .iter()
-                .map(|&v| -dot(sub(v, w), n))
-                .fold(T::zero(), T::max)
-        };
-        let least = if self.count >= 3 {
-            self.vertices()
-                .iter()
-                .zip(self.normals())
-                .map(depth)
-                .fold(T::INFINITY, T::min)
-        } else {
-            T::zero()
-        };
-        self.radius + least * T::HALF
-    }
-
     /// The smallest box holding the shape, `(lower, upper)` corners: what a broad phase
     /// sorts.
     #[must_use]

@@ -38,7 +38,7 @@
 //! static plank, 1 of 192 (a graze of its end at 1,000 m/s that slips round the corner
 //! onto its face).
 
-use crate::collide::{collide, separation};
+use crate::collide::{collide, core_distance};
 use crate::manifold::{ContactPoint, Manifold};
 use crate::shape::Shape;
 use crate::vec2::{add, dot, length, rotate, sub, Vec2};
@@ -49,6 +49,37 @@ use lagrange_core::Real;
 /// The most steps of an advance (a strike head-on takes two or three, a graze more: each
 /// closes a share of the gap).
 const ADVANCES: usize = 24;
+
+/// Half the thinnest width of `shape`: its radius and, for a polygon, half the least depth
+/// of its core behind any of its edges (a box's half height where it is wider than high). A
+/// shape closing on it farther than this in a step may pass the features closest at the
+/// step's start.
+pub(crate) fn half_width<T: Real>(shape: &Shape<T>) -> T {
+    let (vertices, normals) = (shape.vertices(), shape.normals());
+    let depth = |(&w, &n): (&Vec2<T>, &Vec2<T>)| {
+        vertices
+            .iter()
+            .map(|&v| -dot(sub(v, w), n))
+            .fold(T::zero(), T::max)
+    };
+    // A point or a segment has no depth behind an edge.
+    let least = if vertices.len() >= 3 {
+        vertices
+            .iter()
+            .zip(normals)
+            .map(depth)
+            .fold(T::INFINITY, T::min)
+    } else {
+        T::zero()
+    };
+    shape.radius() + least * T::HALF
+}
+
+/// How far apart the surfaces of `a` and `b` are (negative: overlapping by up to their
+/// radii), or `None` where their cores overlap.
+fn separation<T: Real>(a: &Shape<T>, b: &Shape<T>) -> Option<T> {
+    core_distance(a, b).map(|(_, _, d)| d - (a.radius() + b.radius()))
+}
 
 /// A shape moving through a step: its shape in its link's frame, its link's pose at the
 /// step's start and at its end, and how far its farthest point is from its link's origin.
@@ -201,6 +232,39 @@ mod tests {
             origin: [x, y],
             angle: 0.0,
         }
+    }
+
+    /// Half the thinnest width of each kind of shape, worked by hand: a plank's half
+    /// thickness whichever way it stands, a circle's and a capsule's radius, a rounded box's
+    /// half height and rounding, an equilateral triangle's half height (sqrt 3 / 4 for sides
+    /// of 1), whichever vertex it is given from.
+    #[test]
+    fn half_widths() -> Result<(), lagrange_core::Error> {
+        let h = 3.0_f64.sqrt() / 2.0;
+        let cases = [
+            (Shape::rectangle(4.0, 0.01)?, 0.005),
+            (Shape::rectangle(0.01, 4.0)?, 0.005),
+            (Shape::circle(0.1)?, 0.1),
+            (Shape::capsule(0.5, 0.05)?, 0.05),
+            (Shape::rectangle(1.0, 0.5)?.rounded(0.02)?, 0.27),
+            (
+                Shape::polygon(&[[0.0, 0.0], [1.0, 0.0], [0.5, h]])?,
+                h / 2.0,
+            ),
+            (
+                Shape::polygon(&[[1.0, 0.0], [0.5, h], [0.0, 0.0]])?,
+                h / 2.0,
+            ),
+        ];
+        for (shape, expected) in cases {
+            let got = half_width(&shape);
+            // Rounding of a few products of unit size.
+            assert!(
+                (got - expected).abs() < 1e-15,
+                "{shape:?}: {got}, not {expected}"
+            );
+        }
+        Ok(())
     }
 
     /// A ball of radius 0.1 coming down slantwise at a plank 4 m long and 1 cm thick (static),

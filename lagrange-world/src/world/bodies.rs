@@ -1,6 +1,7 @@
 //! A [`World`](super::World)'s bodies and the shapes on them.
 
 use crate::shape::Shape;
+use crate::sweep::half_width;
 use crate::vec2::{add, length, Vec2};
 use lagrange_core::links::{Links, Pose};
 use lagrange_core::nalgebra::SVector;
@@ -104,7 +105,7 @@ pub(crate) struct Attached<T> {
     /// How far the shape reaches from its link's origin: its farthest vertex and its
     /// radius (what a turn of the link moves its farthest point by, per radian).
     pub(crate) extent: T,
-    /// Half its thinnest width ([`Shape::half_width`]): a shape closing on it this far in a
+    /// Half its thinnest width (`sweep::half_width`): a shape closing on it this far in a
     /// step may pass the features closest at the step's start (see `sweep`).
     pub(crate) half_width: T,
     pub(crate) group: u32,
@@ -125,7 +126,7 @@ impl<T: Real> Attached<T> {
             on,
             shape,
             extent,
-            half_width: shape.half_width(),
+            half_width: half_width(&shape),
             group: 1,
             mask: u32::MAX,
         }
