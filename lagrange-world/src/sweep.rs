@@ -199,9 +199,10 @@ pub(crate) fn swept<T: Real>(
 /// How far into the step (0 to 1) the advance of `a` and `b` goes: to the time they first
 /// come within `margin` (> 0) of each other (or a time before that where the advance took
 /// all its steps), or, where they stay farther apart through the step, to the last time it
-/// reached short of the step's end, where they come closest on its way (the features a
-/// speculative contact of theirs is to be taken at: those closest at the start may be ones
-/// they never come near, and a contact there pushes them apart for nothing).
+/// reached, past which they cannot come within the margin before the step's end: on a path
+/// that closes, near where they come closest (the features a speculative contact of theirs
+/// is to be taken at: those closest at the start may be ones they never come near, and a
+/// contact there pushes them apart for nothing).
 pub(crate) fn first_meeting<T: Real>(a: &Moving<'_, T>, b: &Moving<'_, T>, margin: T) -> T {
     let speed = closing(a, b);
     let mut t = T::zero();
