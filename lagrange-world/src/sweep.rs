@@ -235,6 +235,45 @@ mod tests {
         }
     }
 
+    /// A bar 4 m long and 1 cm thick turning about its middle from -0.04 to 0.06 rad in the
+    /// step (its tips 0.2 m), and a ball of radius 0.1 at rest 1.5 m out, 0.1 rad round:
+    /// the bar's face reaches the ball when the bar is at 0.03 rad, 0.7 of the step in. The
+    /// advance, bounded by the bar's turn times its reach, meets it there within the margin
+    /// and never inside it, in the few steps a turn this slow needs.
+    #[test]
+    fn a_turning_bar_meets_a_ball_where_its_face_sweeps_it() -> Result<(), lagrange_core::Error> {
+        let bar = Shape::rectangle(4.0, 0.01)?;
+        let ball = Shape::circle(0.1)?;
+        let margin = 0.004;
+        let turning = |angle: f64| Pose {
+            origin: [0.0, 0.0],
+            angle,
+        };
+        let a = Moving {
+            shape: &bar,
+            from: turning(-0.04),
+            to: turning(0.06),
+            extent: (2.0_f64.powi(2) + 0.005_f64.powi(2)).sqrt(),
+        };
+        let (s, c) = 0.1_f64.sin_cos();
+        let b = Moving {
+            shape: &ball,
+            from: still(1.5 * c, 1.5 * s),
+            to: still(1.5 * c, 1.5 * s),
+            extent: 0.1,
+        };
+        let t = first_meeting(&a, &b, margin);
+        let d = separation(&a.at(t), &ball.placed(&b.from)).unwrap_or(-1.0);
+        assert!((margin / 2.0..=margin).contains(&d), "{d} m apart at {t}");
+        // Where the face reaches the ball: sin(0.1 - angle) = 0.105 / 1.5.
+        let meets = (0.1 - (0.105_f64 / 1.5).asin() + 0.04) / 0.1;
+        assert!(
+            t < meets && t > meets - 0.05,
+            "at {t}, not just before {meets}"
+        );
+        Ok(())
+    }
+
     /// Half the thinnest width of each kind of shape, worked by hand: a plank's half
     /// thickness whichever way it stands, a circle's and a capsule's radius, a rounded box's
     /// half height and rounding, an equilateral triangle's half height (sqrt 3 / 4 for sides
