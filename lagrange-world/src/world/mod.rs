@@ -174,33 +174,32 @@ pub struct WorldHit<T> {
 /// 6. sleep      islands (bodies joined by contacts) at rest for the set time fall asleep
 /// ```
 ///
-/// The rows are taken at the step's start, so an impulse acts on both bodies at the same
-/// point, equal and opposite: linear and angular momentum are kept to rounding through
-/// every contact's impulses (no other scheme of the library's keeps them through friction
-/// off the centre). A pair met later in the step is pushed at the start, each body at the
-/// point of it that will touch: the two points are apart by the pair's move to the meeting,
-/// and the angular momentum moves by the impulse times that lever (the linear is kept); the
-/// drift correction, which moves positions alone, keeps the linear
-/// momentum but moves the angular momentum of bodies that slide across the contact it
-/// corrects. The scheme is first order; between contacts each body moves by semi-implicit
-/// Euler, whose energy error stays bounded. Impulses never add kinetic energy: where the
-/// solve would (rebounds of several contacts at once, or last step's impulses warm-starting
-/// a contact that let go), it is done again ([`WorldReport::guarded`]): from its own
-/// impulses scaled back to where they leave the least kinetic energy, without rebounds, and
-/// where that still adds some, from zero impulses.
+/// The rows are taken at the step's start, so an impulse acts on both bodies at the same point,
+/// equal and opposite: linear and angular momentum are kept to rounding through every contact's
+/// impulses (no other scheme of the library's keeps them through friction off the centre). A
+/// pair met later in the step is pushed at the start, each body at the point of it that will
+/// touch: the two points are apart by the pair's move to the meeting, and the angular momentum
+/// moves by the impulse times that lever (the linear is kept); the drift correction, which
+/// moves positions alone, keeps the linear momentum but moves the angular momentum of bodies
+/// that slide across the contact it corrects. The scheme is first order; between contacts each
+/// body moves by semi-implicit Euler, whose energy error stays bounded. Impulses never add
+/// kinetic energy: where the solve would (rebounds of several contacts at once, or last step's
+/// impulses warm-starting a contact that let go), it is done again ([`WorldReport::guarded`]):
+/// from its own impulses scaled back to where they leave the least kinetic energy, without
+/// rebounds, and where that still adds some, from zero impulses.
 ///
 /// **Cost.** Detection: each awake body's links posed twice (where they are and where the step
 /// takes them: [`Links::poses`]), the broad phase's sweep and prune over the shapes, one narrow
 /// phase a pair that may touch (a pair closing farther than the thinner is half thick: up to 24
 /// distances of their cores on the way: two where they strike head-on, more the more slantwise,
-/// each closing the gap by the cosine of their path's angle off the normal, some 6 at 50
-/// degrees and 13 at 70 from 4 m with a 2 cm margin); then per contact point its rows'
-/// Jacobians, and their mobilities from each body's mass solve, eight contact points of a body
-/// to a call of [`Mechanism::velocity_jumps`] (one factorisation of a ragdoll's mass matrix for
-/// them; a constant mass matrix: a multiply a row). The solve: `sweeps` passes over the
-/// contacts, `8 N` multiply-adds a contact a pass, in an order that lets rows of bodies apart
-/// go at once; the drift: `sweeps` passes again, up to `4 sweeps` where a pile is left deep
-/// (each time one pass more over the contacts to see whether). A body the solve changed is
+/// each closing the share of the gap that is the cosine of their path's angle off the normal:
+/// some 6 at 50 degrees and 13 at 70 from 4 m with a 2 cm margin); then per contact point its
+/// rows' Jacobians, and their mobilities from each body's mass solve, eight contact points of a
+/// body to a call of [`Mechanism::velocity_jumps`] (one factorisation of a ragdoll's mass
+/// matrix for them; a constant mass matrix: a multiply a row). The solve: `sweeps` passes over
+/// the contacts, `8 N` multiply-adds a contact a pass, in an order that lets rows of bodies
+/// apart go at once; the drift: `sweeps` passes again, up to `4 sweeps` where a pile is left
+/// deep (each time one pass more over the contacts to see whether). A body the solve changed is
 /// posed once more where its new velocity takes it; a step whose impulses send one into a shape
 /// it has no contact with (a limb whipped by a landing: 3 to 16 steps of the 900 of ten
 /// ragdolls thrown into a pile) detects and solves twice; a solve the guard takes again sweeps

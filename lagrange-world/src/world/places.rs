@@ -106,9 +106,14 @@ impl<T: Real, const N: usize> Posed<T, N> {
     where
         M: Mechanism<T, N> + Links<T, N>,
     {
-        let then = self.link(body, link);
-        length(sub(then.origin, pose.origin)) + (then.angle - pose.angle).abs() * extent
+        travel(pose, &self.link(body, link), extent)
     }
+}
+
+/// How far any point of a shape reaching `extent` from its link's origin moves when the link
+/// goes from `from` to `to`: the origin's move and the turn times the extent.
+fn travel<T: Real>(from: &Pose<T>, to: &Pose<T>, extent: T) -> T {
+    length(sub(to.origin, from.origin)) + (to.angle - from.angle).abs() * extent
 }
 
 /// Every shape of `shapes` placed (in their order), `by_body` naming the shapes on bodies
@@ -156,15 +161,18 @@ pub(crate) fn place<T, M, L, const N: usize, const B: usize, const S: usize>(
             };
             let link = s.on.map_or(0, |(_, link)| link);
             let pose = now.link(body, link);
-            let reach = [&ahead, &also]
+            // Posed once: the sweep's end and the reach's (a link past `POSED` is a pose
+            // call of its own).
+            let then = ahead.as_ref().map_or(pose, |a| a.link(body, link));
+            let reach = also
+                .as_ref()
+                .map(|a| a.reach(body, s.extent, link, &pose))
                 .into_iter()
-                .flatten()
-                .map(|then| then.reach(body, s.extent, link, &pose))
-                .fold(T::zero(), T::max);
+                .fold(T::zero().max(travel(&pose, &then, s.extent)), T::max);
             *place = Place {
                 shape: s.shape.placed(&pose),
                 pose,
-                then: ahead.as_ref().map_or(pose, |then| then.link(body, link)),
+                then,
                 reach,
             };
         }
